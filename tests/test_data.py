@@ -251,3 +251,18 @@ def test_gaitutils_source():
     assert {"emg_GAM_r", "emg_TA_l", "emg_SOL_r"} <= set(d.channels)
     with pytest.raises(data.DataError, match="no rows for speed class 'Fast'"):
         data.load_gait_data("Fast", source="gaitutils")
+
+
+def test_planned_mtp_hits_table_4_6_postures():
+    dsp, ssp, rng = 0.1, 0.4, np.deg2rad(30)
+    knots = [0, dsp, dsp + ssp, 1.9 * dsp + ssp, 2 * dsp + ssp, 1.0]
+    vals = [0, 0, 0.12 * rng, 0.4 * rng, 0, 0]
+    np.testing.assert_allclose(data.planned_mtp(knots, dsp, ssp, rng), vals, atol=1e-12)
+    # zero velocity at the postures (quintic blend): central differences vanish
+    h = 1e-6
+    for k in knots[1:-1]:
+        v = (data.planned_mtp(k + h, dsp, ssp, rng) - data.planned_mtp(k - h, dsp, ssp, rng)) / (2 * h)
+        assert abs(v) < 1e-4
+    d = data.load_gait_data("Free")
+    assert d.mean["mtp_r"].max() == pytest.approx(0.4 * np.ptp(d.mean["ankle_r"]), rel=0.02)
+    assert (d.sd["mtp_r"] == 0).all()

@@ -599,6 +599,35 @@ def fourier_shift(x: np.ndarray, shift: float, order: int = 5) -> np.ndarray:
     return basis(t + shift) @ (np.linalg.pinv(basis(t)) @ x)
 
 
+def planned_mtp(frac, t_dsp: float, t_ssp: float, ankle_range: float, theta0: float = 0.0) -> np.ndarray:
+    """Planned right metatarsal angle over one cycle (thesis Sec 4.2.2, Table 4.6), rad.
+
+    Six postures — heel strike, toe strike, heel off, toe off, toe free, heel strike — at
+    t = 0, t_DSP, t_DSP + t_SSP, 1.9 t_DSP + t_SSP, 2 t_DSP + t_SSP, 2 (t_DSP + t_SSP) (as
+    fractions of the cycle), with angles θ0, θ0, 0.12 Δθ_a, 0.4 Δθ_a, θ0, θ0 and zero
+    angular velocity and acceleration at each: a 5th-order polynomial between neighbours
+    (θ_a + (θ_b − θ_a)(10 s³ − 15 s⁴ + 6 s⁵)). Positive = toe dorsiflexion (conventions).
+
+    Parameters
+    ----------
+    frac : array of cycle fractions in [0, 1].
+    t_dsp, t_ssp : double- and single-support durations as fractions of the cycle
+        (one of each per half cycle).
+    ankle_range : Δθ_a, the ankle angle's range over the cycle, rad.
+    theta0 : the metatarsal angle while the toe is free, rad.
+    """
+    frac = np.asarray(frac, dtype=float)
+    knots = np.array([0.0, t_dsp, t_dsp + t_ssp, 1.9 * t_dsp + t_ssp, 2 * t_dsp + t_ssp,
+                      2 * (t_dsp + t_ssp)])
+    if np.any(np.diff(knots) <= 0):
+        raise DataError(f"planned_mtp: postures not increasing in time: {knots}")
+    vals = np.array([theta0, theta0, 0.12 * ankle_range, 0.4 * ankle_range, theta0, theta0])
+    f = np.clip(frac, 0.0, knots[-1])
+    i = np.clip(np.searchsorted(knots, f, side="right") - 1, 0, len(knots) - 2)
+    s_ = (f - knots[i]) / (knots[i + 1] - knots[i])
+    return vals[i] + (vals[i + 1] - vals[i]) * (10 * s_**3 - 15 * s_**4 + 6 * s_**5)
+
+
 @dataclass(frozen=True)
 class GaitData:
     """Mean ± SD of one data set and speed class, as the model sees it.
@@ -709,10 +738,10 @@ def speed_and_cycle_time(speed_class: str, body_height: float = cv.BODY_HEIGHT,
 
 def _channel_sort_key(name: str):
     """pelvis, angles, torques, powers, GRFs, EMG; right before left; hip, knee, ankle."""
-    kinds = {"pelvis": 0, "hip": 1, "knee": 1, "ankle": 1, "tau": 2, "pow": 3, "grf": 4, "emg": 5}
+    kinds = {"pelvis": 0, "hip": 1, "knee": 1, "ankle": 1, "mtp": 1, "tau": 2, "pow": 3, "grf": 4, "emg": 5}
     kind = kinds.get(name.split("_")[0], 6)
     side = 0 if name.endswith("_r") else 1
-    joint = next((i for i, j in enumerate(("hip", "knee", "ankle", "x", "y")) if f"_{j}_" in f"_{name}"), 9)
+    joint = next((i for i, j in enumerate(("hip", "knee", "ankle", "mtp", "x", "y")) if f"_{j}_" in f"_{name}"), 9)
     return (kind, side, joint, name)
 
 
@@ -807,6 +836,19 @@ def load_gait_data(speed_class: str = "Free", source: str = "schwartz2008",
                 notes.append("gaitutils EMG: left and right envelopes are the source's own (not shifted).")
             else:
                 add(quantity, "1", g["percent_cycle"].to_numpy(), g["mean"].to_numpy(), g["sd"].to_numpy())
+    # planned metatarsal angles (no data; thesis Sec 4.2.2), SD 0
+    if "ankle_r" in mean_cols:
+        t_dsp = float(ev.get("opposite_foot_off", 0.1))
+        t_ssp = shift - t_dsp
+        rng = float(np.ptp(mean_cols["ankle_r"]))
+        grid = np.linspace(0.0, 1.0, n_data)
+        mtp = planned_mtp(grid, t_dsp, t_ssp, rng)
+        mean_cols["mtp_r"] = np.interp(frac, grid, mtp)
+        mean_cols["mtp_l"] = np.interp(frac, grid, fourier_shift(mtp, shift, fourier_order))
+        for c in ("mtp_r", "mtp_l"):
+            sd_cols[c] = np.zeros_like(frac)
+            units[c] = "rad"
+        notes.append("mtp_r, mtp_l are planned trajectories (thesis Sec 4.2.2, Table 4.6), not data.")
     time = pd.Index(frac * sp["cycle_time"], name="time")
     order = sorted(mean_cols, key=_channel_sort_key)
     mean = pd.DataFrame({c: mean_cols[c] for c in order}, index=time)
