@@ -1,0 +1,571 @@
+"""The thesis's gait optimal control formulation, on top of :mod:`gaitlib.ocp`.
+
+A :class:`GaitSpec` (frozen, hashable: *what* to solve — model, actuation, data, speed
+class, cost function and weights, mesh, free parameters) becomes an
+:class:`gaitlib.ocp.Problem` with :func:`build`; :func:`solve` returns a
+:class:`GaitSolution` with tidy frames (q, torques, GRFs per foot and per ellipsoid,
+activations, residuals), RMSE/NRMSE against the data and the solver's stats.
+
+Formulation (thesis Secs 4.3.2, 5.2.1, 6.1)
+-------------------------------------------
+states   x = [q, q̇, q̈]                                         (Eq 4.6 / 5.28), 33
+controls u = [jerk (11), R_pelvis (3), actuation]                (Eq 4.7 / 5.29)
+         actuation SK: τ (8 joint torques); MSK: τ_mtp (2) + a (12 MTG activations)
+dynamics ẋ = [q̇, q̈, jerk]                                        (Eq 4.9)
+implicit dynamics, path constraint: inverse_dynamics(q, q̇, q̈) − [R; τ_input] = 0 (11)
+         (Eq 4.10/5.30 bound the square of this difference to [0, 1e-12]; we impose the
+         equality directly — the same set, better conditioned for IPOPT)
+residual bounds |R_x|, |R_y| ≤ 1 N, |R_z| ≤ 0.1 N·m              (Eq 4.8)
+per-ellipsoid normal force ≥ 0 (optional, Sec 4.4.1)
+μ_d/μ_s ∈ [0.55, 0.99] when contact parameters are free          (Eq 4.4)
+fixed final time = the data's cycle time; **periodic** gait: x(t_f) = x(0) except
+pelvis_tx, which advances by speed × cycle time. The thesis bounds the initial and final
+states by the data instead of imposing periodicity; periodicity is our departure (a
+steady gait cycle, no drift), stated in the book.
+
+Cost terms (Eqs 4.11–4.13, 5.33, 6.1–6.10), each ``(1/t_f) ∫ Σ_i (e_i / range_i)² dt``
+with ranges (max − min) of the data:
+``Jrk`` t_f⁶ Σ (jerk/range)², ``Rsd`` residuals (ranges from their bounds), ``Imp``
+(τ_inv − τ_input) on the 8 leg joints (≈ 0 under the equality constraint), ``HAT`` the 3
+HAT coordinates vs a reference, ``Act`` activations (range 1), ``Trq`` hip/knee/ankle
+torques (6), ``Ang`` hip/knee/ankle angles (6), ``GRF`` the 4 foot forces, and ``Q`` —
+the motion term of Eqs 4.11 and 5.33 over all 11 coordinates (HAT, joints and the planned
+metatarsal angles).
+
+HAT reference: pelvis_tx = speed·t; pelvis_ty such that the lowest ellipsoid of the
+data's pose sits 2 mm below the ground; pelvis_tilt = 0 (thesis Sec 4.2.1: negligible
+variation, set to zero).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from dataclasses import asdict, dataclass, field
+from functools import cached_property
+from typing import Any
+
+import casadi as ca
+import numpy as np
+import pandas as pd
+
+from . import __version__
+from . import contact as contact_mod
+from . import conventions as cv
+from . import data as data_mod
+from .collocation import Mesh
+from .model import ChildModel
+from .ocp import Goal, Guess, Named, Parameter, PathConstraint, Periodic, Phase, PhaseGuess, Problem, SolverOptions
+from . import ocp
+
+MODELS = ("SK", "MSK")
+TERMS = ("Jrk", "Rsd", "Imp", "HAT", "Act", "Trq", "Ang", "GRF", "Q")
+LEG_JOINTS = tuple(f"{j}_{s}" for s in cv.SIDES for j in ("hip", "knee", "ankle"))  # 6 tracked
+MTG_CONTROLS = tuple(f"a_{j}_{d}_{s}" for s in cv.SIDES for j in ("hip", "knee", "ankle") for d in ("ext", "flex"))
+GRF_CHANNELS = ("grf_x_r", "grf_y_r", "grf_x_l", "grf_y_l")
+
+#: Cost functions: model → name → weights (thesis Tables 4.8, 5.3, 6.2).
+COST_FUNCTIONS: dict[str, dict[str, dict[str, float]]] = {
+    "SK": {
+        # Eq 4.11, Table 4.8 (optimal control contact identification, Sec 4.3.2)
+        "Eq4.11": {"Trq": 1 / 4, "GRF": 1 / 4, "Q": 1 / 4, "Jrk": 1 / 40},
+        # Eq 4.11 + 4.12 + 4.13 (Sec 4.4: w5 = w6 = 1/4)
+        "Eq4.13": {"Trq": 1 / 4, "GRF": 1 / 4, "Q": 1 / 4, "Jrk": 1 / 40, "Imp": 1 / 4, "Rsd": 1 / 4},
+    },
+    "MSK": {
+        # Eq 5.33, Table 5.3 (natural gait, Sec 5.2)
+        "Eq5.33": {"Trq": 1 / 4, "GRF": 1 / 4, "Q": 1 / 4, "Jrk": 1 / 40, "Act": 1 / 100,
+                   "Rsd": 1 / 4, "Imp": 1 / 40},
+    },
+}
+# Table 6.2, MSK rows (Ch 6); HAT tracks a reference, Act = Act_MSK
+_T62 = {
+    "DT": (1 / 40, 1 / 4, 1 / 40, 1 / 4, 1 / 100, 1 / 4, 1 / 4, 1 / 4),
+    "SDT1": (1 / 40, 1 / 4, 1 / 4, 1 / 4, 1 / 100, 0, 1 / 4, 1 / 4),
+    "SDT2": (1 / 40, 1 / 4, 1 / 4, 1 / 4, 1 / 100, 1 / 4, 0, 1 / 4),
+    "SDT3": (1 / 40, 1 / 4, 1 / 4, 1 / 4, 1 / 100, 1 / 4, 1 / 4, 0),
+    "SP1": (1 / 40, 1 / 10, 1 / 3, 1 / 2, 1 / 100, 0, 0, 1 / 4),
+    "SP2": (1 / 40, 1 / 4, 1 / 4, 1 / 4, 1 / 100, 0, 1 / 4, 0),
+    "SP3": (1 / 40, 1 / 4, 1 / 4, 1 / 4, 1 / 100, 1 / 4, 0, 0),
+    "FP": (1 / 40, 1 / 4, 1 / 4, 1 / 4, 1 / 100, 0, 0, 0),
+}
+for _name, _w in _T62.items():
+    COST_FUNCTIONS["MSK"][_name] = {k: v for k, v in zip(("Jrk", "Rsd", "Imp", "HAT", "Act", "Trq", "Ang", "GRF"), _w) if v}
+# SK data tracking "DT" = the Ch 4 cost (Eq 4.11) for convenience in the CLI
+COST_FUNCTIONS["SK"]["DT"] = COST_FUNCTIONS["SK"]["Eq4.11"]
+COST_FUNCTIONS["MSK"].setdefault("Eq5.33", COST_FUNCTIONS["MSK"]["Eq5.33"])
+
+
+@dataclass(frozen=True)
+class GaitSpec:
+    """What to solve: a natural-gait (or speed-class) optimal control problem.
+
+    Parameters
+    ----------
+    model : ``"SK"`` (joint torques) or ``"MSK"`` (12 MTG activations + metatarsal torques).
+    cost : a key of ``COST_FUNCTIONS[model]`` (e.g. ``"Eq4.11"``, ``"Eq5.33"``, ``"DT"``).
+    weights : optional overrides, a tuple of ``(term, weight)`` pairs.
+    speed_class, source : the data (:func:`gaitlib.data.load_gait_data`).
+    n_intervals, degree, scheme : the mesh (thesis: 20 × 5 LGR = 100 nodes).
+    periodic : impose a periodic cycle (our departure, see module docstring).
+    normal_force_constraint : each ellipsoid's normal force ≥ 0 (Sec 4.4.1).
+    free_contact, free_body : identify the 39 contact / 25 body parameters (Ch 4).
+    body_params : ``"default"`` (Tables 4.1–4.3 scaled) or ``"thesis"`` (Tables 4.15–4.16).
+    tol, max_iter : IPOPT settings (thesis: tol 1e-5).
+    """
+
+    model: str = "SK"
+    cost: str = "DT"
+    weights: tuple = ()
+    speed_class: str = "Free"
+    source: str = "schwartz2008"
+    n_intervals: int = 20
+    degree: int = 5
+    scheme: str = "lgr"
+    periodic: bool = True
+    normal_force_constraint: bool = False
+    free_contact: bool = False
+    free_body: bool = False
+    body_params: str = "default"
+    residual_bounds: tuple = (1.0, 1.0, 0.1)
+    tol: float = 1e-5
+    max_iter: int = 1000
+    hessian: str = "exact"
+
+    def __post_init__(self):
+        if self.model not in MODELS:
+            raise ValueError(f"unknown model {self.model!r}; known {MODELS}")
+        if self.cost not in COST_FUNCTIONS[self.model]:
+            raise ValueError(f"unknown cost {self.cost!r} for {self.model}; known {sorted(COST_FUNCTIONS[self.model])}")
+        for k, _ in self.weights:
+            if k not in TERMS:
+                raise ValueError(f"unknown cost term {k!r}; known {TERMS}")
+        if self.speed_class not in cv.SPEED_CLASSES:
+            raise ValueError(f"unknown speed class {self.speed_class!r}; known {cv.SPEED_CLASSES}")
+
+    @property
+    def term_weights(self) -> dict[str, float]:
+        w = dict(COST_FUNCTIONS[self.model][self.cost])
+        w.update(dict(self.weights))
+        return {k: v for k, v in w.items() if v}
+
+    def key(self) -> str:
+        """Hash of the full spec and the library version (cache key)."""
+        blob = json.dumps({**asdict(self), "version": __version__}, sort_keys=True, default=str)
+        return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+
+# ======================================================================================
+# Reference data on the model's channels
+# ======================================================================================
+
+
+def _fourier_derivatives(y: np.ndarray, T: float, order: int = 12, n_der: int = 3):
+    """Least-squares Fourier fit of a periodic sample on t_j = j T/(n−1), j = 0..n−1, and
+    its analytic time derivatives; returns a callable t → (n_der+1, len(t))."""
+    n = y.size
+    t = np.linspace(0.0, T, n)
+    k = np.arange(1, order + 1)
+    w = 2 * np.pi * k / T
+
+    def basis(tt, der):
+        tt = np.atleast_1d(tt)
+        cols = [np.ones_like(tt) if der == 0 else np.zeros_like(tt)]
+        ph = np.outer(tt, w)
+        # d^der/dt^der of cos(w t) and sin(w t)
+        c = np.cos(ph + der * np.pi / 2) * w**der
+        s = np.sin(ph + der * np.pi / 2) * w**der
+        return np.column_stack(cols + [c, s])
+
+    coef = np.linalg.lstsq(basis(t[:-1], 0), y[:-1], rcond=None)[0]  # drop duplicate end point
+    return lambda tt: np.vstack([basis(tt, d) @ coef for d in range(n_der + 1)])
+
+
+@dataclass(frozen=True, eq=False)
+class Reference:
+    """Data (and derived references) on the model's channels, SI, on a time grid."""
+
+    gait: data_mod.GaitData
+    q: pd.DataFrame  # reference coordinates (11), incl. HAT estimate and planned mtp
+    deriv: dict  # name → callable t → (4, n): q, q̇, q̈, jerk from Fourier fits
+    tau: pd.DataFrame  # 6 joint torques
+    grf: pd.DataFrame  # 4 foot forces
+    ranges: dict  # channel → (max − min) for normalisation
+
+
+def reference(gait: data_mod.GaitData, model: ChildModel, p_contact=None, order: int = 12) -> Reference:
+    """Model-channel references from data: joint angles (data), metatarsal (planned), HAT
+    (pelvis_tx = speed·t, pelvis_ty from the lowest ellipsoid at 2 mm penetration,
+    pelvis_tilt = 0); torques; GRFs; Fourier-fit derivatives for the guess and jerk ranges."""
+    T = gait.cycle_time
+    t = gait.time
+    qd = {}
+    for c in cv.COORDS[3:]:
+        qd[c] = gait.mean[c].to_numpy()
+    qd["pelvis_tilt"] = np.zeros_like(t)
+    qd["pelvis_tx"] = gait.speed * t
+    # pelvis height: lowest ellipsoid 2 mm below ground for the data pose
+    Q = np.zeros((t.size, 11))
+    for i, c in enumerate(cv.COORDS):
+        if c not in ("pelvis_tx", "pelvis_ty"):
+            Q[:, i] = qd[c]
+    pc = contact_mod.default_params() if p_contact is None else np.asarray(p_contact)
+    radii = [pc[13 * k + 4:13 * k + 7] for k in range(3)] * 2
+    bottoms = np.zeros(t.size)
+    for n in range(t.size):
+        C, Rs = model.ellipsoid_poses(Q[n], pc)
+        low = [C[e, 1] - math.sqrt(float((Rs[e] @ np.diag(np.square(radii[e])) @ Rs[e].T)[1, 1]))
+               for e in range(6)]
+        bottoms[n] = min(low)
+    qd["pelvis_ty"] = -bottoms - 0.002
+    qref = pd.DataFrame({c: qd[c] for c in cv.COORDS}, index=pd.Index(t, name="time"))
+    deriv = {}
+    for c in cv.COORDS:
+        y = qref[c].to_numpy()
+        if c == "pelvis_tx":
+            deriv[c] = (lambda tt, v=gait.speed: np.vstack([v * np.atleast_1d(tt), v + 0 * np.atleast_1d(tt),
+                                                            0 * np.atleast_1d(tt), 0 * np.atleast_1d(tt)]))
+        else:
+            deriv[c] = _fourier_derivatives(y, T, order)
+    tau = gait.mean[[f"tau_{j}" for j in LEG_JOINTS]].copy()
+    tau.columns = list(LEG_JOINTS)
+    grf = gait.mean[list(GRF_CHANNELS)].copy()
+    ranges = {}
+    fine = np.linspace(0, T, 401)
+    for c in cv.COORDS:
+        vals = deriv[c](fine)
+        ranges[c] = float(np.ptp(qref[c])) if c != "pelvis_tx" else float(gait.speed * T)
+        ranges[f"jerk_{c}"] = float(np.ptp(vals[3])) if np.ptp(vals[3]) > 0 else 1.0
+    for c in LEG_JOINTS:
+        ranges[f"tau_{c}"] = float(np.ptp(tau[c]))
+    for c in GRF_CHANNELS:
+        ranges[c] = float(np.ptp(grf[c]))
+    for c in ("mtp_r", "mtp_l", "pelvis_tilt"):
+        ranges[c] = max(ranges[c], 10 * cv.DEG)  # planned / zero references: avoid 1/0
+    return Reference(gait=gait, q=qref, deriv=deriv, tau=tau, grf=grf, ranges=ranges)
+
+
+# ======================================================================================
+# Problem
+# ======================================================================================
+
+
+@dataclass(eq=False)
+class GaitProblem:
+    """A built gait problem: the spec, the ocp Problem, mesh, options and guess."""
+
+    spec: GaitSpec
+    model: ChildModel
+    ref: Reference
+    problem: Problem
+    mesh: Mesh
+    options: SolverOptions
+    guess: Guess
+    p_body: np.ndarray
+    p_contact: np.ndarray
+
+
+def _controls(spec: GaitSpec) -> tuple[str, ...]:
+    jerk = tuple(f"jerk_{c}" for c in cv.COORDS)
+    if spec.model == "SK":
+        act = tuple(f"tau_{j}" for j in cv.JOINTS)
+    else:
+        act = ("tau_mtp_r", "tau_mtp_l") + MTG_CONTROLS
+    return jerk + cv.RESIDUALS + act
+
+
+def build(spec: GaitSpec) -> GaitProblem:
+    """Turn a :class:`GaitSpec` into an :class:`ocp.Problem` with mesh, options, guess."""
+    model = ChildModel()
+    gait = data_mod.load_gait_data(spec.speed_class, spec.source)
+    p_body = model.p_body_identified() if spec.body_params == "thesis" else model.default_p_body()
+    p_contact = contact_mod.default_params()
+    ref = reference(gait, model, p_contact)
+    T = gait.cycle_time
+    w = spec.term_weights
+
+    states = tuple(cv.COORDS) + tuple(f"qd_{c}" for c in cv.COORDS) + tuple(f"qdd_{c}" for c in cv.COORDS)
+    controls = _controls(spec)
+    Qn, QDn, QDDn = list(cv.COORDS), [f"qd_{c}" for c in cv.COORDS], [f"qdd_{c}" for c in cv.COORDS]
+    JRK = [f"jerk_{c}" for c in cv.COORDS]
+
+    # ---- static parameters
+    params: list[Parameter] = []
+    if spec.free_contact:
+        lo, hi = contact_mod.bounds(include_defaults=True)
+        for n_, l_, h_, g_ in zip(contact_mod.param_names(), lo, hi, p_contact):
+            params.append(Parameter(f"c.{n_}", float(l_), float(h_), float(g_)))
+    if spec.free_body:
+        lo, hi = model.p_body_bounds()
+        for n_, l_, h_, g_ in zip(model.p_body_names, lo, hi, p_body):
+            params.append(Parameter(f"b.{n_}", float(l_), float(h_), float(g_)))
+
+    def pvec(p: Named):
+        pc = ca.vertcat(*[p[f"c.{n}"] for n in contact_mod.param_names()]) if spec.free_contact else ca.DM(p_contact)
+        pb = ca.vertcat(*[p[f"b.{n}"] for n in model.p_body_names]) if spec.free_body else ca.DM(p_body)
+        return pb, pc
+
+    f_id = model.function("inverse_dynamics")
+    f_ct = model.function("contact")
+    cache: dict = {}
+
+    def node(x: Named, u: Named, p: Named):
+        """Inverse dynamics, contact and input torques at a node, computed once per trace."""
+        key = (id(x), id(u), id(p))
+        if key in cache:
+            return cache[key]
+        q, qd, qdd = x[Qn], x[QDn], x[QDDn]
+        pb, pc = pvec(p)
+        tau_id, R_id = f_id(q, qd, qdd, pb, pc)
+        ct = f_ct(q=q, qd=qd, p_contact=pc)
+        if spec.model == "SK":
+            tau_in = ca.vertcat(*[u[f"tau_{j}"] for j in cv.JOINTS])
+        else:
+            from . import mtg
+
+            tin = {}
+            for s in cv.SIDES:
+                for j in ("hip", "knee", "ankle"):
+                    c = f"{j}_{s}"
+                    tin[c] = mtg.joint_torque(j, x[c], x[f"qd_{c}"], u[f"a_{j}_ext_{s}"], u[f"a_{j}_flex_{s}"])
+                tin[f"mtp_{s}"] = u[f"tau_mtp_{s}"]
+            tau_in = ca.vertcat(*[tin[j] for j in cv.JOINTS])
+        R_in = ca.vertcat(*[u[r] for r in cv.RESIDUALS])
+        out = {"tau_id": tau_id, "R_id": R_id, "tau_in": tau_in, "R_in": R_in,
+               "grf": ca.vertcat(ct["grf_x"][0], ct["grf_y"][0], ct["grf_x"][1], ct["grf_y"][1]),
+               "fn_raw": ct["fn_raw"]}
+        cache[key] = out
+        return out
+
+    rg = ref.ranges
+    path = [PathConstraint("dynamics", lambda x, u, p, t: ca.vertcat(node(x, u, p)["R_id"] - node(x, u, p)["R_in"],
+                                                                        node(x, u, p)["tau_id"] - node(x, u, p)["tau_in"]),
+                           0.0, 0.0)]
+    if spec.normal_force_constraint:
+        path.append(PathConstraint("normal_force", lambda x, u, p, t: node(x, u, p)["fn_raw"], 0.0, np.inf))
+    if spec.free_contact:
+        def ratio(x0, xf, p, t0, tf):
+            out = []
+            for e in cv.ELLIPSOIDS:
+                out += [p[f"c.{e}.mu_d"] - 0.55 * p[f"c.{e}.mu_s"], 0.99 * p[f"c.{e}.mu_s"] - p[f"c.{e}.mu_d"]]
+            return ca.vertcat(*out)
+        endpoint = (ocp.EndpointConstraint("friction_ratio", ratio, 0.0, np.inf),)
+    else:
+        endpoint = ()
+
+    def sq(e, r):
+        return (e / r) ** 2
+
+    goals = []
+
+    def goal(name, f):
+        if name in w:
+            goals.append(Goal(name, weight=w[name], integrand=f, divide_by_duration=True))
+
+    goal("Jrk", lambda x, u, p, t: T**6 * sum(sq(u[f"jerk_{c}"], rg[f"jerk_{c}"]) for c in cv.COORDS))
+    rb = dict(zip(cv.RESIDUALS, spec.residual_bounds))
+    goal("Rsd", lambda x, u, p, t: sum(sq(u[r], 2 * rb[r]) for r in cv.RESIDUALS))
+    goal("Imp", lambda x, u, p, t: sum(sq(node(x, u, p)["tau_id"][i] - node(x, u, p)["tau_in"][i],
+                                           rg.get(f"tau_{j}", rg[f"tau_{j.replace('mtp', 'ankle')}"]))
+                                        for i, j in enumerate(cv.JOINTS)))
+    goal("HAT", lambda x, u, p, t, d: sum(sq(x[c] - d[f"ref_{c}"], rg[c]) for c in cv.COORDS[:3]))
+    if spec.model == "MSK":
+        goal("Act", lambda x, u, p, t: sum(u[a] ** 2 for a in MTG_CONTROLS))
+    goal("Trq", lambda x, u, p, t, d: sum(sq(node(x, u, p)["tau_in"][cv.JOINTS.index(j)] - d[f"ref_tau_{j}"], rg[f"tau_{j}"])
+                                          for j in LEG_JOINTS))
+    goal("Ang", lambda x, u, p, t, d: sum(sq(x[j] - d[f"ref_{j}"], rg[j]) for j in LEG_JOINTS))
+    goal("GRF", lambda x, u, p, t, d: sum(sq(node(x, u, p)["grf"][i] - d[f"ref_{g}"], rg[g])
+                                          for i, g in enumerate(GRF_CHANNELS)))
+    goal("Q", lambda x, u, p, t, d: sum(sq(x[c] - d[f"ref_{c}"], rg[c]) for c in cv.COORDS))
+
+    # ---- data on normalised time τ ∈ [0, 1]
+    tau_grid = ref.q.index.to_numpy() / T
+    dat = {f"ref_{c}": ref.q[c].to_numpy() for c in cv.COORDS}
+    dat.update({f"ref_tau_{j}": ref.tau[j].to_numpy() for j in LEG_JOINTS})
+    dat.update({f"ref_{g}": ref.grf[g].to_numpy() for g in GRF_CHANNELS})
+    data_frame = pd.DataFrame(dat, index=tau_grid)
+
+    # ---- bounds (generous, from the data; thesis: "based on the standard deviation")
+    bounds = {}
+    for c in cv.COORDS[3:]:
+        lo = float((gait.mean[c] - 3 * gait.sd[c]).min()) - 15 * cv.DEG
+        hi = float((gait.mean[c] + 3 * gait.sd[c]).max()) + 15 * cv.DEG
+        bounds[c] = (lo, hi)
+    bounds["pelvis_tilt"] = (-30 * cv.DEG, 30 * cv.DEG)
+    bounds["pelvis_ty"] = (0.5, 1.0)
+    bounds["pelvis_tx"] = (-0.5, gait.speed * T + 0.5)
+    for c in cv.COORDS:
+        bounds[f"qd_{c}"] = (-20.0, 20.0)
+        bounds[f"qdd_{c}"] = (-500.0, 500.0)
+        bounds[f"jerk_{c}"] = (-2e4, 2e4)
+    for r, b in rb.items():
+        bounds[r] = (-b, b)
+    if spec.model == "SK":
+        for j in cv.JOINTS:
+            bounds[f"tau_{j}"] = (-250.0, 250.0)
+    else:
+        for a in MTG_CONTROLS:
+            bounds[a] = (0.0, 1.0)
+        for s in cv.SIDES:
+            bounds[f"tau_mtp_{s}"] = (-150.0, 150.0)
+
+    periodic = None
+    if spec.periodic:
+        periodic = Periodic(states, offsets={"pelvis_tx": gait.speed * T})
+
+    phase = Phase(
+        name="cycle", states=states, controls=controls,
+        dynamics=lambda x, u, p, t: ca.vertcat(x[QDn], x[QDDn], u[JRK]),
+        t0=0.0, tf=T, bounds=bounds, initial={"pelvis_tx": 0.0},
+        path_constraints=tuple(path), endpoint_constraints=endpoint, goals=tuple(goals),
+        periodic=periodic, data=data_frame,
+    )
+    problem = Problem(phases=(phase,), parameters=tuple(params), name=f"gait_{spec.model}_{spec.cost}".replace(".", ""))
+    mesh = Mesh(spec.n_intervals, spec.scheme, spec.degree)
+    options = SolverOptions(tol=spec.tol, max_iter=spec.max_iter, hessian=spec.hessian)
+    guess = initial_guess(spec, model, ref, p_body, p_contact)
+    return GaitProblem(spec, model, ref, problem, mesh, options, guess, p_body, p_contact)
+
+
+def initial_guess(spec: GaitSpec, model: ChildModel, ref: Reference, p_body, p_contact) -> Guess:
+    """Data-based guess (thesis Sec 4.3.2): states and jerks from Fourier fits of the
+    reference; torques from data (metatarsal 0) or, for MSK, activations from the
+    inverse MTG (Sec 5.2.1); residuals 0."""
+    T = ref.gait.cycle_time
+    t = np.linspace(0.0, T, 201)
+    S, C = {}, {}
+    for c in cv.COORDS:
+        v = ref.deriv[c](t)
+        S[c], S[f"qd_{c}"], S[f"qdd_{c}"] = v[0], v[1], v[2]
+        C[f"jerk_{c}"] = v[3]
+    for r in cv.RESIDUALS:
+        C[r] = np.zeros_like(t)
+    tau = {j: np.interp(t, ref.tau.index, ref.tau[j]) for j in LEG_JOINTS}
+    if spec.model == "SK":
+        for j in cv.JOINTS:
+            C[f"tau_{j}"] = tau.get(j, np.zeros_like(t))
+    else:
+        from . import mtg
+
+        for s in cv.SIDES:
+            C[f"tau_mtp_{s}"] = np.zeros_like(t)
+            for j in ("hip", "knee", "ankle"):
+                c = f"{j}_{s}"
+                a = mtg.activation_for_torque(j, tau[c], S[c], S[f"qd_{c}"])
+                C[f"a_{j}_ext_{s}"] = np.asarray(a["a_ext"], float)
+                C[f"a_{j}_flex_{s}"] = np.asarray(a["a_flex"], float)
+    return Guess(phases={"cycle": PhaseGuess(time=t, states=S, controls=C)})
+
+
+# ======================================================================================
+# Solution
+# ======================================================================================
+
+
+@dataclass(eq=False)
+class GaitSolution:
+    """A solved gait: the raw :class:`ocp.Solution` plus tidy, named results.
+
+    Frames are indexed by time (s) at the collocation nodes: ``q`` (11 coordinates, SI),
+    ``torques`` (8 joint torques applied, N·m), ``residuals`` (3), ``grf`` (per foot
+    grf_x_r, grf_y_r, grf_x_l, grf_y_l, N), ``ellipsoids`` (fn/fx per ellipsoid, N),
+    ``activations`` (MSK). ``rmse`` is a table per channel against the data mean.
+    """
+
+    spec: GaitSpec
+    solution: ocp.Solution
+    q: pd.DataFrame
+    qd: pd.DataFrame
+    torques: pd.DataFrame
+    residuals: pd.DataFrame
+    grf: pd.DataFrame
+    ellipsoids: pd.DataFrame
+    activations: pd.DataFrame | None
+    rmse: pd.DataFrame
+    stats: dict
+
+    @property
+    def success(self) -> bool:
+        return self.solution.success
+
+
+def _rmse_table(sol_q, torques, grf, ref: Reference) -> pd.DataFrame:
+    gait = ref.gait
+    t = sol_q.index.to_numpy()
+    rows = []
+
+    def add(kind, ch, sim, dat, sd, unit, scale=1.0):
+        err = sim - dat
+        rmse = float(np.sqrt(np.mean(err**2)))
+        rng = float(np.ptp(dat)) or 1.0
+        rows.append({"kind": kind, "channel": ch, "rmse": rmse * scale, "nrmse (% range)": 100 * rmse / rng,
+                     "mean |z| (SD units)": float(np.mean(np.abs(err) / np.maximum(sd, 1e-9))) if np.any(sd > 0) else np.nan,
+                     "unit": unit})
+
+    for j in LEG_JOINTS:
+        add("angle", j, sol_q[j].to_numpy(), np.interp(t, gait.time, gait.mean[j]), np.interp(t, gait.time, gait.sd[j]),
+            "deg", 1 / cv.DEG)
+    for j in LEG_JOINTS:
+        add("torque", j, torques[j].to_numpy(), np.interp(t, gait.time, gait.mean[f"tau_{j}"]),
+            np.interp(t, gait.time, gait.sd[f"tau_{j}"]), "N*m")
+    for g in GRF_CHANNELS:
+        add("grf", g, grf[g].to_numpy(), np.interp(t, gait.time, gait.mean[g]), np.interp(t, gait.time, gait.sd[g]), "N")
+    return pd.DataFrame(rows)
+
+
+def solve(spec: GaitSpec | GaitProblem, guess: Guess | None = None) -> GaitSolution:
+    """Build (if needed) and solve; never hides a failure (``success``/``stats['status']``)."""
+    gp = build(spec) if isinstance(spec, GaitSpec) else spec
+    sol = ocp.solve(gp.problem, gp.mesh, gp.options, guess or gp.guess)
+    return postprocess(gp, sol)
+
+
+def postprocess(gp: GaitProblem, sol: ocp.Solution) -> GaitSolution:
+    spec, model = gp.spec, gp.model
+    ph = sol.phase("cycle")
+    X, U = ph.states, ph.controls
+    t_u = U.index.to_numpy()
+    Xu = ph.interpolate(t_u) if len(X) != len(U) else X
+    if hasattr(Xu, "columns") and not set(cv.COORDS) <= set(Xu.columns):
+        Xu = X.reindex(t_u)
+    pb = np.array([sol.parameters[f"b.{n}"] for n in model.p_body_names]) if spec.free_body else gp.p_body
+    pc = np.array([sol.parameters[f"c.{n}"] for n in contact_mod.param_names()]) if spec.free_contact else gp.p_contact
+    q = Xu[list(cv.COORDS)]
+    qd = Xu[[f"qd_{c}" for c in cv.COORDS]]
+    qd.columns = list(cv.COORDS)
+    f_ct = model.function("contact").map(len(t_u))
+    ct = f_ct(q.to_numpy().T, qd.to_numpy().T, ca.repmat(ca.DM(pc), 1, len(t_u)))
+    ct = {k: np.asarray(v) for k, v in zip(model.function("contact").name_out(), ct)}
+    grf = pd.DataFrame({"grf_x_r": ct["grf_x"][0], "grf_y_r": ct["grf_y"][0],
+                        "grf_x_l": ct["grf_x"][1], "grf_y_l": ct["grf_y"][1]}, index=q.index)
+    ell = {}
+    for i, lab in enumerate(model.ellipsoid_labels):
+        ell[f"fn_{lab}"] = ct["fn"][i]
+        ell[f"fx_{lab}"] = ct["fx"][i]
+    ellipsoids = pd.DataFrame(ell, index=q.index)
+    if spec.model == "SK":
+        torques = pd.DataFrame({j: U[f"tau_{j}"].to_numpy() for j in cv.JOINTS}, index=q.index)
+        acts = None
+    else:
+        from . import mtg
+
+        tq = {}
+        for s in cv.SIDES:
+            for j in ("hip", "knee", "ankle"):
+                c = f"{j}_{s}"
+                tq[c] = np.asarray(mtg.joint_torque(j, q[c].to_numpy(), qd[c].to_numpy(),
+                                                    U[f"a_{j}_ext_{s}"].to_numpy(), U[f"a_{j}_flex_{s}"].to_numpy()), float).ravel()
+            tq[f"mtp_{s}"] = U[f"tau_mtp_{s}"].to_numpy()
+        torques = pd.DataFrame({j: tq[j] for j in cv.JOINTS}, index=q.index)
+        acts = U[list(MTG_CONTROLS)].copy()
+    residuals = U[list(cv.RESIDUALS)].copy()
+    rmse = _rmse_table(q, torques, grf, gp.ref)
+    stats = {
+        "status": sol.status, "success": sol.success, "iterations": sol.iterations,
+        "solve_time_s": sol.solve_time, "build_time_s": sol.build_time,
+        "time_per_iteration_s": sol.time_per_iteration, "objective": sol.objective,
+        "max_violation": sol.max_violation, "n_variables": sol.info.get("n_variables"),
+        "n_constraints": sol.info.get("n_constraints"), "spec_key": spec.key(),
+    }
+    return GaitSolution(spec, sol, q, qd, torques, residuals, grf, ellipsoids, acts, rmse, stats)
