@@ -64,6 +64,8 @@ TERMS = ("Jrk", "Rsd", "Imp", "HAT", "Act", "Trq", "Ang", "GRF", "Q")
 LEG_JOINTS = tuple(f"{j}_{s}" for s in cv.SIDES for j in ("hip", "knee", "ankle"))  # 6 tracked
 MTG_CONTROLS = tuple(f"a_{j}_{d}_{s}" for s in cv.SIDES for j in ("hip", "knee", "ankle") for d in ("ext", "flex"))
 GRF_CHANNELS = ("grf_x_r", "grf_y_r", "grf_x_l", "grf_y_l")
+#: R_max − R_min of thesis Eq 4.8 (N, N, N·m): the Rsd normalisation.
+RESIDUAL_RANGE = (2.0, 2.0, 0.2)
 
 #: Cost functions: model → name → weights (thesis Tables 4.8, 5.3, 6.2).
 COST_FUNCTIONS: dict[str, dict[str, dict[str, float]]] = {
@@ -365,7 +367,10 @@ def build(spec: GaitSpec) -> GaitProblem:
 
     goal("Jrk", lambda x, u, p, t: T**6 * sum(sq(u[f"jerk_{c}"], rg[f"jerk_{c}"]) for c in cv.COORDS))
     rb = dict(zip(cv.RESIDUALS, spec.residual_bounds))
-    goal("Rsd", lambda x, u, p, t: sum(sq(u[r], 2 * rb[r]) for r in cv.RESIDUALS))
+    # Rsd is normalised by the thesis's residual range (Eq 4.8: ±1 N, ±0.1 N·m) even when
+    # the bounds are relaxed (continuation), so relaxing never makes residuals cheap.
+    rn = dict(zip(cv.RESIDUALS, RESIDUAL_RANGE))
+    goal("Rsd", lambda x, u, p, t: sum(sq(u[r], rn[r]) for r in cv.RESIDUALS))
     goal("Imp", lambda x, u, p, t: sum(sq(node(x, u, p)["tau_id"][i] - node(x, u, p)["tau_in"][i],
                                            rg.get(f"tau_{j}", rg[f"tau_{j.replace('mtp', 'ankle')}"]))
                                         for i, j in enumerate(cv.JOINTS)))
