@@ -109,18 +109,15 @@ MUSCLE_GENERATOR = {
     "GAM": "ankle_ext",
     "TA": "ankle_flex",
 }
-#: EMG channel of each muscle in the public data sets (side prefix R/L for gaitutils;
-#: None where Schwartz 2008 has no such channel). Schwartz's "medial hamstrings" is a
-#: second hamstrings channel; BF is matched to its lateral hamstrings.
+#: Model-view EMG channel (``gaitlib.data.GaitData`` column stem, add ``_r``/``_l``) of each
+#: muscle per data source; None where the source has no such muscle. gaitutils has the
+#: thesis's eight (``data.GAITUTILS_EMG``); Schwartz 2008 has five, of which BF is matched to
+#: its lateral hamstrings (LH) and GAM to its medial gastrocnemius (MG); its medial
+#: hamstrings (MH) channel has no thesis counterpart.
 EMG_CHANNELS = {
-    "GM": {"gaitutils": "Glut", "schwartz2008": None},
-    "RF": {"gaitutils": "Rec", "schwartz2008": "rectus femoris"},
-    "VM": {"gaitutils": "Vas", "schwartz2008": None},
-    "BF": {"gaitutils": "Ham", "schwartz2008": "lateral hamstrings"},
-    "SOL": {"gaitutils": "Sol", "schwartz2008": None},
-    "PL": {"gaitutils": "Per", "schwartz2008": None},
-    "GAM": {"gaitutils": "Gas", "schwartz2008": "medial gastrocnemius"},
-    "TA": {"gaitutils": "TibA", "schwartz2008": "tibialis anterior"},
+    m: {"gaitutils": f"emg_{m}",
+        "schwartz2008": {"RF": "emg_RF", "BF": "emg_LH", "GAM": "emg_MG", "TA": "emg_TA"}.get(m)}
+    for m in MUSCLES
 }
 
 #: Electromechanical delay d, s (thesis Eq 5.34).
