@@ -89,3 +89,345 @@ def data_bands(datasets: dict, channels, ncols: int = 3, colors=None, figsize_pe
     if title:
         fig.suptitle(title, fontsize=10)
     return fig
+
+
+# =====================================================================================
+# Stick figures and animations (child gait model, jump models)
+# =====================================================================================
+
+#: Colours of the stick figure: HAT / trunk, right leg, left leg, ground reaction forces.
+FIGURE_COLORS = {"hat": "0.15", "r": "tab:red", "l": "tab:blue", "grf": "tab:green",
+                 "ground": "0.35", "jump": "tab:purple"}
+
+
+def ellipse_outline(centre, R, radii, n: int = 64) -> np.ndarray:
+    """Outline (n, 2) of the orthographic projection of an ellipsoid on the X–Y plane, m.
+
+    The ellipsoid ``{c + R D u : |u| ≤ 1}`` (``R`` ellipsoid → ground, ``D = diag(a, b, c)``)
+    projects onto the ellipse ``{x : (x − c_xy)ᵀ A⁻¹ (x − c_xy) ≤ 1}`` whose shape matrix
+    ``A`` is the top-left 2×2 block of ``R D² Rᵀ``; its outline is ``c_xy + A^½ (cos s, sin s)``.
+    """
+    from .kinematics import shape_matrix
+
+    A = shape_matrix(R, radii)[:2, :2]
+    w, V = np.linalg.eigh(A)
+    half = V @ np.diag(np.sqrt(np.clip(w, 0.0, None))) @ V.T  # symmetric square root
+    s = np.linspace(0.0, 2.0 * np.pi, n)
+    return np.asarray(centre, dtype=float)[:2] + (half @ np.vstack([np.cos(s), np.sin(s)])).T
+
+
+def _line(ax, pts, color, lw=2.5, **kw):
+    (ln,) = ax.plot(pts[:, 0], pts[:, 1], color=color, lw=lw, solid_capstyle="round",
+                    marker="o", ms=lw * 1.2, **kw)
+    return ln
+
+
+def _set_line(ln, pts):
+    ln.set_data(pts[:, 0], pts[:, 1])
+
+
+def _ellipse_patch(ax, color, alpha=0.25):
+    from matplotlib.patches import Polygon
+
+    p = Polygon(np.zeros((3, 2)), closed=True, facecolor=color, edgecolor=color,
+                alpha=alpha, lw=0.8)
+    ax.add_patch(p)
+    return p
+
+
+def _arrow(ax, color):
+    from matplotlib.patches import FancyArrowPatch
+
+    a = FancyArrowPatch((0, 0), (0, 0), arrowstyle="-|>", mutation_scale=12, color=color,
+                        lw=2.0, zorder=5)
+    ax.add_patch(a)
+    return a
+
+
+def _set_arrow(arrow, start, vec, visible=True):
+    arrow.set_positions(tuple(start), (start[0] + vec[0], start[1] + vec[1]))
+    arrow.set_visible(bool(visible))
+
+
+def _ground(ax):
+    return ax.axhline(0.0, color=FIGURE_COLORS["ground"], lw=1.2, zorder=0)
+
+
+def _chains(segments: dict) -> dict:
+    """Group a model's two-point segments into polylines per colour key."""
+    out = {"hat": segments["hat"]}
+    for s in cv.SIDES:
+        # hip → knee → ankle → heel → mtp → ankle, and mtp → toe tip
+        out[f"leg_{s}"] = np.vstack([segments[f"thigh_{s}"], segments[f"shank_{s}"][1:],
+                                     segments[f"hindfoot_{s}"][1:], segments[f"sole_{s}"][1:],
+                                     segments[f"forefoot_{s}"][:1]])
+        out[f"toe_{s}"] = segments[f"toe_{s}"]
+    return out
+
+
+def _chain_color(name: str) -> str:
+    return FIGURE_COLORS["hat"] if name == "hat" else FIGURE_COLORS[name[-1]]
+
+
+def default_grf_scale(model) -> float:
+    """GRF arrow scale, m per N: one body weight is drawn 0.5 m long."""
+    return 0.5 / (model.body_mass * model.g)
+
+
+def model_frame(model, q, qd=None, p_contact=None, p_body=None) -> dict:
+    """Everything :func:`draw_model` draws for one pose, in numbers.
+
+    Returns a dict with ``chains`` (name → (k, 2) polylines: ``hat``, ``leg_r``, ``toe_r``,
+    ``leg_l``, ``toe_l``), ``ellipses`` (label → (n, 2) outlines, order
+    :data:`gaitlib.model.ELLIPSOID_LABELS`), ``contact`` (the :meth:`ChildModel.contact`
+    outputs) and ``bottoms`` (6,) lowest ellipsoid points, m.
+    """
+    from .kinematics import ellipsoid_bottom, ellipsoid_radii
+    from .model import ELLIPSOID_LABELS
+
+    q = np.asarray(q, dtype=float)
+    qd = np.zeros_like(q) if qd is None else np.asarray(qd, dtype=float)
+    segs = model.segments(q, p_body)
+    centres, Rs = model.ellipsoid_poses(q, p_contact)
+    radii = ellipsoid_radii(p_contact)
+    return {
+        "chains": _chains(segs),
+        "ellipses": {lab: ellipse_outline(c, R, r) for lab, c, R, r in
+                     zip(ELLIPSOID_LABELS, centres, Rs, radii)},
+        "bottoms": np.array([ellipsoid_bottom(c, R, r) for c, R, r in zip(centres, Rs, radii)]),
+        "contact": model.contact(q, qd, p_contact),
+    }
+
+
+def update_model(artists: dict, model, q, qd=None, p_contact=None, p_body=None) -> list:
+    """Move the artists returned by :func:`draw_model` to pose ``q`` (and ``qd``).
+
+    Returns the list of changed artists (for ``FuncAnimation(blit=True)``).
+    """
+    fr = model_frame(model, q, qd, p_contact, p_body)
+    changed = []
+    for name, ln in artists["chains"].items():
+        _set_line(ln, fr["chains"][name])
+        changed.append(ln)
+    for lab, patch in artists["ellipsoids"].items():
+        patch.set_xy(fr["ellipses"][lab])
+        changed.append(patch)
+    scale = artists["grf_scale"]
+    c = fr["contact"]
+    for i, s in enumerate(cv.SIDES):
+        if s not in artists["grf"]:
+            continue
+        fy, fx, cop = float(c["grf_y"][i]), float(c["grf_x"][i]), float(c["cop_x"][i])
+        _set_arrow(artists["grf"][s], (cop, 0.0), (scale * fx, scale * fy),
+                   visible=fy > artists["grf_min"])
+        changed.append(artists["grf"][s])
+    artists["frame"] = fr
+    return changed
+
+
+def draw_model(ax, model, q, qd=None, p_contact=None, p_body=None, grf=True, ellipsoids=True,
+               grf_scale=None, grf_min=None, ground=True, ellipse_alpha=0.25,
+               lw=2.5) -> dict:
+    """Draw the 11-DOF child model at pose ``q`` on ``ax`` (sagittal view, metres).
+
+    Parameters
+    ----------
+    ax : matplotlib Axes (its aspect is set to equal).
+    model : gaitlib.model.ChildModel
+    q, qd : (11,) pose and velocity (``qd`` default zeros; it only matters for the GRF,
+        through contact damping and friction).
+    p_contact, p_body : parameter vectors (defaults of the model).
+    grf : draw each foot's ground reaction force (sum of its three ellipsoids,
+        :meth:`ChildModel.contact`) as an arrow from its centre of pressure on the ground,
+        ``grf_scale`` m per N (default :func:`default_grf_scale`: 1 BW ↦ 0.5 m); hidden
+        while the foot's vertical force is below ``grf_min`` N (default 4 % of the body
+        weight, below which the arrow would be shorter than its head).
+    ellipsoids : draw the six contact ellipsoids as their exact sagittal outlines
+        (:func:`ellipse_outline`).
+    ground : draw the ground line y = 0.
+
+    HAT in dark grey, right leg red, left leg blue (:data:`FIGURE_COLORS`).
+
+    Returns
+    -------
+    dict of artists: ``chains`` (name → Line2D), ``ellipsoids`` (label → Polygon), ``grf``
+    (side → FancyArrowPatch), ``ground`` and the numbers drawn (``frame``, see
+    :func:`model_frame`). Pass it to :func:`update_model` to move the figure.
+    """
+    from .model import ELLIPSOID_LABELS
+
+    if grf_min is None:
+        grf_min = 0.04 * model.body_mass * model.g
+    artists = {"chains": {}, "ellipsoids": {}, "grf": {}, "grf_min": grf_min,
+               "grf_scale": default_grf_scale(model) if grf_scale is None else grf_scale}
+    artists["ground"] = _ground(ax) if ground else None
+    if ellipsoids:
+        for lab in ELLIPSOID_LABELS:
+            artists["ellipsoids"][lab] = _ellipse_patch(ax, FIGURE_COLORS[lab[-1]], ellipse_alpha)
+    # left leg behind (drawn first), then HAT, then right leg
+    for name in ("leg_l", "toe_l", "hat", "leg_r", "toe_r"):
+        artists["chains"][name] = _line(ax, np.zeros((2, 2)), _chain_color(name), lw=lw)
+    if grf:
+        for s in cv.SIDES:
+            artists["grf"][s] = _arrow(ax, FIGURE_COLORS["grf"])
+    update_model(artists, model, q, qd, p_contact, p_body)
+    ax.relim()
+    ax.autoscale_view()
+    ax.set_aspect("equal")
+    return artists
+
+
+def _jump_full_q(jump_model, q) -> np.ndarray:
+    q = np.asarray(q, dtype=float)
+    if q.size == len(jump_model.joints):  # welded phase: root at the standing pose
+        q = np.concatenate([np.zeros(3), q])
+    return q
+
+
+def _jump_ellipsoid_function(jump_model):
+    """Cached CasADi function q, p_contact -> ellipsoid centres (3, 3) and rotations."""
+    import casadi as ca
+
+    cache = jump_model.__dict__.setdefault("_plot_functions", {})
+    if "ellipsoids" not in cache:
+        q = ca.SX.sym("q", jump_model.n)
+        pc = ca.SX.sym("p_contact", 39)
+        st = jump_model.tree.kinematics(ca.vertsplit(q))
+        frames, _, _ = jump_model._loads(st, ca.vertsplit(pc))
+        C = ca.horzcat(*[ca.vertcat(*f["centre"]) for f in frames]).T
+        cache["ellipsoids"] = ca.Function("jump_ellipsoids", [q, pc],
+                                          [C] + [f["R"] for f in frames])
+    return cache["ellipsoids"]
+
+
+def jump_frame(jump_model, q, p_contact=None, ellipsoids=None) -> dict:
+    """Numbers :func:`draw_jump` draws: ``chains`` (one polyline toe tip → MTP → ankle →
+    knee → hip → head) and ``ellipses`` (toe, ball, heel outlines; toe-included model)."""
+    from . import contact
+
+    q = _jump_full_q(jump_model, q)
+    P = jump_model.points(q)
+    order = (["toe_tip"] if jump_model.toe else []) + ["mtp", "ankle", "knee", "hip", "head"]
+    out = {"chains": {"body": np.vstack([P[k] for k in order])}, "ellipses": {}}
+    if ellipsoids is None:
+        ellipsoids = jump_model.toe
+    if ellipsoids and jump_model.toe:
+        from .kinematics import ellipsoid_radii
+
+        pc = contact.default_params() if p_contact is None else np.asarray(p_contact, float)
+        res = _jump_ellipsoid_function(jump_model)(q, pc)
+        C = np.asarray(res[0])
+        for k, e in enumerate(cv.ELLIPSOIDS):
+            out["ellipses"][e] = ellipse_outline(C[k], np.asarray(res[1 + k]),
+                                                 ellipsoid_radii(pc)[k])
+    return out
+
+
+def draw_jump(ax, jump_model, q, p_contact=None, ellipsoids=None, ground=True, lw=2.5,
+              color=None) -> dict:
+    """Draw a vertical-jump model (:class:`gaitlib.jump.JumpModel`) at pose ``q``.
+
+    ``q`` is either the free coordinates ``(x, y, theta_z, joints…)`` or, for the welded
+    phase, the joint angles only (root at the standing pose). The toe-included model also
+    shows its three contact ellipsoids (``ellipsoids=None``: whenever the model has a toe).
+    Uses the same drawing helpers as :func:`draw_model`; returns the artists dict
+    (``chains``, ``ellipsoids``, ``ground``, ``frame``).
+    """
+    color = FIGURE_COLORS["jump"] if color is None else color
+    fr = jump_frame(jump_model, q, p_contact, ellipsoids)
+    artists = {"ground": _ground(ax) if ground else None, "frame": fr,
+               "ellipsoids": {e: _ellipse_patch(ax, color) for e in fr["ellipses"]},
+               "chains": {"body": _line(ax, fr["chains"]["body"], color, lw=lw)}}
+    for e, patch in artists["ellipsoids"].items():
+        patch.set_xy(fr["ellipses"][e])
+    ax.relim()
+    ax.autoscale_view()
+    ax.set_aspect("equal")
+    return artists
+
+
+def _pick_frames(n: int, max_frames: int) -> np.ndarray:
+    if n <= max_frames:
+        return np.arange(n)
+    return np.unique(np.round(np.linspace(0, n - 1, max_frames)).astype(int))
+
+
+def animate_gait(model, t, Q, Qd=None, p_contact=None, p_body=None, fps: float = 12,
+                 interval=None, max_frames: int = 50, camera: str = "stride",
+                 window: float = 1.6, figsize=(6.0, 4.0), dpi: int = 72, grf=True,
+                 ellipsoids=True, grf_scale=None, title=None):
+    """Animate a gait trajectory of the child model.
+
+    Parameters
+    ----------
+    model : gaitlib.model.ChildModel
+    t : (n,) s; Q : (n, 11) poses; Qd : (n, 11) velocities (default: ``np.gradient`` of Q;
+        only the GRF arrows use them).
+    fps, interval : frames per second, or the interval between frames in ms (overrides fps).
+    max_frames : at most this many frames, evenly spaced over ``t`` (keeps
+        :func:`animation_html` small: ≈ 20–40 kB per frame at the default size).
+    camera : ``"stride"`` (default) — fixed axes showing the whole motion (every point of
+        every frame plus margins), so progression is visible; ``"pelvis"`` — a window of
+        fixed width ``window`` m centred on the pelvis, moving with it (axes limits change
+        every frame, their size does not). The vertical limits are fixed over the motion in
+        both cases.
+    grf, ellipsoids, grf_scale : as :func:`draw_model`.
+
+    Returns
+    -------
+    matplotlib.animation.FuncAnimation (its figure is ``anim._fig``; the frame indices into
+    ``t`` are ``anim.frame_indices``).
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.animation import FuncAnimation
+
+    t = np.asarray(t, dtype=float)
+    Q = np.asarray(Q, dtype=float)
+    if Qd is None:
+        Qd = np.gradient(Q, t, axis=0) if len(t) > 1 else np.zeros_like(Q)
+    idx = _pick_frames(len(t), max_frames)
+    frames = [model_frame(model, Q[i], Qd[i], p_contact, p_body) for i in idx]
+    pts = np.vstack([np.vstack(list(f["chains"].values()) + list(f["ellipses"].values()))
+                     for f in frames])
+    pad = 0.08
+    ylo, yhi = min(pts[:, 1].min(), 0.0) - pad, pts[:, 1].max() + pad
+    if camera == "stride":
+        xlim = (pts[:, 0].min() - pad, pts[:, 0].max() + pad)
+    elif camera != "pelvis":
+        raise ValueError("camera must be 'stride' or 'pelvis'")
+
+    fig, ax = plt.subplots(figsize=figsize, dpi=dpi, constrained_layout=True)
+    artists = draw_model(ax, model, Q[idx[0]], Qd[idx[0]], p_contact, p_body, grf=grf,
+                         ellipsoids=ellipsoids, grf_scale=grf_scale)
+    ax.set_ylim(ylo, yhi)
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    label = ax.text(0.02, 0.96, "", transform=ax.transAxes, va="top", fontsize=9)
+    if title:
+        ax.set_title(title, fontsize=10)
+
+    def update(k):
+        i = idx[k]
+        changed = update_model(artists, model, Q[i], Qd[i], p_contact, p_body)
+        if camera == "pelvis":
+            ax.set_xlim(Q[i, 0] - window / 2, Q[i, 0] + window / 2)
+        else:
+            ax.set_xlim(*xlim)
+        label.set_text(f"t = {t[i]:.3f} s")
+        return changed + [label]
+
+    update(0)
+    interval = 1000.0 / fps if interval is None else interval
+    anim = FuncAnimation(fig, update, frames=len(idx), interval=interval, blit=False)
+    anim.frame_indices = idx
+    plt.close(fig)  # the notebook shows the animation, not a static copy
+    return anim
+
+
+def animation_html(anim) -> str:
+    """The animation as a self-contained JavaScript/HTML string (``anim.to_jshtml()``);
+    show it with ``IPython.display.HTML(animation_html(anim))``."""
+    import matplotlib as mpl
+
+    with mpl.rc_context({"animation.embed_limit": 20.0}):  # MB
+        return anim.to_jshtml()

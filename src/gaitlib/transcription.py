@@ -34,7 +34,10 @@ metatarsal angles).
 
 HAT reference: pelvis_tx = speed·t; pelvis_ty such that the lowest ellipsoid of the
 data's pose sits 2 mm below the ground; pelvis_tilt = 0 (thesis Sec 4.2.1: negligible
-variation, set to zero).
+variation, set to zero). Hip reference: the data's hip angle plus the data's pelvic tilt
+(the thigh's orientation in the laboratory), because the data's hip angle is measured from
+a pelvis tilted ≈ 11° forward while the model's HAT is upright; tracking the raw hip angle
+with an upright HAT lifts the leading heel ≈ 9 cm off the ground at heel strike.
 """
 
 from __future__ import annotations
@@ -54,6 +57,7 @@ from . import __version__
 from . import contact as contact_mod
 from . import conventions as cv
 from . import data as data_mod
+from . import kinematics
 from .collocation import Mesh
 from .model import ChildModel
 from .ocp import Goal, Guess, Named, Parameter, PathConstraint, Periodic, Phase, PhaseGuess, Problem, SolverOptions
@@ -202,25 +206,10 @@ def reference(gait: data_mod.GaitData, model: ChildModel, p_contact=None, order:
     pelvis_tilt = 0); torques; GRFs; Fourier-fit derivatives for the guess and jerk ranges."""
     T = gait.cycle_time
     t = gait.time
-    qd = {}
-    for c in cv.COORDS[3:]:
-        qd[c] = gait.mean[c].to_numpy()
-    qd["pelvis_tilt"] = np.zeros_like(t)
-    qd["pelvis_tx"] = gait.speed * t
-    # pelvis height: lowest ellipsoid 2 mm below ground for the data pose
-    Q = np.zeros((t.size, 11))
-    for i, c in enumerate(cv.COORDS):
-        if c not in ("pelvis_tx", "pelvis_ty"):
-            Q[:, i] = qd[c]
-    pc = contact_mod.default_params() if p_contact is None else np.asarray(p_contact)
-    radii = [pc[13 * k + 4:13 * k + 7] for k in range(3)] * 2
-    bottoms = np.zeros(t.size)
-    for n in range(t.size):
-        C, Rs = model.ellipsoid_poses(Q[n], pc)
-        low = [C[e, 1] - math.sqrt(float((Rs[e] @ np.diag(np.square(radii[e])) @ Rs[e].T)[1, 1]))
-               for e in range(6)]
-        bottoms[n] = min(low)
-    qd["pelvis_ty"] = -bottoms - 0.002
+    # thigh="lab": hip reference = data hip + data pelvic tilt, so that with an upright HAT
+    # each thigh keeps its measured orientation in the laboratory (kinematics.pose_from_data)
+    Q = kinematics.pose_from_data(model, gait, t, p_contact, penetration=0.002, thigh="lab")
+    qd = {c: Q[:, i] for i, c in enumerate(cv.COORDS)}
     qref = pd.DataFrame({c: qd[c] for c in cv.COORDS}, index=pd.Index(t, name="time"))
     deriv = {}
     for c in cv.COORDS:
@@ -508,8 +497,8 @@ def _rmse_table(sol_q, torques, grf, ref: Reference) -> pd.DataFrame:
                      "mean |z| (SD units)": float(np.mean(np.abs(err) / np.maximum(sd, 1e-9))) if np.any(sd > 0) else np.nan,
                      "unit": unit})
 
-    for j in LEG_JOINTS:
-        add("angle", j, sol_q[j].to_numpy(), np.interp(t, gait.time, gait.mean[j]), np.interp(t, gait.time, gait.sd[j]),
+    for j in LEG_JOINTS:  # against the tracked reference (hip: thigh in the laboratory)
+        add("angle", j, sol_q[j].to_numpy(), np.interp(t, ref.q.index, ref.q[j]), np.interp(t, gait.time, gait.sd[j]),
             "deg", 1 / cv.DEG)
     for j in LEG_JOINTS:
         add("torque", j, torques[j].to_numpy(), np.interp(t, gait.time, gait.mean[f"tau_{j}"]),

@@ -1,0 +1,134 @@
+"""Poses of the child model from data, and the exact geometry of the contact ellipsoids.
+
+Used by the figures (:mod:`gaitlib.plots`) and reusable by the transcription layer (initial
+guesses from data). SI units, signs of :mod:`gaitlib.conventions`.
+
+Ellipsoid geometry
+------------------
+An ellipsoid with centre ``c``, rotation ``R`` (ellipsoid → ground) and radii
+``D = diag(a, b, c)`` is ``{c + R D u : |u| ≤ 1}`` = ``{x : (x − c)ᵀ M⁻¹ (x − c) ≤ 1}``
+with ``M = R D² Rᵀ``. Its support function in the direction ``e`` is ``sqrt(eᵀ M e)``, so its
+lowest point lies at ``y = c_y − sqrt(e_yᵀ M e_y)`` (:func:`ellipsoid_bottom`), and its
+orthographic projection on the X–Y plane is the ellipse whose 2×2 shape matrix is the
+top-left block of ``M`` (:func:`gaitlib.plots.ellipse_outline`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gaitlib import conventions as cv
+
+__all__ = [
+    "shape_matrix",
+    "ellipsoid_bottom",
+    "ellipsoid_radii",
+    "ellipsoid_bottoms",
+    "pose_from_data",
+    "settle_height",
+]
+
+
+def shape_matrix(R, radii) -> np.ndarray:
+    """``M = R D² Rᵀ`` (3, 3) of an ellipsoid with rotation ``R``, radii ``(a, b, c)``; m²."""
+    R = np.asarray(R, dtype=float)
+    d2 = np.asarray(radii, dtype=float) ** 2
+    return (R * d2) @ R.T
+
+
+def ellipsoid_bottom(centre, R, radii) -> float:
+    """Height of the lowest point of an ellipsoid, m: ``c_y − sqrt(e_yᵀ R D² Rᵀ e_y)``."""
+    M = shape_matrix(R, radii)
+    return float(np.asarray(centre, dtype=float)[1] - np.sqrt(M[1, 1]))
+
+
+def ellipsoid_radii(p_contact=None) -> np.ndarray:
+    """Radii (a, b, c) of the six ellipsoids of the child model, (6, 3) m, in the order
+    :data:`gaitlib.model.ELLIPSOID_LABELS` (right foot first; the mirror keeps the radii)."""
+    from gaitlib import contact
+
+    p = contact.default_params() if p_contact is None else np.asarray(p_contact, dtype=float)
+    abc = np.array([p[contact.param_index(e, "a"):contact.param_index(e, "c") + 1]
+                    for e in cv.ELLIPSOIDS])
+    return np.vstack([abc, abc])
+
+
+def ellipsoid_bottoms(model, q, p_contact=None) -> np.ndarray:
+    """Lowest point (y, m) of each of the six ellipsoids at pose ``q`` (11,) → (6,)."""
+    centres, Rs = model.ellipsoid_poses(np.asarray(q, dtype=float), p_contact)
+    radii = ellipsoid_radii(p_contact)
+    return np.array([ellipsoid_bottom(c, R, r) for c, R, r in zip(centres, Rs, radii)])
+
+
+def pose_from_data(model, gait_data, times, p_contact=None, penetration: float = 0.002,
+                   x0: float = 0.0, thigh: str = "lab") -> np.ndarray:
+    """Generalised coordinates of the child model following a data set's joint angles.
+
+    Parameters
+    ----------
+    model : gaitlib.model.ChildModel
+    gait_data : gaitlib.data.GaitData
+        Its ``hip, knee, ankle, mtp`` channels (both legs, rad, model signs) are used,
+        interpolated periodically at ``times``.
+    times : (n,) s
+    p_contact : (39,) contact parameters, default ``contact.default_params()``.
+    penetration : float
+        Depth of the lowest of the six ellipsoids below the ground, m (≥ 0 loads the foot).
+    x0 : pelvis_tx at t = 0, m.
+    thigh : ``"lab"`` (default) or ``"pelvis"``
+        How the data's hip angle (thigh relative to the CGM pelvis) becomes the model's.
+        The HAT is kept upright (``pelvis_tilt = 0``: the data's pelvic tilt, ≈ 11° anterior
+        for *Free*, contains an anatomical offset and is not the model's HAT angle).
+        ``"lab"``: keep the thigh's orientation in the laboratory, ``hip = hip_data +
+        pelvis_tilt_data`` (model signs), so leading and trailing legs are placed as
+        measured. ``"pelvis"``: ``hip = hip_data`` (the thigh rotates forward by the
+        pelvic tilt, ≈ 11°; at heel strike the leading heel then floats ≈ 9 cm above the
+        ground while the trailing toe touches it). Knee, ankle and metatarsal angles are
+        the data's in both cases.
+
+    Returns
+    -------
+    q : (n, 11) in the order :data:`gaitlib.conventions.COORDS`, with
+        ``pelvis_tx = x0 + speed · t``, ``pelvis_tilt = 0``, and ``pelvis_ty`` such that
+        the lowest point of the six ellipsoids is exactly ``penetration`` below the ground
+        (computed from the ellipsoid geometry, see :func:`ellipsoid_bottom`; a vertical
+        shift moves every ellipsoid rigidly).
+    """
+    times = np.atleast_1d(np.asarray(times, dtype=float))
+    if thigh not in ("lab", "pelvis"):
+        raise ValueError("thigh must be 'lab' or 'pelvis'")
+    ang = gait_data.at(times, channels=list(cv.JOINTS) + ["pelvis_tilt"])
+    q = np.zeros((times.size, len(cv.COORDS)))
+    q[:, 0] = x0 + gait_data.speed * times
+    for j in cv.JOINTS:
+        q[:, cv.COORDS.index(j)] = ang[j].to_numpy()
+        if thigh == "lab" and j.startswith("hip_"):
+            q[:, cv.COORDS.index(j)] += ang["pelvis_tilt"].to_numpy()
+    for i in range(times.size):
+        q[i, 1] = 0.0
+        low = ellipsoid_bottoms(model, q[i], p_contact).min()
+        q[i, 1] = -low - penetration
+    return q
+
+
+def settle_height(model, q, p_body=None, p_contact=None, below: float = 0.04,
+                  above: float = 0.002) -> float:
+    """``pelvis_ty`` at which the contact carries the body weight at rest, m.
+
+    The root of the vertical residual ``R_y(pelvis_ty)`` of ``model.inverse_dynamics(q, 0,
+    0)`` (the other coordinates of ``q`` fixed) — the static equilibrium height of the
+    pose. Bracketed between ``above`` m above the height at which the lowest ellipsoid
+    touches the ground (no contact: ``R_y`` = weight > 0) and ``below`` m under it.
+    """
+    from scipy.optimize import brentq
+
+    q = np.array(q, dtype=float)
+    q[1] = 0.0
+    touch = -ellipsoid_bottoms(model, q, p_contact).min()
+    zero = np.zeros_like(q)
+
+    def R_y(ty):
+        q[1] = ty
+        return float(model.inverse_dynamics(q, zero, zero, p_body, p_contact)[1][1])
+
+    return float(brentq(R_y, touch - below, touch + above, xtol=1e-12))
