@@ -100,7 +100,6 @@ for _name, _w in _T62.items():
     COST_FUNCTIONS["MSK"][_name] = {k: v for k, v in zip(("Jrk", "Rsd", "Imp", "HAT", "Act", "Trq", "Ang", "GRF"), _w) if v}
 # SK data tracking "DT" = the Ch 4 cost (Eq 4.11) for convenience in the CLI
 COST_FUNCTIONS["SK"]["DT"] = COST_FUNCTIONS["SK"]["Eq4.11"]
-COST_FUNCTIONS["MSK"].setdefault("Eq5.33", COST_FUNCTIONS["MSK"]["Eq5.33"])
 
 
 @dataclass(frozen=True)
@@ -360,8 +359,11 @@ def build(spec: GaitSpec) -> GaitProblem:
     # the bounds are relaxed (continuation), so relaxing never makes residuals cheap.
     rn = dict(zip(cv.RESIDUALS, RESIDUAL_RANGE))
     goal("Rsd", lambda x, u, p, t: sum(sq(u[r], rn[r]) for r in cv.RESIDUALS))
-    goal("Imp", lambda x, u, p, t: sum(sq(node(x, u, p)["tau_id"][i] - node(x, u, p)["tau_in"][i],
-                                           rg.get(f"tau_{j}", rg[f"tau_{j.replace('mtp', 'ankle')}"]))
+    # Imp (Eq 6.3) over the 8 leg joints; the metatarsal joints have no data, so their
+    # differences are normalised by the same side's ankle torque range.
+    imp_range = {j: rg[f"tau_{j}"] if f"tau_{j}" in rg else rg[f"tau_{j.replace('mtp', 'ankle')}"]
+                 for j in cv.JOINTS}
+    goal("Imp", lambda x, u, p, t: sum(sq(node(x, u, p)["tau_id"][i] - node(x, u, p)["tau_in"][i], imp_range[j])
                                         for i, j in enumerate(cv.JOINTS)))
     goal("HAT", lambda x, u, p, t, d: sum(sq(x[c] - d[f"ref_{c}"], rg[c]) for c in cv.COORDS[:3]))
     if spec.model == "MSK":
