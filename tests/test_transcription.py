@@ -44,7 +44,7 @@ def test_gait_problem_builds_with_expected_dimensions(model):
     assert set(g.states) == set(ph.states) and set(g.controls) == set(ph.controls)
 
 
-def test_reference_hat_height_puts_lowest_ellipsoid_at_2mm():
+def test_reference_hat_height_carries_the_data_vertical_load():
     gp = tr.build(tr.GaitSpec(n_intervals=4, degree=3))
     ref, model = gp.ref, gp.model
     # the pelvis reference advances at the data's speed
@@ -53,17 +53,35 @@ def test_reference_hat_height_puts_lowest_ellipsoid_at_2mm():
     # Fourier derivatives agree with the samples they were fitted to
     v = ref.deriv["knee_r"](t)
     assert np.max(np.abs(v[0] - ref.q["knee_r"])) < np.deg2rad(1.0)
-    # lowest ellipsoid point 2 mm below the ground in the reference pose
-    from gaitlib import contact
+    # height_for_load: at the returned height the contact (at rest) carries the load exactly
+    from gaitlib import contact, kinematics
     pc = contact.default_params()
-    radii = [pc[13 * k + 4:13 * k + 7] for k in range(3)] * 2
-    for n in (0, 12, 30):
-        q = ref.q.iloc[n].to_numpy()
-        C, Rs = model.ellipsoid_poses(q, pc)
-        low = min(C[e, 1] - np.sqrt((Rs[e] @ np.diag(np.square(radii[e])) @ Rs[e].T)[1, 1]) for e in range(6))
-        assert low == pytest.approx(-0.002, abs=1e-9)
+    Q = ref.q.to_numpy()[[0, 12, 25, 40]]
+    load = np.array([300.0, 406.5, 520.0, 150.0])
+    ty = kinematics.height_for_load(model, Q, load, pc)
+    for q, y, f in zip(Q, ty, load):
+        q = q.copy()
+        q[1] = y
+        fy = model.function("contact")(q=q, qd=np.zeros(11), p_contact=pc)["grf_y"]
+        assert float(np.sum(np.asarray(fy))) == pytest.approx(f, abs=1e-4)
+    # the smoothed reference height stays within 5 mm of the per-frame estimate
+    load = (ref.gait.mean["grf_y_r"] + ref.gait.mean["grf_y_l"]).to_numpy()
+    raw = kinematics.height_for_load(model, ref.q.to_numpy(), load, pc)
+    assert np.max(np.abs(raw - ref.q["pelvis_ty"].to_numpy())) < 0.005
     # jerk ranges are finite and positive
     assert all(np.isfinite(ref.ranges[f"jerk_{c}"]) and ref.ranges[f"jerk_{c}"] > 0 for c in cv.COORDS)
+
+
+def test_height_for_load_reports_an_impossible_load():
+    gp = tr.build(tr.GaitSpec(n_intervals=4, degree=3))
+    from gaitlib import kinematics
+    with pytest.raises(ValueError, match="row 0"):
+        kinematics.height_for_load(gp.model, gp.ref.q.to_numpy()[:1], [1e7], below=0.01)
+
+
+def test_spec_round_trip():
+    s = tr.GaitSpec(model="MSK", cost="SDT2", weights=(("Jrk", 0.1),), residual_bounds=(2.0, 2.0, 0.2))
+    assert tr.GaitSpec.from_dict(s.to_dict()) == s and tr.GaitSpec.from_dict(s.to_dict()).key() == s.key()
 
 
 def test_failed_gait_solve_is_reported_as_failed():

@@ -26,6 +26,7 @@ __all__ = [
     "ellipsoid_bottoms",
     "pose_from_data",
     "settle_height",
+    "height_for_load",
 ]
 
 
@@ -132,3 +133,51 @@ def settle_height(model, q, p_body=None, p_contact=None, below: float = 0.04,
         return float(model.inverse_dynamics(q, zero, zero, p_body, p_contact)[1][1])
 
     return float(brentq(R_y, touch - below, touch + above, xtol=1e-12))
+
+
+def height_for_load(model, Q, load, p_contact=None, below: float = 0.06, above: float = 0.002) -> np.ndarray:
+    """``pelvis_ty`` (m) of each pose at which the six ellipsoids carry a given vertical load.
+
+    For every row of ``Q`` (n, 11; ``pelvis_ty`` ignored) the root of
+    ``Σ fy(pelvis_ty) − load`` with the model at rest (``q̇ = 0``: the elastic part of the
+    contact force only), where ``load`` (n,) N is, e.g., the data's total vertical GRF of
+    both feet. The contact force falls monotonically as the body rises, so the root is
+    unique; it is bracketed between ``above`` m over the height where the lowest ellipsoid
+    touches the ground (no load) and ``below`` m under it. A load that needs more than
+    ``below`` of penetration raises ``ValueError`` naming the row.
+
+    This estimates the HAT height that the thesis took from a pelvis marker (Sec 4.2.1),
+    which the public data do not include.
+    """
+    from scipy.optimize import brentq
+
+    f_ct = model.function("contact")
+    Q = np.array(Q, dtype=float)
+    load = np.broadcast_to(np.asarray(load, dtype=float), (Q.shape[0],))
+    out = np.empty(Q.shape[0])
+    zero = np.zeros(Q.shape[1])
+    for i, q in enumerate(Q):
+        q = q.copy()
+        q[1] = 0.0
+        touch = -ellipsoid_bottoms(model, q, p_contact).min()
+        if load[i] <= 0:
+            out[i] = touch
+            continue
+
+        def excess(ty):
+            q[1] = ty
+            fy = f_ct(q=q, qd=zero, p_contact=contact_default(p_contact))["grf_y"]
+            return float(np.sum(np.asarray(fy))) - load[i]
+
+        lo, hi = touch - below, touch + above
+        if excess(lo) < 0:
+            raise ValueError(f"row {i}: a load of {load[i]:.1f} N needs more than {below} m of penetration")
+        out[i] = brentq(excess, lo, hi, xtol=1e-13)
+    return out
+
+
+def contact_default(p_contact):
+    """``p_contact`` or the default contact parameters (39,)."""
+    from gaitlib import contact
+
+    return contact.default_params() if p_contact is None else np.asarray(p_contact, dtype=float)

@@ -431,3 +431,62 @@ def animation_html(anim) -> str:
 
     with mpl.rc_context({"animation.embed_limit": 20.0}):  # MB
         return anim.to_jshtml()
+
+
+# =====================================================================================
+# Simulations against data
+# =====================================================================================
+
+#: The tracked channels of the gait chapters, in figure order.
+GAIT_CHANNELS = ("hip_r", "knee_r", "ankle_r", "mtp_r", "hip_l", "knee_l", "ankle_l", "mtp_l",
+                 "tau_hip_r", "tau_knee_r", "tau_ankle_r", "tau_mtp_r",
+                 "tau_hip_l", "tau_knee_l", "tau_ankle_l", "tau_mtp_l",
+                 "grf_x_r", "grf_y_r", "grf_x_l", "grf_y_l")
+
+
+def tracking_figure(gait, sims: dict, channels=GAIT_CHANNELS, ncols: int = 4, colors=None,
+                    figsize_per=(3.0, 2.1), title=None, data_label="data ±1 SD"):
+    """Simulated channels over the data's mean ± 1 SD band, one panel per channel.
+
+    Parameters
+    ----------
+    gait : gaitlib.data.GaitData (bands; x axis = % of its cycle).
+    sims : ``{label: DataFrame}`` indexed by time (s) from the cycle start, columns named
+        as the data's channels (SI, model signs: angles rad, torques N·m, forces N); e.g.
+        :func:`gaitlib.studies.gait.channels_frame`. Drawn in display units
+        (:func:`channel_display`). Channels the data lack (the metatarsal torque) show the
+        simulation only; a planned reference (``mtp_*``) is drawn as a band of zero width.
+    """
+    import matplotlib.pyplot as plt
+
+    channels = list(channels)
+    nrows = int(np.ceil(len(channels) / ncols))
+    fig, axes = plt.subplots(nrows, ncols, figsize=(figsize_per[0] * ncols, figsize_per[1] * nrows),
+                             squeeze=False, constrained_layout=True)
+    cmap = plt.get_cmap("tab10")
+    colors = colors or {lab: cmap(i) for i, lab in enumerate(sims)}
+    pct_data = 100 * gait.time / gait.cycle_time
+    for ax, ch in zip(axes.flat, channels):
+        name, scale, unit = channel_display(ch)
+        if ch in gait.mean:
+            band(ax, pct_data, scale * gait.mean[ch], scale * gait.sd[ch], label=data_label)
+        for lab, frame in sims.items():
+            if ch in frame:
+                t = np.asarray(frame.index, dtype=float)
+                ax.plot(100 * (t - t[0]) / gait.cycle_time, scale * frame[ch].to_numpy(), color=colors[lab],
+                        lw=1.4, label=lab)
+        side = {"_r": " (right)", "_l": " (left)"}.get(ch[-2:], "")
+        ax.set_title(name + side, fontsize=9)
+        ax.set_ylabel(unit, fontsize=8)
+        ax.set_xlim(0, 100)
+        ax.tick_params(labelsize=7)
+    for ax in axes.flat[len(channels):]:
+        ax.axis("off")
+    for ax in axes[-1]:
+        ax.set_xlabel("% gait cycle", fontsize=8)
+    handles, labs = axes.flat[0].get_legend_handles_labels()
+    if handles:
+        fig.legend(handles, labs, loc="outside lower center", ncols=min(len(labs), 5), fontsize=8)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    return fig

@@ -32,8 +32,10 @@ torques (6), ``Ang`` hip/knee/ankle angles (6), ``GRF`` the 4 foot forces, and `
 the motion term of Eqs 4.11 and 5.33 over all 11 coordinates (HAT, joints and the planned
 metatarsal angles).
 
-HAT reference: pelvis_tx = speed·t; pelvis_ty such that the lowest ellipsoid of the
-data's pose sits 2 mm below the ground; pelvis_tilt = 0 (thesis Sec 4.2.1: negligible
+HAT reference: pelvis_tx = speed·t; pelvis_ty such that the contact of the data's pose,
+at rest, carries the data's total vertical GRF (:func:`kinematics.height_for_load`,
+smoothed by an 8th-order Fourier fit; the thesis used a pelvis marker, which the public
+data lack); pelvis_tilt = 0 (thesis Sec 4.2.1: negligible
 variation, set to zero). Hip reference: the data's hip angle plus the data's pelvic tilt
 (the thigh's orientation in the laboratory), because the data's hip angle is measured from
 a pelvis tilted ≈ 11° forward while the model's HAT is upright; tracking the raw hip angle
@@ -42,18 +44,18 @@ with an upright HAT lifts the leading heel ≈ 9 cm off the ground at heel strik
 
 from __future__ import annotations
 
-import hashlib
 import json
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from functools import cached_property
+from pathlib import Path
 from typing import Any
 
 import casadi as ca
 import numpy as np
 import pandas as pd
 
-from . import __version__
+from . import cache
 from . import contact as contact_mod
 from . import conventions as cv
 from . import data as data_mod
@@ -156,9 +158,19 @@ class GaitSpec:
         return {k: v for k, v in w.items() if v}
 
     def key(self) -> str:
-        """Hash of the full spec and the library version (cache key)."""
-        blob = json.dumps({**asdict(self), "version": __version__}, sort_keys=True, default=str)
-        return hashlib.sha256(blob.encode()).hexdigest()[:16]
+        """Cache key: hash of the full spec, the library version and the code and data
+        (:func:`gaitlib.cache.key`) — any change to either gives a new key."""
+        return cache.key({"kind": "gait", **self.to_dict()})
+
+    def to_dict(self) -> dict:
+        return json.loads(json.dumps(asdict(self)))
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "GaitSpec":
+        d = dict(d)
+        d["weights"] = tuple(tuple(w) for w in d.get("weights", ()))
+        d["residual_bounds"] = tuple(d.get("residual_bounds", (1.0, 1.0, 0.1)))
+        return cls(**d)
 
 
 # ======================================================================================
@@ -208,6 +220,12 @@ def reference(gait: data_mod.GaitData, model: ChildModel, p_contact=None, order:
     # thigh="lab": hip reference = data hip + data pelvic tilt, so that with an upright HAT
     # each thigh keeps its measured orientation in the laboratory (kinematics.pose_from_data)
     Q = kinematics.pose_from_data(model, gait, t, p_contact, penetration=0.002, thigh="lab")
+    # pelvis height: the contact (at rest) carries the data's total vertical GRF, then a
+    # Fourier fit smooths it (the lowest-ellipsoid rule leaves the feet almost unloaded
+    # and its height has kinks where the lowest ellipsoid changes)
+    load = (gait.mean["grf_y_r"] + gait.mean["grf_y_l"]).to_numpy()
+    ty = kinematics.height_for_load(model, Q, load, p_contact)
+    Q[:, 1] = _fourier_derivatives(ty, T, order=8, n_der=0)(t)[0]
     qd = {c: Q[:, i] for i, c in enumerate(cv.COORDS)}
     qref = pd.DataFrame({c: qd[c] for c in cv.COORDS}, index=pd.Index(t, name="time"))
     deriv = {}
@@ -485,6 +503,38 @@ class GaitSolution:
     def success(self) -> bool:
         return self.solution.success
 
+    def summary(self) -> dict:
+        """JSON-able summary: spec, solver stats, cost terms, RMSE table, parameters."""
+        return {
+            "spec": self.spec.to_dict(),
+            "stats": {k: (float(v) if isinstance(v, (np.floating, float)) else v) for k, v in self.stats.items()},
+            "goals": self.solution.goals.to_dict(orient="records"),
+            "rmse": self.rmse.to_dict(orient="records"),
+            "parameters": self.solution.parameters,
+        }
+
+    def save(self, path) -> Path:
+        """Directory with the raw solution (``ocp/``), ``spec.json``, ``summary.json`` and
+        the tidy frames as CSV (``q.csv``, ``torques.csv``, ``grf.csv`` …)."""
+        path = Path(path)
+        self.solution.save(path / "ocp")
+        (path / "spec.json").write_text(json.dumps(self.spec.to_dict(), indent=1))
+        (path / "summary.json").write_text(json.dumps(self.summary(), indent=1, default=str))
+        for name in ("q", "qd", "torques", "residuals", "grf", "ellipsoids", "activations"):
+            frame = getattr(self, name)
+            if frame is not None:
+                frame.to_csv(path / f"{name}.csv", float_format="%.10g")
+        self.rmse.to_csv(path / "rmse.csv", index=False, float_format="%.6g")
+        return path
+
+    @classmethod
+    def load(cls, path) -> "GaitSolution":
+        """Reload a saved solution: the frames are recomputed from the raw solution with
+        the current code (:func:`postprocess`)."""
+        path = Path(path)
+        spec = GaitSpec.from_dict(json.loads((path / "spec.json").read_text()))
+        return postprocess(build(spec), ocp.Solution.load(path / "ocp"))
+
 
 def _rmse_table(sol_q, torques, grf, ref: Reference) -> pd.DataFrame:
     gait = ref.gait
@@ -510,11 +560,58 @@ def _rmse_table(sol_q, torques, grf, ref: Reference) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def solve(spec: GaitSpec | GaitProblem, guess: Guess | None = None) -> GaitSolution:
-    """Build (if needed) and solve; never hides a failure (``success``/``stats['status']``)."""
+def solve(spec: GaitSpec | GaitProblem, guess: "Guess | ocp.Solution | GaitSolution | None" = None,
+          progress: bool = False) -> GaitSolution:
+    """Build (if needed) and solve; never hides a failure (``success``/``stats['status']``).
+
+    ``guess``: default the data-based guess; or a :class:`~gaitlib.ocp.Guess`, or another
+    solution (warm start; variables of the same name are interpolated in normalised time,
+    the others keep the data-based guess). ``progress``: print IPOPT's iteration log every
+    10 iterations (stdout).
+    """
     gp = build(spec) if isinstance(spec, GaitSpec) else spec
-    sol = ocp.solve(gp.problem, gp.mesh, gp.options, guess or gp.guess)
+    options = gp.options
+    if progress:
+        options = replace(options, print_level=5, ipopt={**dict(options.ipopt), "print_frequency_iter": 10})
+    sol = ocp.solve(gp.problem, gp.mesh, options, warm_start(gp, guess))
     return postprocess(gp, sol)
+
+
+def warm_start(gp: GaitProblem, guess) -> Guess:
+    """The data-based guess of ``gp`` overridden by ``guess`` where names match.
+
+    A solution of another model (e.g. SK for an MSK problem) contributes its states and
+    its shared controls (jerks, residuals; SK joint torques become MSK metatarsal torques
+    and, through the inverse MTG, activations) and its parameters of the same name."""
+    if guess is None:
+        return gp.guess
+    if isinstance(guess, Guess):
+        return guess
+    if isinstance(guess, GaitSolution):
+        guess = guess.solution
+    base = gp.guess.phases["cycle"]
+    ph = guess.phase("cycle")
+    names_x = set(gp.problem.phases[0].states)
+    names_u = set(gp.problem.phases[0].controls)
+    S = {k: np.interp(base.time, ph.states.index, ph.states[k]) for k in ph.states.columns if k in names_x}
+    C = dict(base.controls)
+    for k in ph.controls.columns:
+        if k in names_u:
+            C[k] = np.interp(base.time, ph.controls.index, ph.controls[k])
+    if gp.spec.model == "MSK" and "tau_hip_r" in ph.controls.columns:
+        from . import mtg
+
+        for s_ in cv.SIDES:
+            C[f"tau_mtp_{s_}"] = np.interp(base.time, ph.controls.index, ph.controls[f"tau_mtp_{s_}"])
+            for j in ("hip", "knee", "ankle"):
+                c = f"{j}_{s_}"
+                tq = np.interp(base.time, ph.controls.index, ph.controls[f"tau_{c}"])
+                a = mtg.activation_for_torque(j, tq, S[c], S[f"qd_{c}"])
+                C[f"a_{j}_ext_{s_}"] = np.asarray(a["a_ext"], float)
+                C[f"a_{j}_flex_{s_}"] = np.asarray(a["a_flex"], float)
+    params = {k: v for k, v in guess.parameters.items() if k in gp.problem.parameter_names}
+    return Guess(phases={"cycle": PhaseGuess(time=base.time, states={**dict(base.states), **S}, controls=C)},
+                 parameters=params)
 
 
 def postprocess(gp: GaitProblem, sol: ocp.Solution) -> GaitSolution:

@@ -1,0 +1,156 @@
+"""Natural-gait data tracking (issue 4; thesis Secs 4.3.2 and 5.2): SK and MSK models.
+
+Functions
+---------
+:func:`solve_cached`   solve a :class:`~gaitlib.transcription.GaitSpec`, or reload the
+                       solution stored under its key (spec + code + data hash).
+:func:`natural_gait`   the Free-speed data-tracking solve of a model (SK: Eq 4.11 with the
+                       contact parameters free, as Sec 4.3.2; MSK: Eq 5.33).
+:func:`rmse_beside_thesis`  our RMSEs beside the thesis's Table 4.9 / 5.4 (labelled).
+:func:`write_outputs`  frames, ``summary.json`` and figures into a directory (the CLI).
+
+Thesis values are references on *different data* (Bovi 2011 vs our Schwartz 2008 Free
+class) and appear only in columns labelled with their table.
+"""
+
+from __future__ import annotations
+
+import json
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .. import cache
+from .. import conventions as cv
+from .. import ocp
+from .. import transcription as tr
+
+__all__ = ["THESIS_RMSE", "solve_cached", "natural_gait", "natural_gait_spec", "rmse_beside_thesis",
+           "channels_frame", "write_outputs", "stats_table"]
+
+#: Thesis RMSEs (different data, Bovi 2011): (kind, joint/component, side) → value.
+#: Table 4.9, optimal control row (SK, contact parameters identified), torques N·m, GRF N.
+#: Table 5.4 (MSK, Eq 5.33): angles deg, torques N·m, GRF N (tangential = x, normal = y).
+THESIS_RMSE = {
+    "SK": {("torque", "hip", "r"): 0.42, ("torque", "hip", "l"): 0.42,
+           ("torque", "knee", "r"): 0.35, ("torque", "knee", "l"): 0.35,
+           ("torque", "ankle", "r"): 0.66, ("torque", "ankle", "l"): 0.66,
+           ("grf", "x", "r"): 19.81, ("grf", "x", "l"): 8.33,
+           ("grf", "y", "r"): 26.49, ("grf", "y", "l"): 26.38},
+    "MSK": {("angle", "hip", "r"): 0.6, ("angle", "knee", "r"): 1.1, ("angle", "ankle", "r"): 1.0,
+            ("angle", "hip", "l"): 0.6, ("angle", "knee", "l"): 1.2, ("angle", "ankle", "l"): 0.9,
+            ("torque", "hip", "r"): 3.1, ("torque", "knee", "r"): 1.8, ("torque", "ankle", "r"): 3.9,
+            ("torque", "hip", "l"): 2.3, ("torque", "knee", "l"): 1.1, ("torque", "ankle", "l"): 3.8,
+            ("grf", "x", "r"): 7.2, ("grf", "y", "r"): 24.2, ("grf", "x", "l"): 4.6, ("grf", "y", "l"): 19.7},
+}
+THESIS_TABLE = {"SK": "thesis, Table 4.9 (optimal control)", "MSK": "thesis, Table 5.4"}
+
+
+def solve_cached(spec: tr.GaitSpec, *, use_cache: bool = True, root=None, guess=None,
+                 progress: bool = False) -> tr.GaitSolution:
+    """Solve ``spec`` or reload it from the cache (never a stale entry: the key hashes the
+    spec, the library's sources and the data). Failed solves are stored and reloaded as
+    failed — their status is the result. ``guess``: a :class:`~gaitlib.ocp.Guess` or
+    another :class:`~gaitlib.ocp.Solution` (warm start; part of the cache key via its
+    objective and status only if given, so warm-started runs are cached separately)."""
+    desc = {"kind": "gait", **spec.to_dict()}
+    if guess is not None:
+        desc["warm_start"] = _guess_signature(guess)
+    where = cache.lookup("gait", desc, root)
+    if use_cache and (where / "spec.json").exists():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ocp.SolveFailedWarning)
+            return tr.GaitSolution.load(where)
+    sol = tr.solve(spec, guess=guess, progress=progress)
+    if use_cache:
+        sol.save(where)
+    return sol
+
+
+def _guess_signature(guess) -> str:
+    if isinstance(guess, tr.GaitSolution):
+        guess = guess.solution
+    if isinstance(guess, ocp.Solution):
+        return f"solution:{guess.status}:{guess.objective:.12g}:{guess.iterations}"
+    return f"guess:{id(guess)}"
+
+
+def natural_gait_spec(model: str = "SK", cost: str | None = None, speed: str = "Free", **kw) -> tr.GaitSpec:
+    """The issue-4 natural-gait spec: SK → Eq 4.11 with the 39 contact parameters free
+    (Sec 4.3.2); MSK → Eq 5.33 with the thesis's identified contact (fixed)."""
+    if cost is None:
+        cost = "Eq4.11" if model == "SK" else "Eq5.33"
+    if model == "SK":
+        kw.setdefault("free_contact", True)
+    return tr.GaitSpec(model=model, cost=cost, speed_class=speed, **kw)
+
+
+def natural_gait(model: str = "SK", cost: str | None = None, speed: str = "Free", *, use_cache: bool = True,
+                 root=None, guess=None, progress: bool = False, **kw) -> tr.GaitSolution:
+    """Solve (or reload) :func:`natural_gait_spec`; keyword arguments go to the spec."""
+    return solve_cached(natural_gait_spec(model, cost, speed, **kw), use_cache=use_cache, root=root,
+                        guess=guess, progress=progress)
+
+
+def rmse_beside_thesis(sol: tr.GaitSolution) -> pd.DataFrame:
+    """Our RMSE per channel (angles deg, torques N·m, GRFs N) beside the thesis's table
+    for the same model (NaN where the thesis did not report a channel)."""
+    ref = THESIS_RMSE[sol.spec.model]
+    rows = []
+    for _, r in sol.rmse.iterrows():
+        ch = r["channel"]
+        side = ch[-1]
+        part = ch.split("_")[1] if r["kind"] == "grf" else ch.rsplit("_", 1)[0]
+        rows.append({"kind": r["kind"], "channel": part, "side": side, "unit": r["unit"],
+                     "ours": r["rmse"], THESIS_TABLE[sol.spec.model]: ref.get((r["kind"], part, side), np.nan)})
+    return pd.DataFrame(rows)
+
+
+def channels_frame(sol: tr.GaitSolution) -> pd.DataFrame:
+    """The solution on the data's channel names (SI, model signs; index time s): joint
+    angles ``hip_r`` …, torques ``tau_hip_r`` …, and foot forces ``grf_x_r`` …"""
+    out = pd.DataFrame(index=sol.q.index)
+    for c in cv.JOINTS:
+        out[c] = sol.q[c]
+        out[f"tau_{c}"] = sol.torques[c]
+    for g in tr.GRF_CHANNELS:
+        out[g] = sol.grf[g]
+    out["pelvis_tilt"] = sol.q["pelvis_tilt"]
+    return out
+
+
+def stats_table(solutions: dict) -> pd.DataFrame:
+    """One row of solver statistics per labelled solution."""
+    rows = []
+    for label, s in solutions.items():
+        st = s.stats
+        rows.append({"run": label, "status": st["status"], "iterations": st["iterations"],
+                     "solve (s)": st["solve_time_s"], "ms/iteration": 1e3 * st["time_per_iteration_s"],
+                     "build (s)": st["build_time_s"], "objective": st["objective"],
+                     "max violation": st["max_violation"], "variables": st["n_variables"],
+                     "constraints": st["n_constraints"]})
+    return pd.DataFrame(rows).set_index("run")
+
+
+def write_outputs(sol: tr.GaitSolution, out, figures: bool = True) -> Path:
+    """Write ``sol`` (frames, ``summary.json``, ``rmse_vs_thesis.csv``) and, with
+    ``figures``, ``tracking.png`` (angles, torques, GRFs vs the data's ±1 SD bands)."""
+    out = Path(out)
+    sol.save(out)
+    rmse_beside_thesis(sol).to_csv(out / "rmse_vs_thesis.csv", index=False, float_format="%.6g")
+    if figures:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from .. import data as data_mod
+        from .. import plots
+
+        gait = data_mod.load_gait_data(sol.spec.speed_class, sol.spec.source)
+        fig = plots.tracking_figure(gait, {f"{sol.spec.model} {sol.spec.cost}": channels_frame(sol)})
+        fig.savefig(out / "tracking.png", dpi=110)
+    summary = json.loads((out / "summary.json").read_text())
+    summary["files"] = sorted(p.name for p in out.iterdir())
+    (out / "summary.json").write_text(json.dumps(summary, indent=1, default=str))
+    return out
