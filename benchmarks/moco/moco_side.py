@@ -9,9 +9,11 @@ T9-track: torque-driven, 9-DOF, half gait cycle tracking of Moco's 2D walking ex
   ``ModOpReplaceJointsWithWelds(["lumbar"])`` → 9 DOF; six ``CoordinateActuator`` s (hips,
   knees, ankles), optimal force 150 N·m, controls in [−1, 1];
 * ``MocoTrack``: states reference ``referenceCoordinates.sto`` with ``TabOpLowPassFilter(6)``,
-  coordinate values tracked with weight 1 (speeds not tracked), control effort weight 10,
-  ``apply_tracked_states_to_guess`` (reference coordinates, zero speeds, zero controls),
-  t ∈ [0, 0.470089] s fixed;
+  global tracking weight 1, coordinate values *and* speeds tracked
+  (``track_reference_position_derivatives``, as in Moco's example; without it the optimum
+  is standing still, see ``../README.md``), control effort weight 10,
+  ``apply_tracked_states_to_guess`` (reference values and spline-derivative speeds, zero
+  controls), t ∈ [0, 0.470089] s fixed;
 * ``MocoPeriodicityGoal`` as in Moco's example: q_r(0) = q_l(T) and q_l(0) = q_r(T) for the
   leg coordinates (values and speeds), pelvis tilt/ty values and all pelvis speeds periodic;
 * state bounds as in the example (pelvis tilt [−20°, −10°], tx [0, 1] m, ty [0.75, 1.25] m,
@@ -119,20 +121,28 @@ def torque_driven_model(osim, workdir: Path):
     return model, info
 
 
+def _parallel_setting(solver):
+    try:
+        return int(solver.get_parallel())
+    except Exception:  # noqa: BLE001 - unset optional property
+        return "default (all cores)"
+
+
 def build_study(osim, model, scheme: str, n_mesh: int, tol: float, max_iter: int,
-                parallel: int | None, workdir: Path):
+                parallel: int | None, workdir: Path, tracking_weight: float = 1.0,
+                track_speeds: bool = True, effort_weight: float = 10.0):
     track = osim.MocoTrack()
     track.setName("t9track")
     ref = osim.TableProcessor(str(HERE / "referenceCoordinates.sto"))
     ref.append(osim.TabOpLowPassFilter(6))
     track.setModel(osim.ModelProcessor(model))
     track.setStatesReference(ref)
-    track.set_states_global_tracking_weight(1.0)
-    track.set_track_reference_position_derivatives(False)
+    track.set_states_global_tracking_weight(tracking_weight)
+    track.set_track_reference_position_derivatives(track_speeds)
     track.set_allow_unused_references(True)  # the reference's lumbar column
     track.set_apply_tracked_states_to_guess(True)
     track.set_minimize_control_effort(True)
-    track.set_control_effort_weight(10.0)
+    track.set_control_effort_weight(effort_weight)
     track.set_initial_time(0.0)
     track.set_final_time(T_FINAL)
     cwd = os.getcwd()
@@ -188,14 +198,13 @@ def build_study(osim, model, scheme: str, n_mesh: int, tol: float, max_iter: int
         "optim_max_iterations": solver.get_optim_max_iterations(),
         "interpolate_control_mesh_interior_points":
             solver.get_interpolate_control_mesh_interior_points(),
-        "parallel": (solver.get_parallel() if not solver.getProperty_parallel().empty()
-                     else "default (all cores)"),
+        "parallel": _parallel_setting(solver),
         "OPENSIM_MOCO_PARALLEL": os.environ.get("OPENSIM_MOCO_PARALLEL"),
         "periodicity_pairs": pairs,
         "goals": {},
     }
-    for i in range(problem.getPhase(0).getNumGoals()):
-        g = problem.getPhase(0).getGoal(i)
+    for gname in ("state_tracking", "control_effort", "symmetryGoal"):
+        g = problem.getPhase(0).getGoal(gname)
         config["goals"][g.getName()] = {
             "type": g.getConcreteClassName(), "weight": g.getWeight(),
             "divide_by_duration": g.getDivideByDuration(),
@@ -296,7 +305,8 @@ def solve(args) -> dict:
     t0 = time.perf_counter()
     model, model_info = torque_driven_model(osim, work)
     study, config = build_study(osim, model, args.scheme, args.mesh, args.tol, args.max_iter,
-                                args.parallel, work)
+                                args.parallel, work, args.tracking_weight, args.track_speeds,
+                                args.effort_weight)
     setup_time = time.perf_counter() - t0
     log_path = out / f"moco_{tag}_ipopt.log"
     ru0 = resource.getrusage(resource.RUSAGE_SELF)
@@ -461,6 +471,11 @@ def main(argv=None):
     ap.add_argument("--max-iter", type=int, default=1000)
     ap.add_argument("--parallel", type=int, default=None,
                     help="MocoCasADiSolver 'parallel' (default: Moco's default, all cores)")
+    ap.add_argument("--tracking-weight", type=float, default=1.0)
+    ap.add_argument("--track-speeds", action=argparse.BooleanOptionalAction, default=True,
+                    help="also track the reference spline's derivatives (speeds), as Moco's "
+                         "example does (track_reference_position_derivatives; default on)")
+    ap.add_argument("--effort-weight", type=float, default=10.0)
     ap.add_argument("--out", default=str(HERE.parent / "results" / "moco_raw"))
     ap.add_argument("--export-reference", action="store_true")
     ap.add_argument("--check-dynamics", type=int, default=0, metavar="N")
