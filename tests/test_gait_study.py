@@ -62,6 +62,8 @@ def test_implicit_dynamics_hold_when_reevaluated_independently(coarse):
         qdd = Xu.loc[t, [f"qdd_{c}" for c in Qn]].to_numpy()
         tau, R = model.inverse_dynamics(q, qd, qdd)  # default body and contact parameters
         np.testing.assert_allclose(np.ravel(tau), U.loc[t, [f"tau_{j}" for j in cv.JOINTS]], atol=1e-5)
+        np.testing.assert_allclose(np.ravel(tau) + np.ravel(model.function("passive")(q, qd, model.default_p_body())),
+                                   sol.torques.loc[t].to_numpy(), atol=1e-5)  # net = active + passive
         np.testing.assert_allclose(np.ravel(R), U.loc[t, list(cv.RESIDUALS)], atol=1e-5)
     # residual loads within the thesis's bounds (Eq 4.8)
     assert np.all(np.abs(sol.residuals[["R_x", "R_y"]].to_numpy()) <= 1.0 + 1e-6)

@@ -69,7 +69,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--max-iter", type=int, default=1000)
     fc = r.add_mutually_exclusive_group()
     fc.add_argument("--free-contact", dest="free_contact", action="store_true", default=None,
-                    help="identify the 39 contact parameters (default for SK)")
+                    help="identify the 39 contact parameters (Ch 4; default: fixed, thesis Tables 4.17/4.18)")
     fc.add_argument("--fixed-contact", dest="free_contact", action="store_false")
     r.add_argument("--no-cache", action="store_true", help="solve even if a cached solution exists")
     r.add_argument("--no-figures", action="store_true")

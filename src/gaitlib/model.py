@@ -771,6 +771,9 @@ class ChildModel:
             tau = ca.vertcat(*[Q[3 + i] - pas[i] for i in range(8)])
             return ca.Function(name, [q, qd, qdd, pb, S["grf"]], [tau, ca.vertcat(*Q[:3])],
                                ["q", "qd", "qdd", "p_body", "grf"], ["tau", "R"])
+        if name == "passive":
+            pas = self._passive(qs, qds, ca.vertsplit(pb))
+            return ca.Function(name, [q, qd, pb], [ca.vertcat(*pas)], ["q", "qd", "p_body"], ["tau_passive"])
         if name == "mass_matrix":
             Q = tree.generalized_forces(qs, None, qdds, ine, (), 0.0)
             M = ca.jacobian(ca.vertcat(*Q), qdd)
@@ -868,6 +871,10 @@ class ChildModel:
 
         * ``inverse_dynamics``: (q, qd, qdd, p_body, p_contact) -> (tau (8,), R (3,))
         * ``inverse_dynamics_grf``: (q, qd, qdd, p_body, grf (6,)) -> (tau, R)
+        * ``passive``: (q, qd, p_body) -> tau_passive (8,): the joints' spring–damper
+          torques ``−K q − B q̇`` (Table 4.2). ``inverse_dynamics``' ``tau`` is the torque
+          the actuators must add to them; the net joint torque (what gait laboratories
+          report) is ``tau + tau_passive``.
         * ``mass_matrix``: (q, p_body) -> M (11, 11)
         * ``bias``: (q, qd, p_body) -> h (11,)
         * ``forward_dynamics``: (q, qd, tau, R, p_body, p_contact) -> qdd (11,)

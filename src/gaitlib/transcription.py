@@ -28,7 +28,10 @@ with ranges (max − min) of the data:
 ``Jrk`` t_f⁶ Σ (jerk/range)², ``Rsd`` residuals (ranges from their bounds), ``Imp``
 (τ_inv − τ_input) on the 8 leg joints (≈ 0 under the equality constraint), ``HAT`` the 3
 HAT coordinates vs a reference, ``Act`` activations (range 1), ``Trq`` hip/knee/ankle
-torques (6), ``Ang`` hip/knee/ankle angles (6), ``GRF`` the 4 foot forces, and ``Q`` —
+*net* torques (6: actuator + the joint spring–damper of Table 4.2 — gait laboratories
+report net joint moments, so the actuator torque alone is not comparable; with the
+thesis's knee/ankle damping of ≈ 3 N·m·s/rad the difference reaches 10–18 N·m in swing),
+``Ang`` hip/knee/ankle angles (6), ``GRF`` the 4 foot forces, and ``Q`` —
 the motion term of Eqs 4.11 and 5.33 over all 11 coordinates (HAT, joints and the planned
 metatarsal angles).
 
@@ -316,6 +319,7 @@ def build(spec: GaitSpec) -> GaitProblem:
 
     f_id = model.function("inverse_dynamics")
     f_ct = model.function("contact")
+    f_pas = model.function("passive")
     cache: dict = {}
 
     def node(x: Named, u: Named, p: Named):
@@ -340,7 +344,9 @@ def build(spec: GaitSpec) -> GaitProblem:
                 tin[f"mtp_{s}"] = u[f"tau_mtp_{s}"]
             tau_in = ca.vertcat(*[tin[j] for j in cv.JOINTS])
         R_in = ca.vertcat(*[u[r] for r in cv.RESIDUALS])
-        out = {"tau_id": tau_id, "R_id": R_id, "tau_in": tau_in, "R_in": R_in,
+        # net joint torque = actuators + joint spring–dampers: what the data report
+        tau_net = tau_in + f_pas(q, qd, pb)
+        out = {"tau_id": tau_id, "R_id": R_id, "tau_in": tau_in, "R_in": R_in, "tau_net": tau_net,
                "grf": ca.vertcat(ct["grf_x"][0], ct["grf_y"][0], ct["grf_x"][1], ct["grf_y"][1]),
                "fn_raw": ct["fn_raw"]}
         cache[key] = out
@@ -386,7 +392,7 @@ def build(spec: GaitSpec) -> GaitProblem:
     goal("HAT", lambda x, u, p, t, d: sum(sq(x[c] - d[f"ref_{c}"], rg[c]) for c in cv.COORDS[:3]))
     if spec.model == "MSK":
         goal("Act", lambda x, u, p, t: sum(u[a] ** 2 for a in MTG_CONTROLS))
-    goal("Trq", lambda x, u, p, t, d: sum(sq(node(x, u, p)["tau_in"][cv.JOINTS.index(j)] - d[f"ref_tau_{j}"], rg[f"tau_{j}"])
+    goal("Trq", lambda x, u, p, t, d: sum(sq(node(x, u, p)["tau_net"][cv.JOINTS.index(j)] - d[f"ref_tau_{j}"], rg[f"tau_{j}"])
                                           for j in LEG_JOINTS))
     goal("Ang", lambda x, u, p, t, d: sum(sq(x[j] - d[f"ref_{j}"], rg[j]) for j in LEG_JOINTS))
     goal("GRF", lambda x, u, p, t, d: sum(sq(node(x, u, p)["grf"][i] - d[f"ref_{g}"], rg[g])
@@ -444,7 +450,7 @@ def build(spec: GaitSpec) -> GaitProblem:
 
 def initial_guess(spec: GaitSpec, model: ChildModel, ref: Reference, p_body, p_contact) -> Guess:
     """Data-based guess (thesis Sec 4.3.2): states and jerks from Fourier fits of the
-    reference; torques from data (metatarsal 0) or, for MSK, activations from the
+    reference; actuator torques = data (net) torques − joint spring–dampers (metatarsal 0) or, for MSK, activations from the
     inverse MTG (Sec 5.2.1); residuals 0."""
     T = ref.gait.cycle_time
     t = np.linspace(0.0, T, 201)
@@ -455,7 +461,11 @@ def initial_guess(spec: GaitSpec, model: ChildModel, ref: Reference, p_body, p_c
         C[f"jerk_{c}"] = v[3]
     for r in cv.RESIDUALS:
         C[r] = np.zeros_like(t)
-    tau = {j: np.interp(t, ref.tau.index, ref.tau[j]) for j in LEG_JOINTS}
+    # the data's torques are net joint torques; the actuators supply net − passive
+    Qg = np.array([S[c] for c in cv.COORDS])
+    Qdg = np.array([S[f"qd_{c}"] for c in cv.COORDS])
+    pas = np.asarray(model.function("passive").map(t.size)(Qg, Qdg, np.tile(np.asarray(p_body)[:, None], t.size)))
+    tau = {j: np.interp(t, ref.tau.index, ref.tau[j]) - pas[cv.JOINTS.index(j)] for j in LEG_JOINTS}
     if spec.model == "SK":
         for j in cv.JOINTS:
             C[f"tau_{j}"] = tau.get(j, np.zeros_like(t))
@@ -482,7 +492,8 @@ class GaitSolution:
     """A solved gait: the raw :class:`ocp.Solution` plus tidy, named results.
 
     Frames are indexed by time (s) at the collocation nodes: ``q`` (11 coordinates, SI),
-    ``torques`` (8 joint torques applied, N·m), ``residuals`` (3), ``grf`` (per foot
+    ``torques`` (8 net joint torques, N·m: actuators + joint spring–dampers, comparable
+    with the data), ``torques_active`` (the actuators' share: SK controls, MSK MTGs), ``residuals`` (3), ``grf`` (per foot
     grf_x_r, grf_y_r, grf_x_l, grf_y_l, N), ``ellipsoids`` (fn/fx per ellipsoid, N),
     ``activations`` (MSK). ``rmse`` is a table per channel against the data mean.
     """
@@ -498,6 +509,7 @@ class GaitSolution:
     activations: pd.DataFrame | None
     rmse: pd.DataFrame
     stats: dict
+    torques_active: pd.DataFrame | None = None
 
     @property
     def success(self) -> bool:
@@ -520,7 +532,7 @@ class GaitSolution:
         self.solution.save(path / "ocp")
         (path / "spec.json").write_text(json.dumps(self.spec.to_dict(), indent=1))
         (path / "summary.json").write_text(json.dumps(self.summary(), indent=1, default=str))
-        for name in ("q", "qd", "torques", "residuals", "grf", "ellipsoids", "activations"):
+        for name in ("q", "qd", "torques", "torques_active", "residuals", "grf", "ellipsoids", "activations"):
             frame = getattr(self, name)
             if frame is not None:
                 frame.to_csv(path / f"{name}.csv", float_format="%.10g")
@@ -652,6 +664,10 @@ def postprocess(gp: GaitProblem, sol: ocp.Solution) -> GaitSolution:
             tq[f"mtp_{s}"] = U[f"tau_mtp_{s}"].to_numpy()
         torques = pd.DataFrame({j: tq[j] for j in cv.JOINTS}, index=q.index)
         acts = U[list(MTG_CONTROLS)].copy()
+    pas = np.asarray(model.function("passive").map(len(t_u))(q.to_numpy().T, qd.to_numpy().T,
+                                                               np.tile(np.asarray(pb)[:, None], len(t_u))))
+    active = torques
+    torques = active + pd.DataFrame(pas.T, index=q.index, columns=list(cv.JOINTS))
     residuals = U[list(cv.RESIDUALS)].copy()
     rmse = _rmse_table(q, torques, grf, gp.ref)
     stats = {
@@ -661,4 +677,4 @@ def postprocess(gp: GaitProblem, sol: ocp.Solution) -> GaitSolution:
         "max_violation": sol.max_violation, "n_variables": sol.info.get("n_variables"),
         "n_constraints": sol.info.get("n_constraints"), "spec_key": spec.key(),
     }
-    return GaitSolution(spec, sol, q, qd, torques, residuals, grf, ellipsoids, acts, rmse, stats)
+    return GaitSolution(spec, sol, q, qd, torques, residuals, grf, ellipsoids, acts, rmse, stats, active)

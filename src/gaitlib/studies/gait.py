@@ -28,7 +28,7 @@ from .. import ocp
 from .. import transcription as tr
 
 __all__ = ["THESIS_RMSE", "solve_cached", "natural_gait", "natural_gait_spec", "rmse_beside_thesis",
-           "channels_frame", "write_outputs", "stats_table"]
+           "channels_frame", "write_outputs", "stats_table", "tracking_data"]
 
 #: Thesis RMSEs (different data, Bovi 2011): (kind, joint/component, side) → value.
 #: Table 4.9, optimal control row (SK, contact parameters identified), torques N·m, GRF N.
@@ -62,10 +62,13 @@ def solve_cached(spec: tr.GaitSpec, *, use_cache: bool = True, root=None, guess=
     if use_cache and (where / "spec.json").exists():
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ocp.SolveFailedWarning)
-            return tr.GaitSolution.load(where)
+            sol = tr.GaitSolution.load(where)
+        sol.stats["from_cache"] = True
+        return sol
     sol = tr.solve(spec, guess=guess, progress=progress)
     if use_cache:
         sol.save(where)
+    sol.stats["from_cache"] = False
     return sol
 
 
@@ -78,13 +81,26 @@ def _guess_signature(guess) -> str:
 
 
 def natural_gait_spec(model: str = "SK", cost: str | None = None, speed: str = "Free", **kw) -> tr.GaitSpec:
-    """The issue-4 natural-gait spec: SK → Eq 4.11 with the 39 contact parameters free
-    (Sec 4.3.2); MSK → Eq 5.33 with the thesis's identified contact (fixed)."""
+    """The natural-gait data-tracking spec: SK → Eq 4.11 (Table 4.8 weights, Sec 4.3.2),
+    MSK → Eq 5.33 (Table 5.3), both with the thesis's identified contact parameters fixed
+    (Tables 4.17/4.18) unless ``free_contact=True`` (the identification of Ch 4)."""
     if cost is None:
         cost = "Eq4.11" if model == "SK" else "Eq5.33"
-    if model == "SK":
-        kw.setdefault("free_contact", True)
     return tr.GaitSpec(model=model, cost=cost, speed_class=speed, **kw)
+
+
+def tracking_data(gait):
+    """The data as the gait problem tracks them: the hip channels become the thigh's angle
+    in the laboratory (data hip + data pelvic tilt, model signs; SD unchanged), because the
+    model's HAT is upright while the data's pelvis tilts ≈ 11° forward
+    (:mod:`gaitlib.transcription`, :func:`gaitlib.kinematics.pose_from_data`)."""
+    import dataclasses
+
+    mean = gait.mean.copy()
+    for s in cv.SIDES:
+        mean[f"hip_{s}"] = mean[f"hip_{s}"] + mean["pelvis_tilt"]
+    return dataclasses.replace(gait, mean=mean, notes=tuple(getattr(gait, "notes", ()) or ()) +
+                               ("hip = thigh in the laboratory (data hip + pelvic tilt)",))
 
 
 def natural_gait(model: str = "SK", cost: str | None = None, speed: str = "Free", *, use_cache: bool = True,
@@ -147,7 +163,7 @@ def write_outputs(sol: tr.GaitSolution, out, figures: bool = True) -> Path:
         from .. import data as data_mod
         from .. import plots
 
-        gait = data_mod.load_gait_data(sol.spec.speed_class, sol.spec.source)
+        gait = tracking_data(data_mod.load_gait_data(sol.spec.speed_class, sol.spec.source))
         fig = plots.tracking_figure(gait, {f"{sol.spec.model} {sol.spec.cost}": channels_frame(sol)})
         fig.savefig(out / "tracking.png", dpi=110)
     summary = json.loads((out / "summary.json").read_text())
