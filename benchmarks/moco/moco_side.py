@@ -130,7 +130,8 @@ def _parallel_setting(solver):
 
 def build_study(osim, model, scheme: str, n_mesh: int, tol: float, max_iter: int,
                 parallel: int | None, workdir: Path, tracking_weight: float = 1.0,
-                track_speeds: bool = True, effort_weight: float = 10.0):
+                track_speeds: bool = True, effort_weight: float = 10.0,
+                dynamics: str = "explicit"):
     track = osim.MocoTrack()
     track.setName("t9track")
     ref = osim.TableProcessor(str(HERE / "referenceCoordinates.sto"))
@@ -184,6 +185,7 @@ def build_study(osim, model, scheme: str, n_mesh: int, tol: float, max_iter: int
     solver.set_optim_constraint_tolerance(tol)
     solver.set_optim_max_iterations(max_iter)
     solver.set_verbosity(2)
+    solver.set_multibody_dynamics_mode(dynamics)
     if parallel is not None:
         solver.set_parallel(parallel)
     config = {
@@ -301,19 +303,28 @@ def solve(args) -> dict:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     work = Path(tempfile.mkdtemp(prefix="moco_t9_"))
-    tag = "trapezoidal" if args.scheme == "trapezoidal" else "hermite-simpson"
+    tag = args.scheme + ("" if args.dynamics == "explicit" else "_implicit")
     t0 = time.perf_counter()
     model, model_info = torque_driven_model(osim, work)
     study, config = build_study(osim, model, args.scheme, args.mesh, args.tol, args.max_iter,
                                 args.parallel, work, args.tracking_weight, args.track_speeds,
-                                args.effort_weight)
+                                args.effort_weight, args.dynamics)
     setup_time = time.perf_counter() - t0
     log_path = out / f"moco_{tag}_ipopt.log"
+    # Moco exposes no generic IPOPT options; IPOPT itself reads ./ipopt.opt if present.
+    extra = dict(args.ipopt or {})
+    cwd = os.getcwd()
+    os.chdir(work)
+    if extra:
+        (work / "ipopt.opt").write_text("".join(f"{k} {v}\n" for k, v in extra.items()))
     ru0 = resource.getrusage(resource.RUSAGE_SELF)
     t1 = time.perf_counter()
-    with _CaptureFD(log_path):
-        solution = study.solve()
-    wall_solve = time.perf_counter() - t1
+    try:
+        with _CaptureFD(log_path):
+            solution = study.solve()
+    finally:
+        wall_solve = time.perf_counter() - t1
+        os.chdir(cwd)
     ru1 = resource.getrusage(resource.RUSAGE_SELF)
     log = log_path.read_text(errors="replace")
     parsed = parse_ipopt_log(log)
@@ -360,7 +371,9 @@ def solve(args) -> dict:
     result = {
         "tool": "opensim-moco",
         "opensim_version": osim.GetVersionAndDate(),
-        "scheme": tag,
+        "scheme": args.scheme,
+        "tag": tag,
+        "dynamics": args.dynamics,
         "success": success,
         "status": status,
         "iterations": iters,
@@ -380,6 +393,7 @@ def solve(args) -> dict:
         "rms_units": "rad for angles, m for pelvis_tx/ty; vs Moco's GCVSpline of its "
                      "filtered reference at the solution's times",
         "ipopt": parsed,
+        "ipopt_opt_file": extra,
         "model": model_info,
         "config": config,
         "machine": {"platform": platform.platform(), "processor": platform.processor(),
@@ -476,6 +490,11 @@ def main(argv=None):
                     help="also track the reference spline's derivatives (speeds), as Moco's "
                          "example does (track_reference_position_derivatives; default on)")
     ap.add_argument("--effort-weight", type=float, default=10.0)
+    ap.add_argument("--dynamics", choices=("explicit", "implicit"), default="explicit",
+                    help="multibody_dynamics_mode (MocoTrack sets 'explicit')")
+    ap.add_argument("--ipopt", type=json.loads, default=None,
+                    help="extra IPOPT options as JSON, written to ./ipopt.opt for the solve "
+                         "(IPOPT reads that file; Moco has no generic option setter)")
     ap.add_argument("--out", default=str(HERE.parent / "results" / "moco_raw"))
     ap.add_argument("--export-reference", action="store_true")
     ap.add_argument("--check-dynamics", type=int, default=0, metavar="N")
