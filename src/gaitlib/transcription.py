@@ -68,13 +68,27 @@ from .model import ChildModel
 from .ocp import Goal, Guess, Named, Parameter, PathConstraint, Periodic, Phase, PhaseGuess, Problem, SolverOptions
 from . import ocp
 
-MODELS = ("SK", "MSK")
-TERMS = ("Jrk", "Rsd", "Imp", "HAT", "Act", "Trq", "Ang", "GRF", "Q")
+MODELS = ("SK", "MSK", "NMSK")
+TERMS = ("Jrk", "Rsd", "Imp", "HAT", "Act", "Trq", "Ang", "GRF", "Q", "Mtb")
 LEG_JOINTS = tuple(f"{j}_{s}" for s in cv.SIDES for j in ("hip", "knee", "ankle"))  # 6 tracked
 MTG_CONTROLS = tuple(f"a_{j}_{d}_{s}" for s in cv.SIDES for j in ("hip", "knee", "ankle") for d in ("ext", "flex"))
 GRF_CHANNELS = ("grf_x_r", "grf_y_r", "grf_x_l", "grf_y_l")
 #: R_max − R_min of thesis Eq 4.8 (N, N, N·m): the Rsd normalisation.
 RESIDUAL_RANGE = (2.0, 2.0, 0.2)
+#: NMSK (Sec 5.3.4): the 16 muscles (``GM_r`` … ``TA_l``, :data:`gaitlib.activation.EXCITATIONS`).
+NMSK_MUSCLES = ("GM_r", "RF_r", "VM_r", "BF_r", "SOL_r", "PL_r", "GAM_r", "TA_r",
+                "GM_l", "RF_l", "VM_l", "BF_l", "SOL_l", "PL_l", "GAM_l", "TA_l")
+#: NMSK controls: the *delayed* excitations ẽ(t) = e(t − d) of Eq 5.34, 1 (module docstring).
+EXCITATION_CONTROLS = tuple(f"ed_{m}" for m in NMSK_MUSCLES)
+#: NMSK states: the neural activations u of Eq 5.34, 1.
+NEURAL_STATES = tuple(f"u_{m}" for m in NMSK_MUSCLES)
+#: Activation parameters γ of Eq 5.53, in NLP order (names of the free Parameters: ``act.<name>``).
+ACTIVATION_PARAMS = ("tau_act", "c3", "s1", "s2")
+#: Mtb normalisation (Eq 5.56): COT_N (J kg⁻¹ m⁻¹, adult natural speed) and the thesis's
+#: subjects' largest and smallest body masses BM_max, BM_min (kg).
+MTB_COT_N = 1.6
+MTB_BM_MAX = 56.9
+MTB_BM_MIN = 25.9
 
 #: Cost functions: model → name → weights (thesis Tables 4.8, 5.3, 6.2).
 COST_FUNCTIONS: dict[str, dict[str, dict[str, float]]] = {
@@ -105,6 +119,25 @@ for _name, _w in _T62.items():
     COST_FUNCTIONS["MSK"][_name] = {k: v for k, v in zip(("Jrk", "Rsd", "Imp", "HAT", "Act", "Trq", "Ang", "GRF"), _w) if v}
 # SK data tracking "DT" = the Ch 4 cost (Eq 4.11) for convenience in the CLI
 COST_FUNCTIONS["SK"]["DT"] = COST_FUNCTIONS["SK"]["Eq4.11"]
+COST_FUNCTIONS["NMSK"] = {
+    # Eq 5.55, Table 5.9 (natural gait, Sec 5.3.4); Act = Act_NMSK (muscle activations)
+    "Eq5.55": {"Trq": 1 / 4, "GRF": 1 / 4, "Q": 1 / 4, "Jrk": 1 / 40, "Act": 1 / 100,
+               "Rsd": 1 / 4, "Imp": 1 / 40, "Mtb": 1 / 5},
+}
+# Table 6.2, NMSK rows (Ch 6): Jrk Rsd Imp HAT Act_NMSK Mtb Trq Ang GRF
+_T62_NMSK = {
+    "DT": (1 / 40, 1 / 4, 1 / 40, 1 / 4, 1 / 100, 1 / 5, 1 / 4, 1 / 4, 1 / 4),
+    "SDT1": (1 / 40, 1 / 4, 1 / 10, 1 / 4, 1 / 100, 1 / 5, 0, 1 / 4, 1 / 4),
+    "SDT2": (1 / 40, 1 / 4, 1 / 10, 1 / 4, 1 / 100, 1 / 5, 1 / 4, 0, 1 / 4),
+    "SDT3": (1 / 40, 1 / 4, 1 / 20, 1 / 4, 1 / 100, 1 / 5, 1 / 4, 1 / 4, 0),
+    "SP1": (1 / 40, 1 / 10, 1 / 20, 1 / 2, 1 / 100, 1 / 5, 0, 0, 1 / 4),
+    "SP2": (1 / 40, 1 / 4, 1 / 10, 1 / 4, 1 / 100, 1 / 5, 0, 1 / 4, 0),
+    "SP3": (1 / 40, 1 / 4, 1 / 10, 1 / 4, 1 / 100, 1 / 5, 1 / 4, 0, 0),
+    "FP": (1 / 40, 1 / 10, 1 / 4, 1, 1 / 100, 1 / 5, 0, 0, 0),
+}
+for _name, _w in _T62_NMSK.items():
+    COST_FUNCTIONS["NMSK"][_name] = {
+        k: v for k, v in zip(("Jrk", "Rsd", "Imp", "HAT", "Act", "Mtb", "Trq", "Ang", "GRF"), _w) if v}
 
 
 @dataclass(frozen=True)
@@ -113,8 +146,10 @@ class GaitSpec:
 
     Parameters
     ----------
-    model : ``"SK"`` (joint torques) or ``"MSK"`` (12 MTG activations + metatarsal torques).
-    cost : a key of ``COST_FUNCTIONS[model]`` (e.g. ``"Eq4.11"``, ``"Eq5.33"``, ``"DT"``).
+    model : ``"SK"`` (joint torques), ``"MSK"`` (12 MTG activations + metatarsal torques) or
+        ``"NMSK"`` (16 muscle excitations + metatarsal torques, activation dynamics).
+    cost : a key of ``COST_FUNCTIONS[model]`` (e.g. ``"Eq4.11"``, ``"Eq5.33"``,
+        ``"Eq5.55"``, ``"DT"``).
     weights : optional overrides, a tuple of ``(term, weight)`` pairs.
     speed_class, source : the data (:func:`gaitlib.data.load_gait_data`).
     n_intervals, degree, scheme : the mesh (thesis: 20 × 5 LGR = 100 nodes).
@@ -123,6 +158,21 @@ class GaitSpec:
     free_contact, free_body : identify the 39 contact / 25 body parameters (Ch 4).
     body_params : ``"default"`` (Tables 4.1–4.3 scaled) or ``"thesis"`` (Tables 4.15–4.16).
     tol, max_iter : IPOPT settings (thesis: tol 1e-5).
+    tf_bounds : ``()`` — final time fixed to the data's cycle time T; ``(lo, hi)`` (s) — free
+        final time within the bounds. The stride length stays the data's (speed × T) in the
+        periodic pelvis offset, so the walking speed becomes stride / t_f; the data are
+        tracked on normalised time t / t_f; the Jrk (and Mtb) t_f⁶ scaling uses the
+        variable t_f.
+    free_activation : NMSK only — identify the activation parameters γ = (τ_act, c3, s1,
+        s2) (Eq 5.53; bounds Sec 5.3.4, guess Table 5.10 "initial"); otherwise they are
+        fixed to Table 5.10's identified values (as in Ch 6).
+    excitation_guess : NMSK only — ``"mtg"``: excitations from the inverse-MTG activations
+        of the data (the MSK guess of Sec 5.2.1) through the inverted activation dynamics;
+        ``"emg"``: the data's processed EMG where the source has the muscle (thesis Sec
+        5.3.4), ``"mtg"`` elsewhere.
+    t_stim : NMSK Mtb — the stimulation time of Eq 5.40 (s), one value for every muscle;
+        ``None``: per muscle from the initial guess's excitations (time above 10 % of the
+        maximum, Sec 5.3.3), held constant in the NLP (module docstring).
     """
 
     model: str = "SK"
@@ -142,10 +192,22 @@ class GaitSpec:
     tol: float = 1e-5
     max_iter: int = 1000
     hessian: str = "exact"
+    tf_bounds: tuple = ()
+    free_activation: bool = False
+    excitation_guess: str = "mtg"
+    t_stim: float | None = None
 
     def __post_init__(self):
         if self.model not in MODELS:
             raise ValueError(f"unknown model {self.model!r}; known {MODELS}")
+        if self.tf_bounds:
+            lo, hi = self.tf_bounds
+            if not 0.0 < float(lo) <= float(hi):
+                raise ValueError(f"tf_bounds must be () or (lo, hi) with 0 < lo <= hi, got {self.tf_bounds!r}")
+        if self.model != "NMSK" and (self.free_activation or self.excitation_guess != "mtg" or self.t_stim is not None):
+            raise ValueError("free_activation, excitation_guess and t_stim apply to the NMSK model only")
+        if self.excitation_guess not in ("mtg", "emg"):
+            raise ValueError(f"excitation_guess must be 'mtg' or 'emg', got {self.excitation_guess!r}")
         if self.cost not in COST_FUNCTIONS[self.model]:
             raise ValueError(f"unknown cost {self.cost!r} for {self.model}; known {sorted(COST_FUNCTIONS[self.model])}")
         for k, _ in self.weights:
@@ -173,6 +235,7 @@ class GaitSpec:
         d = dict(d)
         d["weights"] = tuple(tuple(w) for w in d.get("weights", ()))
         d["residual_bounds"] = tuple(d.get("residual_bounds", (1.0, 1.0, 0.1)))
+        d["tf_bounds"] = tuple(d.get("tf_bounds", ()))
         return cls(**d)
 
 
@@ -264,7 +327,12 @@ def reference(gait: data_mod.GaitData, model: ChildModel, p_contact=None, order:
 
 @dataclass(eq=False)
 class GaitProblem:
-    """A built gait problem: the spec, the ocp Problem, mesh, options and guess."""
+    """A built gait problem: the spec, the ocp Problem, mesh, options and guess.
+
+    ``t_stim`` (NMSK): the stimulation time per muscle (s, :data:`NMSK_MUSCLES` order) held
+    constant in the Mtb term; ``functions``: per-node CasADi functions of the formulation
+    (NMSK ``"edot"``: (x, u, p, t_stim) → Ė and its components, W).
+    """
 
     spec: GaitSpec
     model: ChildModel
@@ -275,15 +343,51 @@ class GaitProblem:
     guess: Guess
     p_body: np.ndarray
     p_contact: np.ndarray
+    t_stim: tuple = ()
+    functions: dict = field(default_factory=dict)
+
+    @property
+    def stride(self) -> float:
+        """Stride length D = data speed × data cycle time (m): the periodic pelvis offset."""
+        return float(self.ref.gait.speed * self.ref.gait.cycle_time)
 
 
 def _controls(spec: GaitSpec) -> tuple[str, ...]:
     jerk = tuple(f"jerk_{c}" for c in cv.COORDS)
     if spec.model == "SK":
         act = tuple(f"tau_{j}" for j in cv.JOINTS)
+    elif spec.model == "NMSK":
+        act = ("tau_mtp_r", "tau_mtp_l") + EXCITATION_CONTROLS
     else:
         act = ("tau_mtp_r", "tau_mtp_l") + MTG_CONTROLS
     return jerk + cv.RESIDUALS + act
+
+
+def _states(spec: GaitSpec) -> tuple[str, ...]:
+    x = tuple(cv.COORDS) + tuple(f"qd_{c}" for c in cv.COORDS) + tuple(f"qdd_{c}" for c in cv.COORDS)
+    return x + NEURAL_STATES if spec.model == "NMSK" else x
+
+
+def activation_values(spec: GaitSpec) -> dict[str, float]:
+    """Numeric activation parameters γ (Eq 5.53) of an NMSK spec: Table 5.10's identified
+    values, or its initial guesses when ``free_activation`` (then they are NLP variables)."""
+    from . import activation
+
+    src = activation.ACTIVATION_INITIAL if spec.free_activation else activation.ACTIVATION_IDENTIFIED
+    return {k: float(src[k]) for k in ACTIVATION_PARAMS}
+
+
+def mtb_scale(t_f, stride: float, body_mass: float = cv.BODY_MASS):
+    """Factor k of the Mtb integrand k Ė² (Eqs 5.55–5.56 / 6.7), 1/W².
+
+    Mtb = ∫ t_f⁶/(BM² D⁴) (Ė / (Ė_max − Ė_min))² dt with Ė_max − Ė_min =
+    COT_N (BM_max − BM_min) D / t_f: k = t_f⁸ / (BM² D⁶ (COT_N (BM_max − BM_min))²).
+    ``t_f`` (s) may be a CasADi symbol (free final time); ``stride`` D (m), ``body_mass``
+    BM (kg). The thesis's "d" of the t_f⁶ BM⁻² d⁻⁴ factor is read as the distance D of
+    Eq 5.56 (module docstring).
+    """
+    d_edot = MTB_COT_N * (MTB_BM_MAX - MTB_BM_MIN) * stride / t_f
+    return t_f**6 / (body_mass**2 * stride**4) / d_edot**2
 
 
 def build(spec: GaitSpec) -> GaitProblem:
@@ -294,9 +398,12 @@ def build(spec: GaitSpec) -> GaitProblem:
     p_contact = contact_mod.default_params()
     ref = reference(gait, model, p_contact)
     T = gait.cycle_time
+    stride = gait.speed * T  # fixed stride length, also with a free final time
     w = spec.term_weights
+    nmsk = spec.model == "NMSK"
+    free_tf = bool(spec.tf_bounds)
 
-    states = tuple(cv.COORDS) + tuple(f"qd_{c}" for c in cv.COORDS) + tuple(f"qdd_{c}" for c in cv.COORDS)
+    states = _states(spec)
     controls = _controls(spec)
     Qn, QDn, QDDn = list(cv.COORDS), [f"qd_{c}" for c in cv.COORDS], [f"qdd_{c}" for c in cv.COORDS]
     JRK = [f"jerk_{c}" for c in cv.COORDS]
@@ -311,11 +418,35 @@ def build(spec: GaitSpec) -> GaitProblem:
         lo, hi = model.p_body_bounds()
         for n_, l_, h_, g_ in zip(model.p_body_names, lo, hi, p_body):
             params.append(Parameter(f"b.{n_}", float(l_), float(h_), float(g_)))
+    if free_tf:
+        # t_f as a static parameter too, so that integrands (Jrk, Mtb) can use it; an
+        # endpoint constraint ties it to the phase's final time
+        params.append(Parameter("t_f", float(spec.tf_bounds[0]), float(spec.tf_bounds[1]),
+                                float(np.clip(T, *spec.tf_bounds))))
+    if nmsk:
+        from . import activation, metabolics, mtg
+
+        act_fixed = activation_values(spec)
+        if spec.free_activation:
+            for k in ACTIVATION_PARAMS:
+                params.append(Parameter(f"act.{k}", *map(float, activation.ACTIVATION_BOUNDS[k]), act_fixed[k]))
 
     def pvec(p: Named):
         pc = ca.vertcat(*[p[f"c.{n}"] for n in contact_mod.param_names()]) if spec.free_contact else ca.DM(p_contact)
         pb = ca.vertcat(*[p[f"b.{n}"] for n in model.p_body_names]) if spec.free_body else ca.DM(p_body)
         return pb, pc
+
+    def tf_of(p: Named):
+        return p["t_f"] if free_tf else T
+
+    def act_of(p: Named) -> dict:
+        """Activation parameters γ (Eq 5.53): NLP variables or Table 5.10 values."""
+        return {k: (p[f"act.{k}"] if spec.free_activation else act_fixed[k]) for k in ACTIVATION_PARAMS}
+
+    def muscle_activations(x: Named, p: Named) -> dict:
+        """a = c3 √u + (1 − c3) u (Eq 5.37, smoothed √, activation.neural_to_muscle_activation)."""
+        c3 = act_of(p)["c3"]
+        return {m: activation.neural_to_muscle_activation(x[f"u_{m}"], c3) for m in NMSK_MUSCLES}
 
     f_id = model.function("inverse_dynamics")
     f_ct = model.function("contact")
@@ -331,9 +462,10 @@ def build(spec: GaitSpec) -> GaitProblem:
         pb, pc = pvec(p)
         tau_id, R_id = f_id(q, qd, qdd, pb, pc)
         ct = f_ct(q=q, qd=qd, p_contact=pc)
+        extra = {}
         if spec.model == "SK":
             tau_in = ca.vertcat(*[u[f"tau_{j}"] for j in cv.JOINTS])
-        else:
+        elif spec.model == "MSK":
             from . import mtg
 
             tin = {}
@@ -343,12 +475,26 @@ def build(spec: GaitSpec) -> GaitProblem:
                     tin[c] = mtg.joint_torque(j, x[c], x[f"qd_{c}"], u[f"a_{j}_ext_{s}"], u[f"a_{j}_flex_{s}"])
                 tin[f"mtp_{s}"] = u[f"tau_mtp_{s}"]
             tau_in = ca.vertcat(*[tin[j] for j in cv.JOINTS])
+        else:  # NMSK: muscle activations → 12 generator activations (Eq 5.54) → MTGs
+            from . import mtg
+
+            am = muscle_activations(x, p)
+            ap = act_of(p)
+            tin = {}
+            for s in cv.SIDES:
+                ag = activation.generator_activations(am, ap["s1"], ap["s2"], side=s)
+                for j in ("hip", "knee", "ankle"):
+                    c = f"{j}_{s}"
+                    tin[c] = mtg.joint_torque(j, x[c], x[f"qd_{c}"], ag[f"{j}_ext"], ag[f"{j}_flex"])
+                tin[f"mtp_{s}"] = u[f"tau_mtp_{s}"]
+            tau_in = ca.vertcat(*[tin[j] for j in cv.JOINTS])
+            extra["a_muscle"] = am
         R_in = ca.vertcat(*[u[r] for r in cv.RESIDUALS])
         # net joint torque = actuators + joint spring–dampers: what the data report
         tau_net = tau_in + f_pas(q, qd, pb)
         out = {"tau_id": tau_id, "R_id": R_id, "tau_in": tau_in, "R_in": R_in, "tau_net": tau_net,
                "grf": ca.vertcat(ct["grf_x"][0], ct["grf_y"][0], ct["grf_x"][1], ct["grf_y"][1]),
-               "fn_raw": ct["fn_raw"]}
+               "fn_raw": ct["fn_raw"], **extra}
         cache[key] = out
         return out
 
@@ -358,15 +504,47 @@ def build(spec: GaitSpec) -> GaitProblem:
                            0.0, 0.0)]
     if spec.normal_force_constraint:
         path.append(PathConstraint("normal_force", lambda x, u, p, t: node(x, u, p)["fn_raw"], 0.0, np.inf))
+    endpoint = []
     if spec.free_contact:
         def ratio(x0, xf, p, t0, tf):
             out = []
             for e in cv.ELLIPSOIDS:
                 out += [p[f"c.{e}.mu_d"] - 0.55 * p[f"c.{e}.mu_s"], 0.99 * p[f"c.{e}.mu_s"] - p[f"c.{e}.mu_d"]]
             return ca.vertcat(*out)
-        endpoint = (ocp.EndpointConstraint("friction_ratio", ratio, 0.0, np.inf),)
-    else:
-        endpoint = ()
+        endpoint.append(ocp.EndpointConstraint("friction_ratio", ratio, 0.0, np.inf))
+    if free_tf:
+        endpoint.append(ocp.EndpointConstraint("t_f", lambda x0, xf, p, t0, tf: tf - p["t_f"], 0.0, 0.0))
+    endpoint = tuple(endpoint)
+
+    # ---- initial guess (before the goals: the NMSK Mtb term's t_stim comes from it)
+    guess = initial_guess(spec, model, ref, p_body, p_contact)
+    functions: dict = {}
+    t_stim: tuple = ()
+    if nmsk:
+        if spec.t_stim is not None:
+            t_stim = tuple(float(spec.t_stim) for _ in NMSK_MUSCLES)
+        else:
+            g0 = guess.phases["cycle"]
+            tg = np.asarray(g0.time, float)
+            t_stim = tuple(metabolics.stimulation_time(tg[:-1], np.asarray(g0.controls[f"ed_{m}"], float)[:-1],
+                                                       period=T) for m in NMSK_MUSCLES)
+        # Ė at a node (Eq 5.38, metabolics.nmsk_metabolic_rate): heats from the excitation
+        # that drives the activation dynamics (ẽ = e(t − d)), MTG torques from the muscle
+        # activations, work of the MTG and metatarsal joints
+        xs_, us_ = ca.SX.sym("x", len(states)), ca.SX.sym("u", len(controls))
+        ps_, ts_ = ca.SX.sym("p", len(params)), ca.SX.sym("t_stim", len(NMSK_MUSCLES))
+        xn_, un_ = Named(xs_, states, "state"), Named(us_, controls, "control")
+        pn_ = Named(ps_, tuple(p_.name for p_ in params), "parameter")
+        ap_ = act_of(pn_)
+        r = metabolics.nmsk_metabolic_rate(
+            {j: xn_[j] for j in cv.JOINTS}, {j: xn_[f"qd_{j}"] for j in cv.JOINTS},
+            {m: un_[f"ed_{m}"] for m in NMSK_MUSCLES}, muscle_activations(xn_, pn_),
+            s1=ap_["s1"], s2=ap_["s2"], mtp_torques={f"mtp_{s}": un_[f"tau_mtp_{s}"] for s in cv.SIDES},
+            t_stim={m: ts_[i] for i, m in enumerate(NMSK_MUSCLES)})
+        parts = ("total", "activation", "maintenance", "shortening", "basal", "work")
+        functions["edot"] = ca.Function("edot", [xs_, us_, ps_, ts_], [r[k] for k in parts],
+                                        ["x", "u", "p", "t_stim"], list(parts))
+    t_stim_dm = ca.DM(list(t_stim)) if t_stim else None
 
     def sq(e, r):
         return (e / r) ** 2
@@ -377,7 +555,7 @@ def build(spec: GaitSpec) -> GaitProblem:
         if name in w:
             goals.append(Goal(name, weight=w[name], integrand=f, divide_by_duration=True))
 
-    goal("Jrk", lambda x, u, p, t: T**6 * sum(sq(u[f"jerk_{c}"], rg[f"jerk_{c}"]) for c in cv.COORDS))
+    goal("Jrk", lambda x, u, p, t: tf_of(p)**6 * sum(sq(u[f"jerk_{c}"], rg[f"jerk_{c}"]) for c in cv.COORDS))
     rb = dict(zip(cv.RESIDUALS, spec.residual_bounds))
     # Rsd is normalised by the thesis's residual range (Eq 4.8: ±1 N, ±0.1 N·m) even when
     # the bounds are relaxed (continuation), so relaxing never makes residuals cheap.
@@ -392,12 +570,21 @@ def build(spec: GaitSpec) -> GaitProblem:
     goal("HAT", lambda x, u, p, t, d: sum(sq(x[c] - d[f"ref_{c}"], rg[c]) for c in cv.COORDS[:3]))
     if spec.model == "MSK":
         goal("Act", lambda x, u, p, t: sum(u[a] ** 2 for a in MTG_CONTROLS))
+    elif nmsk:
+        # Act_NMSK (Eq 6.6): the 16 muscle activations, range a_max − a_min = 1 (Sec 5.3.4)
+        goal("Act", lambda x, u, p, t: sum(a_**2 for a_ in muscle_activations(x, p).values()))
+        # Mtb (Eq 6.7 with Eq 5.56)
+        goal("Mtb", lambda x, u, p, t: mtb_scale(tf_of(p), stride)
+             * functions["edot"](x.vec, u.vec, p.vec, t_stim_dm)[0] ** 2)
     goal("Trq", lambda x, u, p, t, d: sum(sq(node(x, u, p)["tau_net"][cv.JOINTS.index(j)] - d[f"ref_tau_{j}"], rg[f"tau_{j}"])
                                           for j in LEG_JOINTS))
     goal("Ang", lambda x, u, p, t, d: sum(sq(x[j] - d[f"ref_{j}"], rg[j]) for j in LEG_JOINTS))
     goal("GRF", lambda x, u, p, t, d: sum(sq(node(x, u, p)["grf"][i] - d[f"ref_{g}"], rg[g])
                                           for i, g in enumerate(GRF_CHANNELS)))
     goal("Q", lambda x, u, p, t, d: sum(sq(x[c] - d[f"ref_{c}"], rg[c]) for c in cv.COORDS))
+    unused = set(w) - {g.name for g in goals}
+    if unused:
+        raise ValueError(f"cost terms {sorted(unused)} are not defined for model {spec.model}")
 
     # ---- data on normalised time τ ∈ [0, 1]
     tau_grid = ref.q.index.to_numpy() / T
@@ -414,7 +601,7 @@ def build(spec: GaitSpec) -> GaitProblem:
         bounds[c] = (lo, hi)
     bounds["pelvis_tilt"] = (-30 * cv.DEG, 30 * cv.DEG)
     bounds["pelvis_ty"] = (0.5, 1.0)
-    bounds["pelvis_tx"] = (-0.5, gait.speed * T + 0.5)
+    bounds["pelvis_tx"] = (-0.5, stride + 0.5)
     for c in cv.COORDS:
         bounds[f"qd_{c}"] = (-20.0, 20.0)
         bounds[f"qdd_{c}"] = (-500.0, 500.0)
@@ -425,27 +612,38 @@ def build(spec: GaitSpec) -> GaitProblem:
         for j in cv.JOINTS:
             bounds[f"tau_{j}"] = (-250.0, 250.0)
     else:
-        for a in MTG_CONTROLS:
-            bounds[a] = (0.0, 1.0)
+        if nmsk:
+            for m in NMSK_MUSCLES:
+                bounds[f"ed_{m}"] = tuple(map(float, activation.EXCITATION_BOUNDS))  # [0, 0.8], Sec 5.3.4
+                bounds[f"u_{m}"] = (0.0, 1.0)
+        else:
+            for a in MTG_CONTROLS:
+                bounds[a] = (0.0, 1.0)
         for s in cv.SIDES:
             bounds[f"tau_mtp_{s}"] = (-150.0, 150.0)
 
     periodic = None
     if spec.periodic:
-        periodic = Periodic(states, offsets={"pelvis_tx": gait.speed * T})
+        periodic = Periodic(states, offsets={"pelvis_tx": stride})
+
+    def dynamics(x, u, p, t):
+        xdot = [x[QDn], x[QDDn], u[JRK]]
+        if nmsk:  # Eq 5.34 on the delayed excitation ẽ = e(t − d) (module docstring)
+            tau_act = act_of(p)["tau_act"]
+            xdot += [activation.activation_rate(x[f"u_{m}"], u[f"ed_{m}"], tau_act) for m in NMSK_MUSCLES]
+        return ca.vertcat(*xdot)
 
     phase = Phase(
         name="cycle", states=states, controls=controls,
-        dynamics=lambda x, u, p, t: ca.vertcat(x[QDn], x[QDDn], u[JRK]),
-        t0=0.0, tf=T, bounds=bounds, initial={"pelvis_tx": 0.0},
+        dynamics=dynamics,
+        t0=0.0, tf=tuple(map(float, spec.tf_bounds)) if free_tf else T, bounds=bounds, initial={"pelvis_tx": 0.0},
         path_constraints=tuple(path), endpoint_constraints=endpoint, goals=tuple(goals),
         periodic=periodic, data=data_frame,
     )
     problem = Problem(phases=(phase,), parameters=tuple(params), name=f"gait_{spec.model}_{spec.cost}".replace(".", ""))
     mesh = Mesh(spec.n_intervals, spec.scheme, spec.degree)
     options = SolverOptions(tol=spec.tol, max_iter=spec.max_iter, hessian=spec.hessian)
-    guess = initial_guess(spec, model, ref, p_body, p_contact)
-    return GaitProblem(spec, model, ref, problem, mesh, options, guess, p_body, p_contact)
+    return GaitProblem(spec, model, ref, problem, mesh, options, guess, p_body, p_contact, t_stim, functions)
 
 
 def initial_guess(spec: GaitSpec, model: ChildModel, ref: Reference, p_body, p_contact) -> Guess:
@@ -479,7 +677,84 @@ def initial_guess(spec: GaitSpec, model: ChildModel, ref: Reference, p_body, p_c
                 a = mtg.activation_for_torque(j, tau[c], S[c], S[f"qd_{c}"])
                 C[f"a_{j}_ext_{s}"] = np.asarray(a["a_ext"], float)
                 C[f"a_{j}_flex_{s}"] = np.asarray(a["a_flex"], float)
+        if spec.model == "NMSK":
+            Sx, Cx = _nmsk_guess(spec, ref, t, {k: C.pop(k) for k in MTG_CONTROLS})
+            S.update(Sx)
+            C.update(Cx)
     return Guess(phases={"cycle": PhaseGuess(time=t, states=S, controls=C)})
+
+
+def _invert_muscle_activation(a, c3: float, delta: float = 1e-4):
+    """u with neural_to_muscle_activation(u, c3) = a (Eq 5.37 inverted; monotone), 1."""
+    from . import activation
+
+    ug = np.linspace(0.0, 1.0, 20001)
+    return np.interp(a, activation.neural_to_muscle_activation(ug, c3, delta), ug)
+
+
+def _periodic_interp(t_src, y, period: float, t):
+    """Linear interpolation of periodic samples ``y`` at ``t_src`` (one period, no repeated
+    end point) to times ``t`` (any, wrapped)."""
+    t_src = np.asarray(t_src, float)
+    ts = np.concatenate([t_src - period, t_src, t_src + period])
+    return np.interp(np.mod(np.asarray(t, float) - t_src[0], period) + t_src[0], ts, np.tile(y, 3))
+
+
+def _nmsk_guess(spec: GaitSpec, ref: Reference, t, a_gen: dict):
+    """NMSK guess (states ``u_*``, controls ``ed_*``) on ``t`` (0 … T, end point included)
+    from generator activations ``a_gen`` (names :data:`MTG_CONTROLS`, arrays over ``t``).
+
+    Each muscle takes its generator's activation (Table 5.5; SOL, PL and GAM all take the
+    ankle extensor's, which Eq 5.54 then reproduces exactly because s1 + s2 + (1 − s1 − s2)
+    = 1), capped at the activation reachable with ẽ ≤ 0.8; Eq 5.37 is inverted for u and
+    Eq 5.34 for the excitation, ẽ = the root ≥ 0 of c1 ẽ² + (c2 − c1 u) ẽ − (c2 u + u̇) = 0
+    (u̇ from a periodic Fourier fit; ẽ = 0 where even ẽ = 0 cannot deactivate that fast),
+    clipped to the bounds [0, 0.8]. With ``excitation_guess="emg"`` the data's processed EMG,
+    delayed by d (the controls are ẽ(t) = e(t − d)), replaces this where the source has the
+    muscle. The states are then the periodic solution of Eq 5.34 for these excitations
+    (:func:`gaitlib.activation.simulate_activation`), so the guess satisfies the activation
+    dynamics.
+    """
+    from . import activation
+
+    t = np.asarray(t, float)
+    T = ref.gait.cycle_time
+    ap = activation_values(spec)
+    tau_act, c3 = ap["tau_act"], ap["c3"]
+    tau_deact = activation.DEACTIVATION_RATIO * tau_act
+    c1, c2 = 1.0 / tau_act - 1.0 / tau_deact, 1.0 / tau_deact
+    e_lo, e_hi = map(float, activation.EXCITATION_BOUNDS)
+    a_hi = activation.neural_to_muscle_activation(e_hi, c3)
+    emg = {}
+    if spec.excitation_guess == "emg":
+        gait = ref.gait
+        tg = np.asarray(gait.time, float)
+        n = len(tg) - 1 if np.isclose(tg[-1] - tg[0], T) else len(tg)  # drop a repeated end point
+        for m in NMSK_MUSCLES:
+            base, side = m.rsplit("_", 1)
+            stem = activation.EMG_CHANNELS[base].get(gait.source)
+            col = f"{stem}_{side}" if stem else None
+            if col and col in gait.mean.columns:
+                y = activation.delay_periodic(gait.mean[col].to_numpy(float)[:n], activation.DELAY, T)
+                emg[m] = _periodic_interp(tg[:n], y, T, t)
+    S, C = {}, {}
+    for m in NMSK_MUSCLES:
+        if m in emg:
+            ed = emg[m]
+        else:
+            base, side = m.rsplit("_", 1)
+            a = np.clip(a_gen[f"a_{activation.MUSCLE_GENERATOR[base]}_{side}"], 0.0, a_hi)
+            u = _invert_muscle_activation(a, c3)
+            du = _fourier_derivatives(u, T, order=12, n_der=1)(t)[1]
+            b = c2 - c1 * u
+            rhs = c2 * u + du
+            ed = np.where(rhs > 0, (-b + np.sqrt(np.maximum(b * b + 4 * c1 * rhs, 0.0))) / (2 * c1), 0.0)
+        C[f"ed_{m}"] = np.clip(ed, e_lo, e_hi)
+    E = np.column_stack([C[f"ed_{m}"][:-1] for m in NMSK_MUSCLES])
+    U, _ = activation.simulate_activation(t[:-1], E, tau_act, c3, delay=0.0, periodic=True, period=T)
+    for i, m in enumerate(NMSK_MUSCLES):
+        S[f"u_{m}"] = np.append(U[:, i], U[0, i])
+    return S, C
 
 
 # ======================================================================================
@@ -495,7 +770,16 @@ class GaitSolution:
     ``torques`` (8 net joint torques, N·m: actuators + joint spring–dampers, comparable
     with the data), ``torques_active`` (the actuators' share: SK controls, MSK MTGs), ``residuals`` (3), ``grf`` (per foot
     grf_x_r, grf_y_r, grf_x_l, grf_y_l, N), ``ellipsoids`` (fn/fx per ellipsoid, N),
-    ``activations`` (MSK). ``rmse`` is a table per channel against the data mean.
+    ``activations`` (MSK: the controls; NMSK: the 12 generator activations of Eq 5.54, same
+    column names). ``rmse`` is a table per channel against the data mean (on normalised time
+    when the final time is free).
+
+    NMSK only: ``excitations`` (16 muscles, e(t) = ẽ(t + d): the neural command, comparable
+    with EMG; the controls ``ed_*`` in ``solution`` are the delayed ẽ), ``muscle_activations``
+    (16, Eq 5.37) and ``metabolic`` (Ė and its components of Eq 5.38, W, with the NLP's
+    t_stim). ``stats`` then also has ``COT`` (Eq 5.57, J kg⁻¹ m⁻¹, with the NLP's t_stim),
+    ``COT_t_stim_solution`` (t_stim re-estimated from the solution's excitations, as the
+    thesis's definition of t_stim reads), ``t_stim_s`` and ``activation_parameters``.
     """
 
     spec: GaitSpec
@@ -510,6 +794,9 @@ class GaitSolution:
     rmse: pd.DataFrame
     stats: dict
     torques_active: pd.DataFrame | None = None
+    excitations: pd.DataFrame | None = None
+    muscle_activations: pd.DataFrame | None = None
+    metabolic: pd.DataFrame | None = None
 
     @property
     def success(self) -> bool:
@@ -532,7 +819,8 @@ class GaitSolution:
         self.solution.save(path / "ocp")
         (path / "spec.json").write_text(json.dumps(self.spec.to_dict(), indent=1))
         (path / "summary.json").write_text(json.dumps(self.summary(), indent=1, default=str))
-        for name in ("q", "qd", "torques", "torques_active", "residuals", "grf", "ellipsoids", "activations"):
+        for name in ("q", "qd", "torques", "torques_active", "residuals", "grf", "ellipsoids", "activations",
+                     "excitations", "muscle_activations", "metabolic"):
             frame = getattr(self, name)
             if frame is not None:
                 frame.to_csv(path / f"{name}.csv", float_format="%.10g")
@@ -548,9 +836,11 @@ class GaitSolution:
         return postprocess(build(spec), ocp.Solution.load(path / "ocp"))
 
 
-def _rmse_table(sol_q, torques, grf, ref: Reference) -> pd.DataFrame:
+def _rmse_table(sol_q, torques, grf, ref: Reference, time_scale: float = 1.0) -> pd.DataFrame:
+    """RMSE per channel; the data are read at ``time_scale`` × the solution's times (T / t_f
+    with a free final time: comparison on normalised time)."""
     gait = ref.gait
-    t = sol_q.index.to_numpy()
+    t = sol_q.index.to_numpy() * time_scale
     rows = []
 
     def add(kind, ch, sim, dat, sd, unit, scale=1.0):
@@ -594,7 +884,13 @@ def warm_start(gp: GaitProblem, guess) -> Guess:
 
     A solution of another model (e.g. SK for an MSK problem) contributes its states and
     its shared controls (jerks, residuals; SK joint torques become MSK metatarsal torques
-    and, through the inverse MTG, activations) and its parameters of the same name."""
+    and, through the inverse MTG, activations) and its parameters of the same name.
+    For an NMSK problem, an MSK solution's 12 MTG activations (or an SK solution's torques
+    through the inverse MTG) become muscle activations, neural activations and delayed
+    excitations by :func:`_nmsk_guess` (Table 5.5 muscle ↔ generator map, Eqs 5.37 and 5.34
+    inverted); an NMSK solution contributes its own states and excitations. Solutions are
+    read on normalised time t / t_f; with a free final time the guess's t_f is the
+    solution's."""
     if guess is None:
         return gp.guess
     if isinstance(guess, Guess):
@@ -603,27 +899,51 @@ def warm_start(gp: GaitProblem, guess) -> Guess:
         guess = guess.solution
     base = gp.guess.phases["cycle"]
     ph = guess.phase("cycle")
+    T = float(base.time[-1])
+    # the source's times mapped onto this problem's guess grid (0 … T): normalised time
+    ts = ph.states.index.to_numpy() * (T / ph.tf) if gp.spec.tf_bounds else ph.states.index
+    tc = ph.controls.index.to_numpy() * (T / ph.tf) if gp.spec.tf_bounds else ph.controls.index
     names_x = set(gp.problem.phases[0].states)
     names_u = set(gp.problem.phases[0].controls)
-    S = {k: np.interp(base.time, ph.states.index, ph.states[k]) for k in ph.states.columns if k in names_x}
+    S = {k: np.interp(base.time, ts, ph.states[k]) for k in ph.states.columns if k in names_x}
     C = dict(base.controls)
     for k in ph.controls.columns:
         if k in names_u:
-            C[k] = np.interp(base.time, ph.controls.index, ph.controls[k])
-    if gp.spec.model == "MSK" and "tau_hip_r" in ph.controls.columns:
+            C[k] = np.interp(base.time, tc, ph.controls[k])
+    if gp.spec.model in ("MSK", "NMSK") and "tau_hip_r" in ph.controls.columns:
         from . import mtg
 
         for s_ in cv.SIDES:
-            C[f"tau_mtp_{s_}"] = np.interp(base.time, ph.controls.index, ph.controls[f"tau_mtp_{s_}"])
+            C[f"tau_mtp_{s_}"] = np.interp(base.time, tc, ph.controls[f"tau_mtp_{s_}"])
             for j in ("hip", "knee", "ankle"):
                 c = f"{j}_{s_}"
-                tq = np.interp(base.time, ph.controls.index, ph.controls[f"tau_{c}"])
+                tq = np.interp(base.time, tc, ph.controls[f"tau_{c}"])
                 a = mtg.activation_for_torque(j, tq, S[c], S[f"qd_{c}"])
                 C[f"a_{j}_ext_{s_}"] = np.asarray(a["a_ext"], float)
                 C[f"a_{j}_flex_{s_}"] = np.asarray(a["a_flex"], float)
+    if gp.spec.model == "NMSK" and not set(EXCITATION_CONTROLS) <= set(ph.controls.columns):
+        a_gen = {}
+        for k in MTG_CONTROLS:
+            v = C.pop(k, None)
+            a_gen[k] = v if v is not None else np.interp(base.time, tc, ph.controls[k])
+        Sx, Cx = _nmsk_guess(gp.spec, gp.ref, base.time, a_gen)
+        S.update(Sx)
+        C.update(Cx)
     params = {k: v for k, v in guess.parameters.items() if k in gp.problem.parameter_names}
-    return Guess(phases={"cycle": PhaseGuess(time=base.time, states={**dict(base.states), **S}, controls=C)},
+    time = base.time
+    if gp.spec.tf_bounds:
+        tf_g = float(np.clip(ph.tf, *gp.spec.tf_bounds))
+        time = np.asarray(base.time, float) * (tf_g / T)
+        params["t_f"] = tf_g
+    return Guess(phases={"cycle": PhaseGuess(time=time, states={**dict(base.states), **S}, controls=C)},
                  parameters=params)
+
+
+def _activation_solution(gp: GaitProblem, sol: ocp.Solution) -> dict[str, float]:
+    """Activation parameters γ of an NMSK solution: identified (free) or the spec's fixed."""
+    if gp.spec.free_activation:
+        return {k: float(sol.parameters[f"act.{k}"]) for k in ACTIVATION_PARAMS}
+    return activation_values(gp.spec)
 
 
 def postprocess(gp: GaitProblem, sol: ocp.Solution) -> GaitSolution:
@@ -649,10 +969,12 @@ def postprocess(gp: GaitProblem, sol: ocp.Solution) -> GaitSolution:
         ell[f"fn_{lab}"] = ct["fn"][i]
         ell[f"fx_{lab}"] = ct["fx"][i]
     ellipsoids = pd.DataFrame(ell, index=q.index)
+    nmsk_frames: dict = {}
+    nmsk_stats: dict = {}
     if spec.model == "SK":
         torques = pd.DataFrame({j: U[f"tau_{j}"].to_numpy() for j in cv.JOINTS}, index=q.index)
         acts = None
-    else:
+    elif spec.model == "MSK":
         from . import mtg
 
         tq = {}
@@ -664,17 +986,85 @@ def postprocess(gp: GaitProblem, sol: ocp.Solution) -> GaitSolution:
             tq[f"mtp_{s}"] = U[f"tau_mtp_{s}"].to_numpy()
         torques = pd.DataFrame({j: tq[j] for j in cv.JOINTS}, index=q.index)
         acts = U[list(MTG_CONTROLS)].copy()
+    else:
+        torques, acts, nmsk_frames, nmsk_stats = _postprocess_nmsk(gp, sol, Xu, U, q, qd)
     pas = np.asarray(model.function("passive").map(len(t_u))(q.to_numpy().T, qd.to_numpy().T,
                                                                np.tile(np.asarray(pb)[:, None], len(t_u))))
     active = torques
     torques = active + pd.DataFrame(pas.T, index=q.index, columns=list(cv.JOINTS))
     residuals = U[list(cv.RESIDUALS)].copy()
-    rmse = _rmse_table(q, torques, grf, gp.ref)
+    time_scale = gp.ref.gait.cycle_time / ph.tf if spec.tf_bounds else 1.0
+    rmse = _rmse_table(q, torques, grf, gp.ref, time_scale)
     stats = {
         "status": sol.status, "success": sol.success, "iterations": sol.iterations,
         "solve_time_s": sol.solve_time, "build_time_s": sol.build_time,
         "time_per_iteration_s": sol.time_per_iteration, "objective": sol.objective,
         "max_violation": sol.max_violation, "n_variables": sol.info.get("n_variables"),
         "n_constraints": sol.info.get("n_constraints"), "spec_key": spec.key(),
+        "tf_s": float(ph.tf),
+        **nmsk_stats,
     }
-    return GaitSolution(spec, sol, q, qd, torques, residuals, grf, ellipsoids, acts, rmse, stats, active)
+    return GaitSolution(spec, sol, q, qd, torques, residuals, grf, ellipsoids, acts, rmse, stats, active,
+                        **nmsk_frames)
+
+
+def _postprocess_nmsk(gp: GaitProblem, sol: ocp.Solution, Xu, U, q, qd):
+    """NMSK frames: MTG torques from the states' muscle activations, generator activations,
+    excitations e(t) = ẽ(t + d), muscle activations, metabolic rate and COT."""
+    from . import activation, metabolics, mtg
+
+    ph = sol.phase("cycle")
+    tf = float(ph.tf)
+    t_u = U.index.to_numpy()
+    ap = _activation_solution(gp, sol)
+    am = {m: np.asarray(activation.neural_to_muscle_activation(Xu[f"u_{m}"].to_numpy(), ap["c3"]), float)
+          for m in NMSK_MUSCLES}
+    tq, acts = {}, {}
+    for s in cv.SIDES:
+        ag = activation.generator_activations(am, ap["s1"], ap["s2"], side=s)
+        for j in ("hip", "knee", "ankle"):
+            c = f"{j}_{s}"
+            acts[f"a_{j}_ext_{s}"], acts[f"a_{j}_flex_{s}"] = ag[f"{j}_ext"], ag[f"{j}_flex"]
+            tq[c] = np.asarray(mtg.joint_torque(j, q[c].to_numpy(), qd[c].to_numpy(), ag[f"{j}_ext"],
+                                                ag[f"{j}_flex"]), float).ravel()
+        tq[f"mtp_{s}"] = U[f"tau_mtp_{s}"].to_numpy()
+    torques = pd.DataFrame({j: tq[j] for j in cv.JOINTS}, index=q.index)
+    acts = pd.DataFrame({k: acts[k] for k in MTG_CONTROLS}, index=q.index)
+    # one period of control samples (drop a node at t_f that repeats t = 0, e.g. trapezoidal)
+    per = t_u < tf - 1e-12 * max(tf, 1.0)
+    tp = t_u[per]
+    ed = {m: U[f"ed_{m}"].to_numpy()[per] for m in NMSK_MUSCLES}
+    exc = pd.DataFrame({m: _periodic_interp(tp, ed[m], tf, t_u + activation.DELAY) for m in NMSK_MUSCLES},
+                       index=q.index)
+    mus = pd.DataFrame(am, index=q.index)
+    # metabolic rate with the NLP's own function (the Mtb term's Ė)
+    f = gp.functions["edot"]
+    names_x = list(gp.problem.phases[0].states)
+    Xn = Xu[names_x].to_numpy().T
+    Un = U[list(gp.problem.phases[0].controls)].to_numpy().T
+    pv = np.array([sol.parameters[n] for n in gp.problem.parameter_names], float).reshape(-1, 1)
+
+    def edot(t_stim):
+        out = f.map(len(t_u))(Xn, Un, np.tile(pv, len(t_u)), np.tile(np.reshape(t_stim, (-1, 1)), len(t_u)))
+        return {k: np.asarray(v, float).ravel() for k, v in zip(f.name_out(), out)}
+
+    def cot(e_total):
+        tt = np.append(tp, tf)  # close the cycle: Ė(t_f) = Ė(0) on a periodic gait
+        ee = np.append(e_total[per], e_total[per][0])
+        return metabolics.cost_of_transport(tt, ee, distance=gp.stride)
+
+    E = edot(np.asarray(gp.t_stim, float))
+    metab = pd.DataFrame(E, index=q.index)
+    metab["per_kg"] = metab["total"] / cv.BODY_MASS
+    ts_sol = [metabolics.stimulation_time(tp, ed[m], period=tf) for m in NMSK_MUSCLES]
+    cot_nlp = cot(E["total"])
+    stats = {
+        "COT": cot_nlp,
+        "COT_t_stim_solution": cot(edot(np.asarray(ts_sol))["total"]),
+        "mean_metabolic_rate_W": cot_nlp * cv.BODY_MASS * gp.stride / tf,  # ∫Ė dt / t_f
+        "t_stim_s": [float(v) for v in gp.t_stim],
+        "t_stim_solution_s": [float(v) for v in ts_sol],
+        "activation_parameters": {k: float(v) for k, v in ap.items()},
+    }
+    frames = {"excitations": exc, "muscle_activations": mus, "metabolic": metab}
+    return torques, acts, frames, stats
