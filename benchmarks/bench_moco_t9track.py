@@ -9,11 +9,14 @@ first use, then for each scheme runs, each in its own process with one BLAS thre
 
 1. Moco (``moco/moco_side.py`` with the Moco venv's python), as MocoTrack configures it;
 2. gaitlib (``t9track.py``), the benchmark configuration (μ_init = 1e-3);
-3. gaitlib with IPOPT's default options (μ_init = 0.1), for reference.
+3. gaitlib with IPOPT's default options (μ_init = 0.1), for reference;
+4. gaitlib with an unexpanded MX graph (builds in a fraction of a second, evaluates slower).
 
 It prints one table (setup time, solve time, iterations, time per iteration, objective,
 max constraint violation, RMS per coordinate), writes ``results/moco_t9track.json`` and
-``results/moco_t9track.md`` (date, machine, versions) and ends with one line per scheme::
+``results/moco_t9track.md`` (date, machine, versions), appends the table to
+``results/moco_t9track_history.md``, keeps each run's raw JSON, IPOPT log and trajectory
+CSV in ``results/moco_raw/``, and ends with one line per scheme::
 
     speedup_vs_moco SCHEME X
 
@@ -111,6 +114,8 @@ def main(argv=None):
     ap.add_argument("--repeats", type=int, default=1)
     ap.add_argument("--no-defaults-variant", action="store_true",
                     help="skip the gaitlib run with IPOPT's default options")
+    ap.add_argument("--no-mx-variant", action="store_true",
+                    help="skip the gaitlib run with an unexpanded MX graph (fast setup)")
     ap.add_argument("--out", default=str(RESULTS / "moco_t9track"))
     args = ap.parse_args(argv)
 
@@ -135,6 +140,11 @@ def main(argv=None):
                                  [sys.executable, str(HERE / "t9track.py"), "--scheme", scheme,
                                   "--ipopt-defaults", "--out", str(RAW)],
                                  f"gaitlib_{scheme}_ipoptdefaults"))
+            if not args.no_mx_variant:
+                variants.append(("gaitlib (MX, not expanded)",
+                                 [sys.executable, str(HERE / "t9track.py"), "--scheme", scheme,
+                                  "--graph", "mx-noexpand", "--out", str(RAW)],
+                                 f"gaitlib_{scheme}_mx-noexpand"))
             for tool, cmd, stem in variants:
                 run(cmd, tool)
                 res = json.loads((RAW / f"{stem}.json").read_text())
@@ -176,7 +186,8 @@ def main(argv=None):
 
     # ------------------------------------------------------------------ summary
     tools = ["moco", "gaitlib"] + ([] if args.no_defaults_variant else
-                                   ["gaitlib (IPOPT defaults)"])
+                                   ["gaitlib (IPOPT defaults)"]) + (
+        [] if args.no_mx_variant else ["gaitlib (MX, not expanded)"])
     speedups, lines = {}, []
     head = ("| scheme | tool | rep | status | setup s | solve s | it | ms/it | objective | "
             "max viol | " + " | ".join(COORDS) + " |")
@@ -201,9 +212,17 @@ def main(argv=None):
                             "moco_solve_median": med["moco"],
                             "gaitlib_solve_median": med["gaitlib"],
                             "all_succeeded": ok}
-        if "gaitlib (IPOPT defaults)" in med:
-            speedups[scheme]["speedup_ipopt_defaults"] = (
-                med["moco"] / med["gaitlib (IPOPT defaults)"])
+        for tool, key in (("gaitlib (IPOPT defaults)", "speedup_ipopt_defaults"),
+                          ("gaitlib (MX, not expanded)", "speedup_mx_noexpand")):
+            if tool in med:
+                speedups[scheme][key] = med["moco"] / med[tool]
+        # end to end (setup + solve), medians
+        e2e = {}
+        for tool in tools:
+            ts = [r["setup_time"] + r["solve_time"] for r in runs
+                  if r["scheme"] == scheme and r["tool"] == tool]
+            e2e[tool] = statistics.median(ts) if ts else float("nan")
+        speedups[scheme]["end_to_end_median"] = e2e
     finished = dt.datetime.now(dt.timezone.utc)
     meta = {"started_utc": started.isoformat(timespec="seconds"),
             "finished_utc": finished.isoformat(timespec="seconds"),
@@ -238,8 +257,12 @@ def main(argv=None):
     for scheme, s in speedups.items():
         md.append(f"- {scheme}: Moco {s['moco_solve_median']:.2f} s / gaitlib "
                   f"{s['gaitlib_solve_median']:.2f} s = **{s['speedup']:.1f}×**"
-                  + (f" (gaitlib with IPOPT defaults: {s['speedup_ipopt_defaults']:.1f}×)"
-                     if "speedup_ipopt_defaults" in s else ""))
+                  + (f"; gaitlib with IPOPT defaults {s['speedup_ipopt_defaults']:.1f}×"
+                     if "speedup_ipopt_defaults" in s else "")
+                  + (f"; gaitlib MX not expanded {s['speedup_mx_noexpand']:.1f}×"
+                     if "speedup_mx_noexpand" in s else "")
+                  + "; setup + solve: " + ", ".join(
+                      f"{k} {v:.1f} s" for k, v in s["end_to_end_median"].items()))
     for r in runs:
         if r["tool"] == "moco":
             cc = r["cross_check_in_gaitlib_nlp"]
@@ -247,6 +270,15 @@ def main(argv=None):
                       f"NLP: objective {cc['objective']:.10f} (Moco: {r['objective']:.10f}), "
                       f"max defect {cc['max_violation_by_kind'].get('defects', float('nan')):.1e}")
     Path(args.out).with_suffix(".md").write_text("\n".join(md) + "\n")
+    # every invocation is also appended to a history file (repeated measurements)
+    hist = Path(args.out).parent / (Path(args.out).name + "_history.md")
+    entry = [f"## {meta['started_utc']} (load average at start "
+             f"{', '.join(f'{x:.2f}' for x in load_start)}; repeats {args.repeats})", "",
+             *lines, "", *[ln for ln in md if ln.startswith("- ")], ""]
+    with hist.open("a") as fh:
+        if hist.stat().st_size == 0:
+            fh.write("# T9-track benchmark history (appended by bench_moco_t9track.py)\n\n")
+        fh.write("\n".join(entry) + "\n")
 
     print()
     print("\n".join(lines))

@@ -37,6 +37,7 @@ Run ``python benchmarks/t9track.py --scheme trapezoidal`` (writes JSON + CSV lik
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import os
 import platform
@@ -275,7 +276,8 @@ def run(args) -> dict:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     tag = args.tag or (args.scheme + ("" if args.dynamics == "explicit" else "_implicit")
-                       + ("_ipoptdefaults" if args.ipopt_defaults else ""))
+                       + ("_ipoptdefaults" if args.ipopt_defaults else "")
+                       + ("" if args.graph == "sx" else "_" + args.graph))
     log_path = out / f"gaitlib_{tag}_ipopt.log"
     t0 = time.perf_counter()
     problem, mesh, guess, model, (filt, spline) = build(
@@ -287,6 +289,8 @@ def run(args) -> dict:
                   "print_user_options": "yes"})
     extra.update(dict(args.ipopt or {}))
     opts = ipopt_options(args.tol, args.max_iter, extra)
+    if args.graph == "mx-noexpand":
+        opts = dataclasses.replace(opts, graph="mx", expand=False)
     tr = ocp.transcribe(problem, mesh, opts)
     setup_time = time.perf_counter() - t0
     w0 = tr.initial_point(guess)
@@ -317,6 +321,7 @@ def run(args) -> dict:
                                                                      "file_print_level",
                                                                      "print_user_options")},
         "dynamics": args.dynamics,
+        "graph": args.graph,
         "success": sol.success,
         "status": sol.status,
         "iterations": sol.iterations,
@@ -375,6 +380,9 @@ def main(argv=None):
                     help='extra IPOPT options as JSON, e.g. \'{"linear_solver": "spral"}\'')
     ap.add_argument("--ipopt-defaults", action="store_true",
                     help=f"do not add gaitlib's benchmark IPOPT setting {GAITLIB_IPOPT}")
+    ap.add_argument("--graph", choices=("sx", "mx-noexpand"), default="sx",
+                    help="NLP graph: one SX graph (default) or MX with mapped per-node calls, "
+                         "not expanded (fast to build, slower to evaluate)")
     ap.add_argument("--tag", default=None, help="output file stem (default from options)")
     ap.add_argument("--out", default=str(HERE / "results" / "moco_raw"))
     args = ap.parse_args(argv)
