@@ -59,9 +59,9 @@ def build_parser() -> argparse.ArgumentParser:
     r = sub.add_parser("run", help="run a study (gait) and write frames, figures and summary.json")
     r.add_argument("study", help="study name: gait")
     r.add_argument("--out", required=True, help="output directory")
-    r.add_argument("--model", default="MSK", choices=["SK", "MSK"])
-    r.add_argument("--cost", default=None, help="cost function (default: Eq4.11 for SK, Eq5.33 for MSK; "
-                                                 "also DT, SDT1..3, SP1..3, FP)")
+    r.add_argument("--model", default="MSK", choices=["SK", "MSK", "NMSK"])
+    r.add_argument("--cost", default=None, help="cost function (default: Eq4.11 for SK, Eq5.33 for MSK, "
+                                                 "Eq5.55 for NMSK; also DT, SDT1..3, SP1..3, FP)")
     r.add_argument("--speed", default="Free", help="speed class (VerySlow, Slow, Free, Fast, VeryFast)")
     r.add_argument("--intervals", type=int, default=20, help="mesh intervals (thesis: 20)")
     r.add_argument("--degree", type=int, default=5, help="collocation points per interval (thesis: 5)")

@@ -8,10 +8,13 @@ activations, residuals), RMSE/NRMSE against the data and the solver's stats.
 
 Formulation (thesis Secs 4.3.2, 5.2.1, 6.1)
 -------------------------------------------
-states   x = [q, q̇, q̈]                                         (Eq 4.6 / 5.28), 33
-controls u = [jerk (11), R_pelvis (3), actuation]                (Eq 4.7 / 5.29)
-         actuation SK: τ (8 joint torques); MSK: τ_mtp (2) + a (12 MTG activations)
+states   x = [q, q̇, q̈]                                         (Eq 4.6 / 5.28 / 5.51), 33
+         NMSK: + u (16 neural activations, Eq 5.34), 49
+controls u = [jerk (11), R_pelvis (3), actuation]                (Eq 4.7 / 5.29 / 5.52)
+         actuation SK: τ (8 joint torques); MSK: τ_mtp (2) + a (12 MTG activations);
+         NMSK: τ_mtp (2) + ẽ (16 delayed muscle excitations ``ed_<muscle>_<side>``)
 dynamics ẋ = [q̇, q̈, jerk]                                        (Eq 4.9)
+         NMSK: u̇ = (c1 ẽ + c2)(ẽ − u)                             (Eqs 5.34–5.36)
 implicit dynamics, path constraint: inverse_dynamics(q, q̇, q̈) − [R; τ_input] = 0 (11)
          (Eq 4.10/5.30 bound the square of this difference to [0, 1e-12]; we impose the
          equality directly — the same set, better conditioned for IPOPT)
@@ -34,6 +37,64 @@ thesis's knee/ankle damping of ≈ 3 N·m·s/rad the difference reaches 10–18 
 ``Ang`` hip/knee/ankle angles (6), ``GRF`` the 4 foot forces, and ``Q`` —
 the motion term of Eqs 4.11 and 5.33 over all 11 coordinates (HAT, joints and the planned
 metatarsal angles).
+
+NMSK (Secs 5.3.2–5.3.4, 6.1)
+----------------------------
+The thesis solved Eq 5.34 "recursively over all time steps" from the excitation controls;
+in a collocation NLP the neural activations u are states with Eq 5.34 as dynamics (one
+more set of collocation defects, exact derivatives, and u(t_f) = u(0) on the periodic
+cycle). The electromechanical delay d = 50 ms is handled by making the **delayed**
+excitation ẽ(t) = e(t − d) — the signal that reaches the activation dynamics — the
+control, bounded to [0, 0.8] (Sec 5.3.4). On a periodic cycle e and ẽ are the same
+periodic signal shifted by d, so nothing is lost, the dynamics need no delay and no
+coupling across nodes (a delay operator on node values, e.g.
+:func:`gaitlib.activation.periodic_delay_matrix`, would need a uniform grid and, with a free
+final time, a t_f-dependent dense matrix; LGR nodes are not uniform). The solution reports
+e(t) = ẽ(t + d) (``GaitSolution.excitations``), comparable with EMG. Muscle activations
+a = c3 √u + (1 − c3) u (Eq 5.37, smoothed √, :func:`gaitlib.activation.neural_to_muscle_activation`);
+the 12 MTG activations follow Table 5.5 / Eq 5.54 (ankle extensor = s1 a_SOL + s2 a_PL +
+(1 − s1 − s2) a_GAM, :func:`gaitlib.activation.generator_activations`) and drive
+:func:`gaitlib.mtg.joint_torque`. γ = (τ_act, c3, s1, s2) (Eq 5.53): Table 5.10's
+identified values (0.006 s, 0.0001, 0.25, 0.25), or NLP parameters within Sec 5.3.4's
+bounds from Table 5.10's initial values with ``free_activation`` (the identification of
+Sec 5.3.4).
+
+``Act`` for NMSK is Act_NMSK (Eq 6.6): Σ of the 16 muscle activations squared (range 1).
+``Mtb`` (Eq 6.7 = the 8th term of Eq 5.55): t_f⁶/(BM² D⁴) (Ė/(Ė_max − Ė_min))² with
+Ė_max − Ė_min = COT_N (BM_max − BM_min) D / t_f (Eq 5.56: COT_N = 1.6 J kg⁻¹ m⁻¹,
+BM_max = 56.9 kg, BM_min = 25.9 kg), BM = the model's body mass (41.4 kg) and D = the
+data's stride length (the thesis: 1.24 m, its subjects' distance). The thesis writes the
+scaling as t_f⁶ BM⁻² d⁻⁴ without defining d; we read d as the distance D — the only reading
+that makes t_f⁶/(BM² d⁴) the inverse square of a power, as the text's motivation ("the
+magnitude of energy rate is considerably greater than the other cost terms") implies (the
+delay d = 0.05 s would make the term ≈ 4·10⁵ times larger). Ė is
+:func:`gaitlib.metabolics.nmsk_metabolic_rate` (Eq 5.38; its documented smoothing and
+sign conventions) with the heats from ẽ — the excitation the activation dynamics receive,
+Bhargava's "excitation" — the MTG torques from the muscle activations, and the
+metatarsal torques' work (Eq 5.50). t_stim (Eq 5.40) is the time a muscle's excitation
+exceeds 10 % of its maximum; the thesis re-estimated it "constantly" during the
+optimisation, which is piecewise constant in the decision variables (no derivative). We
+fix it per muscle from the initial (data-based) guess's excitations (or to
+``GaitSpec.t_stim``); ``GaitSolution.stats`` reports the COT with it and with t_stim
+re-estimated from the solution. The thesis defines Mtb for NMSK only (Sec 6.1), so MSK
+has no Mtb term and no metabolic frame.
+
+Initial guess (NMSK): states as for MSK (data); the thesis used the processed EMG for
+the excitations (Sec 5.3.4). Our default (``excitation_guess="mtg"``) maps the MSK guess's
+inverse-MTG activations (Sec 5.2.1) to muscles (Table 5.5) and inverts Eqs 5.37 and 5.34
+for the excitations; ``"emg"`` uses the data's EMG where the source has the muscle
+(Schwartz 2008: RF, BF ≈ lateral hamstrings, GAM, TA; gaitutils: all eight, normalised to
+a maximum of ≈ 1, so clipped at 0.8). :func:`warm_start` maps an MSK solution's MTG
+activations the same way (Sec 6.1 warm-starts NMSK from Ch 5's results).
+
+Final time
+----------
+Fixed to the data's cycle time T by default; ``GaitSpec.tf_bounds = (lo, hi)`` makes it
+free within bounds. The stride length stays the data's D = speed × T (periodic pelvis
+offset and HAT reference), so the speed is D / t_f; the data are tracked on normalised
+time t / t_f; the Jrk and Mtb t_f⁶ factors use the variable t_f (a static parameter
+``t_f`` tied to the phase's final time by an endpoint constraint, because integrands see
+only (x, u, p, t)).
 
 HAT reference: pelvis_tx = speed·t; pelvis_ty such that the contact of the data's pose,
 at rest, carries the data's total vertical GRF (:func:`kinematics.height_for_load`,

@@ -1,12 +1,12 @@
-"""Natural-gait data tracking (issue 4; thesis Secs 4.3.2 and 5.2): SK and MSK models.
+"""Natural-gait data tracking (issue 4; thesis Secs 4.3.2, 5.2 and 5.3): SK, MSK and NMSK models.
 
 Functions
 ---------
 :func:`solve_cached`   solve a :class:`~gaitlib.transcription.GaitSpec`, or reload the
                        solution stored under its key (spec + code + data hash).
 :func:`natural_gait`   the Free-speed data-tracking solve of a model (SK: Eq 4.11 with the
-                       contact parameters free, as Sec 4.3.2; MSK: Eq 5.33).
-:func:`rmse_beside_thesis`  our RMSEs beside the thesis's Table 4.9 / 5.4 (labelled).
+                       contact parameters free, as Sec 4.3.2; MSK: Eq 5.33; NMSK: Eq 5.55).
+:func:`rmse_beside_thesis`  our RMSEs beside the thesis's Table 4.9 / 5.4 / 5.11 (labelled).
 :func:`write_outputs`  frames, ``summary.json`` and figures into a directory (the CLI).
 
 Thesis values are references on *different data* (Bovi 2011 vs our Schwartz 2008 Free
@@ -44,8 +44,15 @@ THESIS_RMSE = {
             ("torque", "hip", "r"): 3.1, ("torque", "knee", "r"): 1.8, ("torque", "ankle", "r"): 3.9,
             ("torque", "hip", "l"): 2.3, ("torque", "knee", "l"): 1.1, ("torque", "ankle", "l"): 3.8,
             ("grf", "x", "r"): 7.2, ("grf", "y", "r"): 24.2, ("grf", "x", "l"): 4.6, ("grf", "y", "l"): 19.7},
+    # Table 5.11 (NMSK, Eq 5.55), as printed
+    "NMSK": {("angle", "hip", "r"): 0.6, ("angle", "knee", "r"): 1.1, ("angle", "ankle", "r"): 1.0,
+             ("angle", "hip", "l"): 0.6, ("angle", "knee", "l"): 1.2, ("angle", "ankle", "l"): 0.9,
+             ("torque", "hip", "r"): 2.3, ("torque", "knee", "r"): 1.1, ("torque", "ankle", "r"): 3.8,
+             ("torque", "hip", "l"): 2.3, ("torque", "knee", "l"): 1.1, ("torque", "ankle", "l"): 3.8,
+             ("grf", "x", "r"): 7.2, ("grf", "y", "r"): 24.1, ("grf", "x", "l"): 4.6, ("grf", "y", "l"): 19.8},
 }
-THESIS_TABLE = {"SK": "thesis, Table 4.9 (optimal control)", "MSK": "thesis, Table 5.4"}
+THESIS_TABLE = {"SK": "thesis, Table 4.9 (optimal control)", "MSK": "thesis, Table 5.4",
+                "NMSK": "thesis, Table 5.11"}
 
 
 def solve_cached(spec: tr.GaitSpec, *, use_cache: bool = True, root=None, guess=None,
@@ -82,10 +89,11 @@ def _guess_signature(guess) -> str:
 
 def natural_gait_spec(model: str = "SK", cost: str | None = None, speed: str = "Free", **kw) -> tr.GaitSpec:
     """The natural-gait data-tracking spec: SK → Eq 4.11 (Table 4.8 weights, Sec 4.3.2),
-    MSK → Eq 5.33 (Table 5.3), both with the thesis's identified contact parameters fixed
-    (Tables 4.17/4.18) unless ``free_contact=True`` (the identification of Ch 4)."""
+    MSK → Eq 5.33 (Table 5.3), NMSK → Eq 5.55 (Table 5.9), all with the thesis's identified
+    contact parameters fixed (Tables 4.17/4.18) unless ``free_contact=True`` (the
+    identification of Ch 4)."""
     if cost is None:
-        cost = "Eq4.11" if model == "SK" else "Eq5.33"
+        cost = {"SK": "Eq4.11", "MSK": "Eq5.33", "NMSK": "Eq5.55"}.get(model, "Eq5.33")
     return tr.GaitSpec(model=model, cost=cost, speed_class=speed, **kw)
 
 
