@@ -267,7 +267,6 @@ def parse_ipopt_log(text: str) -> dict:
         out["iter0_objective"] = float(it0.group(1))
         out["iter0_inf_pr"] = float(it0.group(2))
         out["iter0_inf_du"] = float(it0.group(3))
-    m = re.search(r"Number of variables with .*?:\s*(\d+)", text)
     total = re.search(r"Total number of variables\.*:\s*(\d+)", text)
     if total:
         out["n_variables"] = int(total.group(1))
