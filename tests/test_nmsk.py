@@ -41,7 +41,8 @@ def test_nmsk_cost_functions_match_thesis_tables():
 def test_nmsk_problem_builds_with_expected_dimensions():
     gp = tr.build(tr.GaitSpec(model="NMSK", cost="DT", n_intervals=4, degree=3))
     ph = gp.problem.phases[0]
-    assert len(ph.states) == 33 + 16 and len(ph.controls) == 11 + 3 + 2 + 16
+    assert len(ph.states) == 33 + 16 and len(ph.controls) == 11 + 3 + 2 + 16 + 1  # + lifted Ė (Mtb)
+    assert ph.controls[-1] == "edot_rest" and [c.name for c in ph.path_constraints] == ["dynamics", "metabolic_rate"]
     assert {g.name for g in ph.goals} == {"Jrk", "Rsd", "Imp", "HAT", "Act", "Mtb", "Trq", "Ang", "GRF"}
     assert gp.problem.parameter_names == ()  # Table 5.10 identified values fixed (Ch 6)
     assert all(ph.bounds[f"ed_{m}"] == (0.0, 0.8) for m in tr.NMSK_MUSCLES)  # Sec 5.3.4
@@ -132,10 +133,6 @@ def test_mtb_and_act_integrands_equal_independent_evaluation():
     uv["tau_mtp_r"], uv["tau_mtp_l"] = 3.0, -2.0
     xv["qd_mtp_r"], xv["qd_mtp_l"] = 1.5, -0.7
     t_f = 1.07
-    x = np.array([xv[s] for s in ph.states])
-    u = np.array([uv[c] for c in ph.controls])
-    mtb = _eval_integrand(gp, "Mtb", x, u, np.array([t_f]))
-
     c3 = activation.ACTIVATION_IDENTIFIED["c3"]
     act = {m: activation.neural_to_muscle_activation(xv[f"u_{m}"], c3) for m in tr.NMSK_MUSCLES}
     r = metabolics.nmsk_metabolic_rate(
@@ -143,6 +140,19 @@ def test_mtb_and_act_integrands_equal_independent_evaluation():
         {m: uv[f"ed_{m}"] for m in tr.NMSK_MUSCLES}, act, s1=0.25, s2=0.25,
         mtp_torques={"mtp_r": 3.0, "mtp_l": -2.0}, t_stim=dict(zip(tr.NMSK_MUSCLES, gp.t_stim)))
     edot = float(r["total"])
+    rest = float(r["activation"] + r["maintenance"] + r["shortening"] + r["work"])
+    # the lifted Ė: the path constraint ties edot_rest to Ȧ + Ṁ + Ṡ + Ẇ ...
+    uv["edot_rest"] = rest + 0.5
+    x = np.array([xv[s] for s in ph.states])
+    u = np.array([uv[c] for c in ph.controls])
+    xs, us, ps = ca.SX.sym("x", len(ph.states)), ca.SX.sym("u", len(ph.controls)), ca.SX.sym("p", 1)
+    pc = next(c for c in ph.path_constraints if c.name == "metabolic_rate")
+    g = ca.Function("g", [xs, us, ps], [pc.fun(Named(xs, ph.states), Named(us, ph.controls), Named(ps, ("t_f",)), 0.0)])
+    assert float(g(x, u, t_f)) == pytest.approx(0.5, abs=1e-9)
+    # ... and Mtb is evaluated on B + smax(edot_rest), i.e. on Ė where the constraint holds
+    uv["edot_rest"] = rest
+    u = np.array([uv[c] for c in ph.controls])
+    mtb = _eval_integrand(gp, "Mtb", x, u, np.array([t_f]))
     assert abs(edot) > 1.0  # W: away from the basal-rate clip, so the components all count
     D = gp.ref.gait.speed * gp.ref.gait.cycle_time
     BM = 41.4

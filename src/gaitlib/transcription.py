@@ -13,6 +13,7 @@ states   x = [q, q̇, q̈]                                         (Eq 4.6 / 5.2
 controls u = [jerk (11), R_pelvis (3), actuation]                (Eq 4.7 / 5.29 / 5.52)
          actuation SK: τ (8 joint torques); MSK: τ_mtp (2) + a (12 MTG activations);
          NMSK: τ_mtp (2) + ẽ (16 delayed muscle excitations ``ed_<muscle>_<side>``)
+         [+ ``edot_rest`` (lifted metabolic rate, W) when Mtb is weighted]
 dynamics ẋ = [q̇, q̈, jerk]                                        (Eq 4.9)
          NMSK: u̇ = (c1 ẽ + c2)(ẽ − u)                             (Eqs 5.34–5.36)
 implicit dynamics, path constraint: inverse_dynamics(q, q̇, q̈) − [R; τ_input] = 0 (11)
@@ -71,7 +72,13 @@ delay d = 0.05 s would make the term ≈ 4·10⁵ times larger). Ė is
 :func:`gaitlib.metabolics.nmsk_metabolic_rate` (Eq 5.38; its documented smoothing and
 sign conventions) with the heats from ẽ — the excitation the activation dynamics receive,
 Bhargava's "excitation" — the MTG torques from the muscle activations, and the
-metatarsal torques' work (Eq 5.50). t_stim (Eq 5.40) is the time a muscle's excitation
+metatarsal torques' work (Eq 5.50). Ė is *lifted*: a control ``edot_rest`` (W) equals
+Ȧ + Ṁ + Ṡ + Ẇ through an equality path constraint (``metabolic_rate``), and Mtb integrates
+k (B + smax(edot_rest))² (B the basal rate, smax as in :func:`gaitlib.metabolics.metabolic_rate`).
+This is the same NLP optimum, but the square and the smooth max no longer couple all ≈ 50
+variables Ė depends on at a node in the Hessian (dense rank-one blocks): on an 8 × 3 mesh
+the Lagrangian Hessian has 19,824 instead of 42,072 non-zeros (without Mtb: 19,800).
+t_stim (Eq 5.40) is the time a muscle's excitation
 exceeds 10 % of its maximum; the thesis re-estimated it "constantly" during the
 optimisation, which is piecewise constant in the decision variables (no derivative). We
 fix it per muscle from the initial (data-based) guess's excitations (or to
@@ -83,8 +90,8 @@ Initial guess (NMSK): states as for MSK (data); the thesis used the processed EM
 the excitations (Sec 5.3.4). Our default (``excitation_guess="mtg"``) maps the MSK guess's
 inverse-MTG activations (Sec 5.2.1) to muscles (Table 5.5) and inverts Eqs 5.37 and 5.34
 for the excitations; ``"emg"`` uses the data's EMG where the source has the muscle
-(Schwartz 2008: RF, BF ≈ lateral hamstrings, GAM, TA; gaitutils: all eight, normalised to
-a maximum of ≈ 1, so clipped at 0.8). :func:`warm_start` maps an MSK solution's MTG
+(Schwartz 2008: RF, BF ≈ lateral hamstrings, GAM ≈ medial gastrocnemius, TA; the
+gaitutils data have all eight muscles but no GRFs, which the gait problem needs). :func:`warm_start` maps an MSK solution's MTG
 activations the same way (Sec 6.1 warm-starts NMSK from Ch 5's results).
 
 Final time
@@ -419,6 +426,8 @@ def _controls(spec: GaitSpec) -> tuple[str, ...]:
         act = tuple(f"tau_{j}" for j in cv.JOINTS)
     elif spec.model == "NMSK":
         act = ("tau_mtp_r", "tau_mtp_l") + EXCITATION_CONTROLS
+        if "Mtb" in spec.term_weights:
+            act = act + ("edot_rest",)  # lifted non-basal metabolic rate, W (module docstring)
     else:
         act = ("tau_mtp_r", "tau_mtp_l") + MTG_CONTROLS
     return jerk + cv.RESIDUALS + act
@@ -605,7 +614,20 @@ def build(spec: GaitSpec) -> GaitProblem:
         parts = ("total", "activation", "maintenance", "shortening", "basal", "work")
         functions["edot"] = ca.Function("edot", [xs_, us_, ps_, ts_], [r[k] for k in parts],
                                         ["x", "u", "p", "t_stim"], list(parts))
+        basal = float(sum(metabolics.basal_rate(m) for m in NMSK_MUSCLES))
+        if "Mtb" in w:
+            guess = _with_edot_rest_guess(guess, states, controls, params, functions["edot"], t_stim)
     t_stim_dm = ca.DM(list(t_stim)) if t_stim else None
+
+    def edot_rest(x: Named, u: Named, p: Named):
+        """Ȧ + Ṁ + Ṡ + Ẇ (Eq 5.38 without the basal rate), W."""
+        out = functions["edot"](x.vec, u.vec, p.vec, t_stim_dm)
+        return out[1] + out[2] + out[3] + out[5]
+
+    if nmsk and "Mtb" in w:
+        # Ė lifted: edot_rest = Ȧ + Ṁ + Ṡ + Ẇ as a path constraint, Mtb on B + smax(edot_rest)
+        path.append(PathConstraint("metabolic_rate", lambda x, u, p, t: u["edot_rest"] - edot_rest(x, u, p),
+                                   0.0, 0.0))
 
     def sq(e, r):
         return (e / r) ** 2
@@ -634,9 +656,9 @@ def build(spec: GaitSpec) -> GaitProblem:
     elif nmsk:
         # Act_NMSK (Eq 6.6): the 16 muscle activations, range a_max − a_min = 1 (Sec 5.3.4)
         goal("Act", lambda x, u, p, t: sum(a_**2 for a_ in muscle_activations(x, p).values()))
-        # Mtb (Eq 6.7 with Eq 5.56)
+        # Mtb (Eq 6.7 with Eq 5.56); Ė = B + smax(Ȧ + Ṁ + Ṡ + Ẇ) as metabolics.metabolic_rate
         goal("Mtb", lambda x, u, p, t: mtb_scale(tf_of(p), stride)
-             * functions["edot"](x.vec, u.vec, p.vec, t_stim_dm)[0] ** 2)
+             * (basal + metabolics._smax0(u["edot_rest"], 0.1)) ** 2)
     goal("Trq", lambda x, u, p, t, d: sum(sq(node(x, u, p)["tau_net"][cv.JOINTS.index(j)] - d[f"ref_tau_{j}"], rg[f"tau_{j}"])
                                           for j in LEG_JOINTS))
     goal("Ang", lambda x, u, p, t, d: sum(sq(x[j] - d[f"ref_{j}"], rg[j]) for j in LEG_JOINTS))
@@ -677,6 +699,8 @@ def build(spec: GaitSpec) -> GaitProblem:
             for m in NMSK_MUSCLES:
                 bounds[f"ed_{m}"] = tuple(map(float, activation.EXCITATION_BOUNDS))  # [0, 0.8], Sec 5.3.4
                 bounds[f"u_{m}"] = (0.0, 1.0)
+            if "edot_rest" in controls:
+                bounds["edot_rest"] = (-1e4, 1e4)
         else:
             for a in MTG_CONTROLS:
                 bounds[a] = (0.0, 1.0)
@@ -816,6 +840,20 @@ def _nmsk_guess(spec: GaitSpec, ref: Reference, t, a_gen: dict):
     for i, m in enumerate(NMSK_MUSCLES):
         S[f"u_{m}"] = np.append(U[:, i], U[0, i])
     return S, C
+
+
+def _with_edot_rest_guess(guess: Guess, states, controls, params, f_edot, t_stim) -> Guess:
+    """``guess`` with the lifted control ``edot_rest`` = Ȧ + Ṁ + Ṡ + Ẇ evaluated on it."""
+    g = guess.phases["cycle"]
+    n = len(np.asarray(g.time))
+    X = np.array([np.asarray(g.states[k], float) for k in states])
+    U = np.array([np.asarray(g.controls[k], float) if k in g.controls else np.zeros(n) for k in controls])
+    pv = np.array([guess.parameters.get(p_.name, p_.initial()) for p_ in params], float).reshape(-1, 1)
+    out = f_edot.map(n)(X, U, np.tile(pv, n), np.tile(np.reshape(np.asarray(t_stim, float), (-1, 1)), n))
+    rest = np.asarray(out[1] + out[2] + out[3] + out[5], float).ravel()
+    C = {**dict(g.controls), "edot_rest": rest}
+    return Guess(phases={"cycle": PhaseGuess(time=g.time, states=g.states, controls=C, t0=g.t0, tf=g.tf)},
+                 parameters=dict(guess.parameters))
 
 
 # ======================================================================================
@@ -996,8 +1034,13 @@ def warm_start(gp: GaitProblem, guess) -> Guess:
         tf_g = float(np.clip(ph.tf, *gp.spec.tf_bounds))
         time = np.asarray(base.time, float) * (tf_g / T)
         params["t_f"] = tf_g
-    return Guess(phases={"cycle": PhaseGuess(time=time, states={**dict(base.states), **S}, controls=C)},
-                 parameters=params)
+    out = Guess(phases={"cycle": PhaseGuess(time=time, states={**dict(base.states), **S}, controls=C)},
+                parameters=params)
+    ph0 = gp.problem.phases[0]
+    if "edot_rest" in ph0.controls and "edot_rest" not in ph.controls.columns:
+        out = _with_edot_rest_guess(out, ph0.states, ph0.controls, gp.problem.parameters, gp.functions["edot"],
+                                    gp.t_stim)
+    return out
 
 
 def _activation_solution(gp: GaitProblem, sol: ocp.Solution) -> dict[str, float]:
