@@ -39,6 +39,37 @@ def channel_display(channel: str) -> tuple[str, float, str]:
     return (stem, 1.0, "")
 
 
+def _panel_grid(n: int, ncols: int, figsize_per):
+    """A grid of ``n`` panels (figure, axes array), constrained layout."""
+    import matplotlib.pyplot as plt
+
+    nrows = int(np.ceil(n / ncols))
+    return plt.subplots(nrows, ncols, figsize=(figsize_per[0] * ncols, figsize_per[1] * nrows),
+                        squeeze=False, constrained_layout=True)
+
+
+def _label_panel(ax, channel: str, unit: str, name: str):
+    side = {"_r": " (right)", "_l": " (left)"}.get(channel[-2:], "")
+    ax.set_title(name + side, fontsize=9)
+    ax.set_ylabel(unit, fontsize=8)
+    ax.set_xlim(0, 100)
+    ax.tick_params(labelsize=7)
+
+
+def _finish_panels(fig, axes, n: int, title=None):
+    """Hide unused panels, label the x axes (% gait cycle), one legend, a title."""
+    for ax in axes.flat[n:]:
+        ax.axis("off")
+    for ax in axes[-1]:
+        ax.set_xlabel("% gait cycle", fontsize=8)
+    handles, labs = axes.flat[0].get_legend_handles_labels()
+    if handles:
+        fig.legend(handles, labs, loc="outside lower center", ncols=min(len(labs), 5), fontsize=8)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    return fig
+
+
 def band(ax, x, mean, sd, color="0.6", label=None, alpha=0.35, line=True):
     """Draw mean ± 1 SD as a shaded band (and the mean as a dotted line)."""
     x, mean, sd = (np.asarray(v, dtype=float) for v in (x, mean, sd))
@@ -60,9 +91,7 @@ def data_bands(datasets: dict, channels, ncols: int = 3, colors=None, figsize_pe
     import matplotlib.pyplot as plt
 
     channels = list(channels)
-    nrows = int(np.ceil(len(channels) / ncols))
-    fig, axes = plt.subplots(nrows, ncols, figsize=(figsize_per[0] * ncols, figsize_per[1] * nrows),
-                             squeeze=False, constrained_layout=True)
+    fig, axes = _panel_grid(len(channels), ncols, figsize_per)
     cmap = plt.get_cmap("viridis")
     labels = list(datasets)
     if colors is None:
@@ -74,21 +103,8 @@ def data_bands(datasets: dict, channels, ncols: int = 3, colors=None, figsize_pe
                 continue
             pct = 100 * d.time / d.cycle_time
             band(ax, pct, scale * d.mean[ch], scale * d.sd[ch], color=colors[lab], label=lab, alpha=0.25)
-        side = {"_r": " (right)", "_l": " (left)"}.get(ch[-2:], "")
-        ax.set_title(name + side, fontsize=9)
-        ax.set_ylabel(unit, fontsize=8)
-        ax.set_xlim(0, 100)
-        ax.tick_params(labelsize=7)
-    for ax in axes.flat[len(channels):]:
-        ax.axis("off")
-    for ax in axes[-1]:
-        ax.set_xlabel("% gait cycle", fontsize=8)
-    handles, labs = axes.flat[0].get_legend_handles_labels()
-    if handles:
-        fig.legend(handles, labs, loc="outside lower center", ncols=min(len(labs), 5), fontsize=8)
-    if title:
-        fig.suptitle(title, fontsize=10)
-    return fig
+        _label_panel(ax, ch, unit, name)
+    return _finish_panels(fig, axes, len(channels), title)
 
 
 # =====================================================================================
@@ -460,9 +476,7 @@ def tracking_figure(gait, sims: dict, channels=GAIT_CHANNELS, ncols: int = 4, co
     import matplotlib.pyplot as plt
 
     channels = list(channels)
-    nrows = int(np.ceil(len(channels) / ncols))
-    fig, axes = plt.subplots(nrows, ncols, figsize=(figsize_per[0] * ncols, figsize_per[1] * nrows),
-                             squeeze=False, constrained_layout=True)
+    fig, axes = _panel_grid(len(channels), ncols, figsize_per)
     cmap = plt.get_cmap("tab10")
     colors = colors or {lab: cmap(i) for i, lab in enumerate(sims)}
     pct_data = 100 * gait.time / gait.cycle_time
@@ -475,18 +489,77 @@ def tracking_figure(gait, sims: dict, channels=GAIT_CHANNELS, ncols: int = 4, co
                 t = np.asarray(frame.index, dtype=float)
                 ax.plot(100 * (t - t[0]) / gait.cycle_time, scale * frame[ch].to_numpy(), color=colors[lab],
                         lw=1.4, label=lab)
-        side = {"_r": " (right)", "_l": " (left)"}.get(ch[-2:], "")
-        ax.set_title(name + side, fontsize=9)
-        ax.set_ylabel(unit, fontsize=8)
-        ax.set_xlim(0, 100)
-        ax.tick_params(labelsize=7)
-    for ax in axes.flat[len(channels):]:
-        ax.axis("off")
-    for ax in axes[-1]:
-        ax.set_xlabel("% gait cycle", fontsize=8)
-    handles, labs = axes.flat[0].get_legend_handles_labels()
-    if handles:
-        fig.legend(handles, labs, loc="outside lower center", ncols=min(len(labs), 5), fontsize=8)
+        _label_panel(ax, ch, unit, name)
+    return _finish_panels(fig, axes, len(channels), title)
+
+
+def animate_jump(jump_model, t, Q, p_contact=None, grf=None, cop=None, fps: float = 12,
+                 interval=None, max_frames: int = 50, figsize=(4.5, 5.0), dpi: int = 72,
+                 grf_scale=None, grf_min=None, ellipsoids=None, title=None):
+    """Animate a vertical jump of a :class:`gaitlib.jump.JumpModel` (thesis Ch 3).
+
+    Parameters
+    ----------
+    jump_model : gaitlib.jump.JumpModel
+    t : (n,) s; Q : (n, jump_model.n) free coordinates ``(x, y, theta_z, joints…)``, m and
+        rad (the welded phase's rows have the root at 0).
+    p_contact : contact parameters of the toe-included model's ellipsoids (default
+        :func:`gaitlib.contact.default_params`).
+    grf : optional (n, 2) ground reaction force of both feet (F_x, F_y), N, drawn as an
+        arrow from ``(cop[i], 0)`` (``cop`` (n,) m; default: below the MTP point), hidden
+        where F_y < ``grf_min`` (default 4 % of the weight) or where ``cop`` is NaN.
+        ``grf_scale`` m per N (default: one body weight ↦ 0.5 m).
+    fps, interval, max_frames, figsize, dpi, title : as :func:`animate_gait`.
+
+    Fixed axes that contain every frame (so the height of the jump is visible); the body
+    is drawn with :func:`draw_jump`. Returns a ``FuncAnimation`` (``anim.frame_indices``).
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.animation import FuncAnimation
+
+    t = np.asarray(t, dtype=float)
+    Q = np.asarray(Q, dtype=float)
+    W = jump_model.total_mass * jump_model.g
+    scale = 0.5 / W if grf_scale is None else grf_scale
+    fmin = 0.04 * W if grf_min is None else grf_min
+    idx = _pick_frames(len(t), max_frames)
+    frames = [jump_frame(jump_model, Q[i], p_contact, ellipsoids) for i in idx]
+    pts = np.vstack([np.vstack(list(f["chains"].values()) + list(f["ellipses"].values()))
+                     for f in frames])
+    pad = 0.15
+    xlo, xhi = pts[:, 0].min() - pad, pts[:, 0].max() + pad
+    ylo, yhi = min(pts[:, 1].min(), 0.0) - 0.05, pts[:, 1].max() + 0.08
+
+    fig, ax = plt.subplots(figsize=figsize, dpi=dpi, constrained_layout=True)
+    artists = draw_jump(ax, jump_model, Q[idx[0]], p_contact, ellipsoids)
+    arrow = _arrow(ax, FIGURE_COLORS["grf"]) if grf is not None else None
+    ax.set_xlim(xlo, xhi)
+    ax.set_ylim(ylo, yhi)
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    label = ax.text(0.02, 0.97, "", transform=ax.transAxes, va="top", fontsize=9)
     if title:
-        fig.suptitle(title, fontsize=10)
-    return fig
+        ax.set_title(title, fontsize=10)
+
+    def update(k):
+        i = idx[k]
+        fr = frames[k]
+        _set_line(artists["chains"]["body"], fr["chains"]["body"])
+        for e, patch in artists["ellipsoids"].items():
+            patch.set_xy(fr["ellipses"][e])
+        changed = [artists["chains"]["body"], *artists["ellipsoids"].values(), label]
+        if arrow is not None:
+            fx, fy = (float(v) for v in grf[i])
+            x0 = float(Q[i, 0]) if cop is None else float(cop[i])
+            _set_arrow(arrow, (x0, 0.0), (scale * fx, scale * fy),
+                       visible=bool(fy > fmin and np.isfinite(x0)))
+            changed.append(arrow)
+        label.set_text(f"t = {t[i]:.3f} s")
+        return changed
+
+    update(0)
+    interval = 1000.0 / fps if interval is None else interval
+    anim = FuncAnimation(fig, update, frames=len(idx), interval=interval, blit=False)
+    anim.frame_indices = idx
+    plt.close(fig)
+    return anim
