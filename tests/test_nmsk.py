@@ -209,6 +209,10 @@ def test_coarse_nmsk_data_tracking_converges(coarse_nmsk):
     assert s.metabolic["basal"].to_numpy() == pytest.approx(basal)
     assert s.metabolic["total"].min() >= basal - 0.05 - 1e-9
     assert np.isfinite(s.stats["COT"]) and s.stats["COT"] > 0
+    # the lifted control equals Ȧ + Ṁ + Ṡ + Ẇ recomputed from the states and excitations
+    m = s.metabolic
+    rest = (m["activation"] + m["maintenance"] + m["shortening"] + m["work"]).to_numpy()
+    np.testing.assert_allclose(s.solution.phase("cycle").controls["edot_rest"].to_numpy(), rest, atol=1e-5)
     # the reported excitation is the control shifted by the delay: e(t) = ẽ(t + d)
     U = s.solution.phase("cycle").controls
     t = U.index.to_numpy()
