@@ -250,6 +250,20 @@ class JumpModel:
             qdd = solve_spd(M, Q - h)
             outs = {"qdd": qdd, **extra}
             return ca.Function(name, inputs, list(outs.values()), names, list(outs))
+        if name == "contact_id":
+            q, qd, qdd = S["q"], S["qd"], S["qdd"]
+            qs, qds = ca.vertsplit(q), ca.vertsplit(qd)
+            st = tree.kinematics(qs, qds, ca.vertsplit(qdd))
+            _, res, loads = self._loads(st, ca.vertsplit(S["p_contact"]))
+            Q = self._dyn(qs, qds, ca.vertsplit(qdd), loads)
+            k = float(self.contact_feet)
+            tau = ca.vertcat(*Q[3:]) + B * qd[3:]
+            outs = {"tau": tau, "residual": ca.vertcat(*Q[:3]),
+                    "fn": k * ca.vertcat(*[r["fn"] for r in res]),
+                    "grf_x": sum(ld.force[0] for ld in loads),
+                    "grf_y": sum(ld.force[1] for ld in loads)}
+            return ca.Function(name, [q, qd, qdd, S["p_contact"]], list(outs.values()),
+                               ["q", "qd", "qdd", "p_contact"], list(outs))
         if name == "flight_id":
             q, qd, qdd = S["q"], S["qd"], S["qdd"]
             Q = self._dyn(ca.vertsplit(q), ca.vertsplit(qd), ca.vertsplit(qdd))
@@ -310,6 +324,8 @@ class JumpModel:
           cop_x -- root welded at the standing pose (DOF 3 / 4)
         * ``stance_id``: (qj, qdj, qddj) -> tau, grf, cop_x
         * ``contact``: (q, qd, tau, p_contact) -> qdd, fn (3,), grf_x, grf_y (toe model)
+        * ``contact_id``: (q, qd, qdd, p_contact) -> tau, residual (root wrench the contact
+          and gravity leave unbalanced: zero if consistent), fn (3,), grf_x, grf_y
         * ``com``: (q, qd) -> com (2,), com_vel (2,); ``energies``: (q, qd) -> kinetic,
           potential_gravity; ``points``: (q) -> mtp, ankle, knee, hip, head, [toe_tip]
         """

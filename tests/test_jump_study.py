@@ -1,0 +1,211 @@
+"""Physics and number tests of the Ch 3 vertical-jump study (gaitlib.studies.jump).
+
+Coarse meshes (5 LGR intervals x 4 points per phase) keep each solve to a few seconds; the
+assertions are about the physics of the solution, which does not depend on the mesh:
+take-off and apex events, the static start, zero flight GRF, the ballistic flight, the COM
+band, the friction ratio of Eq 3.6 and the bookkeeping of failed solves.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from gaitlib import conventions as cv, ocp
+from gaitlib.studies import jump as J
+
+COARSE = dict(n_intervals=5)
+
+
+@pytest.fixture(scope="module")
+def toe():
+    return J.solve(J.spec("toe", **COARSE))
+
+
+@pytest.fixture(scope="module")
+def ellipsoid():
+    return J.solve(J.spec("ellipsoid", **COARSE))
+
+
+# ------------------------------------------------------------------------------ spec
+def test_thesis_tables():
+    """Weights (Table 3.10), COM bands (Table 3.8) and the ankle mapping of Table 3.5."""
+    assert J.SPECS["toeless"].weights == (1.0, 12.0)
+    assert J.SPECS["toe"].weights == (1.0, 1.0)
+    assert J.SPECS["ellipsoid"].weights == (2.0, 1.0, 1.0, 5.0)
+    assert [J.SPECS[k].dx_com for k in ("toeless", "toe", "ellipsoid")] == [0.01, 0.06, 0.002]
+    b = J.joint_bounds("ankle")  # thesis 50..110 deg, 90 = standing, dorsiflexion decreases it
+    np.testing.assert_allclose(np.degrees(b["q"]), [-20.0, 40.0])
+    np.testing.assert_allclose(np.degrees(b["qd"]), [-1500.0, 1200.0])
+    assert b["tau"] == (-2000.0, 4000.0)
+    k = J.joint_bounds("knee")
+    np.testing.assert_allclose(np.degrees(k["q"]), [-150.0, 0.0])
+    assert k["tau"] == (-2000.0, 1500.0)
+    with pytest.raises(ValueError):
+        J.JumpSpec("toe", weights=(1.0, 1.0, 1.0, 1.0))
+
+
+def test_implicit_and_explicit_dynamics_agree():
+    """The implicit form's inverse-dynamics constraint is the explicit model inverted: the
+    two phase models give the same residual-free q̈ for the same state and torques."""
+    jp = J.build(J.spec("toe", n_intervals=2))
+    m = jp.model
+    rng = np.random.default_rng(3)
+    qj, qdj, tau = rng.normal(size=4) * 0.3, rng.normal(size=4), rng.normal(size=4) * 80
+    qdd = m.stance_dynamics(qj, qdj, tau)["qddj"]
+    back = m.stance_inverse_dynamics(qj, qdj, qdd)["tau"]
+    np.testing.assert_allclose(back, tau, rtol=1e-9, atol=1e-8)
+
+
+# ------------------------------------------------------------------------------ kinematic
+def test_kinematic_jump_events_and_physics(toe):
+    s = toe
+    assert s.success, s.status
+    tr, m = s.trajectory, s.model
+    W = m.total_mass * m.g
+    crouch, thrust, flight = (tr[tr.phase == p] for p in ("crouch", "thrust", "flight"))
+    # Table 3.7: a_COM = 0 at the start (GRF = weight, no horizontal force), at rest
+    np.testing.assert_allclose(crouch[["grf_x", "grf_y"]].iloc[0], [0.0, W], atol=1e-5 * W)
+    np.testing.assert_allclose(crouch[[f"qd_{j}" for j in m.joints]].iloc[0], 0.0, atol=1e-8)
+    # take-off: vertical GRF zero at the end of the thrust, COM moving up
+    assert abs(thrust["grf_y"].iloc[-1]) < 1e-4 * W
+    assert thrust["com_vy"].iloc[-1] > 0.5
+    # the welded ground only pushes
+    assert (pd.concat([crouch, thrust])["grf_y"] > -1e-3 * W).all()
+    # flight: no ground force, apex at the end (v_y,COM = 0)
+    assert (flight[["grf_x", "grf_y"]] == 0.0).all().all()
+    assert abs(flight["com_vy"].iloc[-1]) < 1e-6
+    # continuity at take-off: joint angles, velocities, torques and the root at rest
+    a, b = thrust.iloc[-1], flight.iloc[0]
+    cols = list(m.joints) + [f"qd_{j}" for j in m.joints] + [f"tau_{j}" for j in m.joints]
+    np.testing.assert_allclose(a[cols].astype(float), b[cols].astype(float), atol=1e-7)
+    np.testing.assert_allclose(b[["x", "y", "theta_z", "qd_x", "qd_y", "qd_theta_z"]].astype(float),
+                               0.0, atol=1e-9)
+
+
+def test_jump_height_is_ballistic(toe):
+    """COM rise in flight = v_TO² / 2g, flight time = v_TO / g, and the COM follows the
+    parabola y_TO + v_TO s − g s²/2 at every interior flight node (only its end is
+    constrained), within 1 cm on this coarse mesh."""
+    s = toe
+    h, g = s.jump_height, s.model.g
+    v = h["takeoff_vy"]
+    assert h["com_rise_flight"] == pytest.approx(v**2 / (2 * g), rel=1e-6)
+    assert h["ballistic"] == pytest.approx(v**2 / (2 * g), rel=1e-12)
+    assert h["apex_time"] - h["takeoff_time"] == pytest.approx(v / g, rel=1e-6)
+    fl = s.trajectory[s.trajectory.phase == "flight"]
+    t = fl.index.to_numpy() - h["takeoff_time"]
+    parabola = fl["com_y"].iloc[0] + v * t - 0.5 * g * t**2
+    assert np.max(np.abs(fl["com_y"].to_numpy() - parabola)) < 0.01
+    # the COM velocity of the collocated states errs most just after take-off, where the
+    # light toe is released (the collocation error the ballistic apex constraint guards
+    # the cost against): within 15 % of v_TO on this 5-interval mesh
+    assert np.max(np.abs(fl["com_vy"].to_numpy() - (v - g * t))) < 0.15 * v
+    # COM rise from standing and foot lift are consistent with the COM rise in flight
+    assert h["com_rise_standing"] == pytest.approx(
+        fl["com_y"].iloc[-1] - s.trajectory["com_y"].iloc[0])
+    assert h["foot_lift"] == pytest.approx(fl["y"].iloc[-1])
+
+
+def test_com_band_and_bounds(toe):
+    """Table 3.8 band |x_COM − x_COM(0)| ≤ 6 cm in every phase; Table 3.5 bounds hold."""
+    s = toe
+    tr = s.trajectory
+    dx = tr["com_x"] - tr["com_x"].iloc[0]
+    assert dx.abs().max() <= s.spec.dx_com + 1e-6
+    for j in s.model.joints:
+        b = J.joint_bounds(j)
+        assert tr[j].min() >= b["q"][0] - 1e-6 and tr[j].max() <= b["q"][1] + 1e-6
+        assert tr[f"tau_{j}"].min() >= b["tau"][0] - 1e-4
+        assert tr[f"tau_{j}"].max() <= b["tau"][1] + 1e-4
+    assert tr.loc[tr.phase != "flight", "mtp"].min() >= -1e-8  # heel above the ground
+
+
+def test_friction_ratio_eq_3_6(toe):
+    s = toe
+    tr = s.trajectory
+    W = s.model.total_mass * s.model.g
+    loaded = tr["grf_y"] >= s.spec.fy_min_fraction * W
+    np.testing.assert_allclose(tr.loc[loaded, "friction_ratio"],
+                               (tr.loc[loaded, "grf_x"] / tr.loc[loaded, "grf_y"]).abs())
+    assert tr.loc[~loaded, "friction_ratio"].isna().all()
+    contact = tr[tr.phase != "flight"]
+    assert s.required_friction == pytest.approx(contact["friction_ratio"].max())
+
+
+def test_results_and_stats_tables(toe):
+    res = J.results_table({"toe": toe})
+    row = res.iloc[0]
+    assert row["IPOPT status"] == "Solve_Succeeded"
+    assert row["jump height (cm), thesis, Sec 3.4.4"] == 66.0
+    assert row["μ_s, thesis, Sec 3.4.3"] == 1.0
+    assert row["COM rise in flight (cm)"] == pytest.approx(100 * toe.jump_height["com_rise_flight"])
+    st = J.stats_table({"toe": toe}).iloc[0]
+    assert st["iterations"] > 0 and st["solve_time_s"] > 0
+    assert st["time_per_iteration_ms"] == pytest.approx(1e3 * st["solve_time_s"] / st["iterations"])
+
+
+# ------------------------------------------------------------------------------ ellipsoid
+def test_ellipsoid_jump(ellipsoid):
+    s = ellipsoid
+    assert s.success, s.status
+    tr, m = s.trajectory, s.model
+    W = m.total_mass * m.g
+    crouch, thrust, flight = (tr[tr.phase == p] for p in ("crouch", "thrust", "flight"))
+    # static start carried by the ellipsoids: GRF = (0, W), at rest
+    np.testing.assert_allclose(crouch[["grf_x", "grf_y"]].iloc[0], [0.0, W], atol=1e-4 * W)
+    np.testing.assert_allclose(crouch.filter(like="qd_").iloc[0], 0.0, atol=1e-8)
+    # take-off: 0 ≤ F_y ≤ 1 N; in flight the feet are off the ground (GRF < 1 N)
+    assert 0.0 <= thrust["grf_y"].iloc[-1] <= s.spec.fy_takeoff + 1e-6
+    assert flight["grf_y"].max() < 1.0
+    # ballistic apex and the 2 mm COM band
+    v, g = s.jump_height["takeoff_vy"], m.g
+    assert s.jump_height["com_rise_flight"] == pytest.approx(v**2 / (2 * g), rel=1e-6)
+    assert (tr["com_x"] - tr["com_x"].iloc[0]).abs().max() <= 0.002 + 1e-6
+    # velocity-based friction: |Fx/Fy| cannot exceed the largest μ of the ellipsoids much
+    assert s.required_friction < 0.5
+
+
+# ------------------------------------------------------------------------------ failures
+def test_failed_solve_is_reported():
+    """An unconverged solve keeps IPOPT's status; tables and figures say FAILED."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ocp.SolveFailedWarning)
+        s = J.solve(J.spec("toeless", n_intervals=3, max_iter=3))
+    assert not s.success
+    assert s.status == "Maximum_Iterations_Exceeded"
+    assert J.results_table({"toeless": s}).iloc[0]["IPOPT status"] == s.status
+    import matplotlib
+
+    matplotlib.use("Agg")
+    fig = J.plot_channels({"toeless": s}, "angles")
+    assert "FAILED" in fig.axes[0].get_title()
+
+
+def test_cache_roundtrip(toe, tmp_path):
+    """A cached solution reloads with the same numbers and says so."""
+    from gaitlib import cache
+
+    sp = toe.spec
+    where = cache.lookup("jump", {"kind": "jump", **sp.to_dict()}, tmp_path)
+    toe.solution.save(where)
+    s2 = J.solve(sp, use_cache=True, root=tmp_path)
+    assert s2.from_cache and s2.stats["from_cache"]
+    assert s2.jump_height == pytest.approx(toe.jump_height)
+    pd.testing.assert_frame_equal(s2.trajectory, toe.trajectory)
+
+
+def test_animation(toe):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    anim = J.animate(toe, max_frames=6)
+    assert len(anim.frame_indices) == 6
+    html = __import__("gaitlib.plots", fromlist=["animation_html"]).animation_html(anim)
+    assert "<img" in html or "data:image" in html
+    t, Q = toe.poses()
+    assert Q.shape == (len(t), toe.model.n) and np.all(np.diff(t) > 0)
