@@ -49,12 +49,15 @@ Our choices where Ch 3 is silent (each one a field of :class:`JumpSpec`)
   [−40°, 20°], would not let the knee bend to the −122° and −150° the thesis reports with
   the foot flat). The other joints' bounds are used as printed (their signs match
   :mod:`gaitlib.conventions`).
-* Phase durations (``durations``): crouch 0.1–1.5 s, thrust 0.05–1 s, flight 0.05–1.5 s.
+* Phase durations (``durations``): crouch 0.1–1 s, thrust 0.05–0.5 s, flight 0.05–1.5 s.
 * Kinematic contact: the welded ground may only push (F_y ≥ 0 in preflight,
   ``unilateral``), the heel may not go below the ground (mtp ≥ 0 while the toe is welded),
   and in flight the ankle and toe tip stay above the ground (``flight_clearance``; the MTP
   point is bounded y ≥ 0).
-* Ellipsoid contact: take-off is ``0 ≤ F_y ≤ fy_takeoff`` (1 N) — the smoothed contact law
+* Ellipsoid contact: the feet stay on the ground during the crouch (F_y ≥ 2 % of the
+  weight at its collocation nodes, ``contact_fy_min``; without it the optimum hops during
+  the "crouch"); take-off is ``0 ≤ F_y ≤ fy_takeoff`` (1 N), and F_y ≤ ``flight_fy_max``
+  (7 N, 1 % of the weight) in flight (the feet must not touch down again) — the smoothed contact law
   (:class:`gaitlib.contact.Smoothing`) never gives exactly 0; the contact parameters are
   the child foot's (:func:`gaitlib.contact.default_params`) on both (doubled) feet, see
   :mod:`gaitlib.jump` (Ch 3 used Brown & McPhee's adult values, not printed).
@@ -65,7 +68,8 @@ Our choices where Ch 3 is silent (each one a field of :class:`JumpSpec`)
   of the light, fast-spinning toe (the root segment). ``"nodes"`` imposes the parabola at
   every collocation node too (nearly redundant constraints: IPOPT converges badly).
 * A small regularisation ``w_reg ∫ Σ_j (τ̇_j / taud_max)² dt`` in every phase (reported as
-  goal ``reg_taud``): the flight's torques do not enter the thesis's cost at all.
+  goal ``reg_taud``, a few per cent of the objective): the flight's torques do not enter
+  the thesis's cost at all, and without it the torques ring from node to node.
 * Mesh: GPOPS-II's hp-adaptive mesh (Table 3.11: "30 meshes", 4–20 collocation points per
   interval) is replaced by fixed LGR meshes, ``degree`` = 4 points (their minimum) ×
   ``n_intervals`` per phase, the thrust's intervals shrinking towards take-off
@@ -179,6 +183,12 @@ class JumpSpec:
     unilateral : F_y ≥ 0 in the welded preflight (kinematic contact).
     fy_takeoff : take-off F_y upper bound, N (ellipsoid contact; 0 is imposed exactly for
         the kinematic contact).
+    flight_fy_max : F_y upper bound, N, at the flight's collocation nodes (ellipsoid
+        contact: the feet must not touch down again; 7 N ≈ 1 % of the weight — with 1 N the
+        10-interval solve did not converge in 5000 iterations); None switches it off.
+    contact_fy_min : ellipsoid contact: F_y ≥ this fraction of the weight at every collocation
+        node of the crouch (without it the optimum hops during the "crouch"); None
+        switches it off.
     fy_min_fraction : |F_x/F_y| (Eq 3.6) is evaluated where F_y ≥ this fraction of the
         body weight (the ratio is undefined at take-off, where F_y → 0).
     w_reg : weight of our regularisation ``∫ Σ_j (τ̇_j / taud_max)² dt`` in every phase
@@ -204,12 +214,14 @@ class JumpSpec:
     degree: int = 4
     thrust_refine: float = 8.0
     continuation: tuple = (5,)
-    durations: tuple = ((0.1, 1.5), (0.05, 1.0), (0.05, 1.5))
+    durations: tuple = ((0.1, 1.0), (0.05, 0.5), (0.05, 1.5))
     taud_max: float = 3.0e4
     unilateral: bool = True
     fy_takeoff: float = 1.0
+    contact_fy_min: float | None = 0.02
+    flight_fy_max: float | None = 7.0
     fy_min_fraction: float = 0.05
-    w_reg: float = 1e-3
+    w_reg: float = 0.1
     ballistic_flight: str = "apex"
     flight_clearance: bool = True
     damping: float = 0.1
@@ -526,12 +538,16 @@ def build(sp: JumpSpec) -> JumpProblem:
     else:
         st, ct, dyn, pcs = phase_model("contact")
         b = bounds(True, False)
+        on_ground = pcs
+        if sp.contact_fy_min is not None:  # the feet stay on the ground until take-off
+            on_ground = pcs + [ocp.PathConstraint(
+                "feet_on_ground", lambda x, u, p, t: grf_end(x)[1], sp.contact_fy_min * W, np.inf)]
         knee_des = sp.knee_des_deg * cv.DEG
         w = sp.weights
         crouch = ocp.Phase(
             "crouch", st, ct, dyn, t0=0.0, tf=d[0], bounds=b,
             initial={"x": 0.0, **{j: 0.0 for j in joints}, **{v: 0.0 for v in qdn_f}},
-            path_constraints=tuple([com_band(True)] + pcs),
+            path_constraints=tuple([com_band(True)] + on_ground),
             endpoint_constraints=(com_start(True), static_start),
             goals=(
                 ocp.Goal("knee_angle", weight=w[0],
@@ -551,7 +567,9 @@ def build(sp: JumpSpec) -> JumpProblem:
         )
         fl = ocp.Phase(
             "flight", st, ct, dyn, t0=(0.0, t_max), tf=(0.0, t_max), duration=d[2], bounds=b,
-            path_constraints=tuple(flight_path + pcs),
+            path_constraints=tuple(flight_path + pcs + ([] if sp.flight_fy_max is None else [
+                ocp.PathConstraint("feet_off_ground", lambda x, u, p, t: grf_end(x)[1], 0.0,
+                                   sp.flight_fy_max)])),
             endpoint_constraints=tuple(flight_ends),
             goals=(apex_goal,),
         )
@@ -1008,7 +1026,7 @@ def plot_channels(sols: dict[str, JumpSolution], kind: str, figsize_per=(3.4, 2.
                     ax.plot(seg.index, sc * seg[c], lw=1.4, color=PHASE_COLORS[ph], label=ph)
                 if c == "grf_y":
                     W = s.model.total_mass * s.model.g
-                    ax.axhline(W, color="k", ls="--", lw=0.8, label=f"weight {W:.0f} N")
+                    ax.axhline(W, color="k", ls="--", lw=0.8, label="body weight")
             ax.set_ylabel(f"{lab} ({unit})", fontsize=7)
             ax.tick_params(labelsize=7)
             if i == 0:
