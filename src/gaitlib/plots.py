@@ -529,6 +529,10 @@ def animate_jump(jump_model, t, Q, p_contact=None, grf=None, cop=None, fps: floa
     pad = 0.15
     xlo, xhi = pts[:, 0].min() - pad, pts[:, 0].max() + pad
     ylo, yhi = min(pts[:, 1].min(), 0.0) - 0.05, pts[:, 1].max() + 0.08
+    min_w = 0.6 * (yhi - ylo)  # not a sliver for a high jump (equal aspect)
+    if xhi - xlo < min_w:
+        xc = 0.5 * (xlo + xhi)
+        xlo, xhi = xc - 0.5 * min_w, xc + 0.5 * min_w
 
     fig, ax = plt.subplots(figsize=figsize, dpi=dpi, constrained_layout=True)
     artists = draw_jump(ax, jump_model, Q[idx[0]], p_contact, ellipsoids)
