@@ -1,6 +1,6 @@
 """Physics and number tests of the Ch 3 vertical-jump study (gaitlib.studies.jump).
 
-Coarse meshes (5 LGR intervals x 4 points per phase) keep each solve to a few seconds; the
+Coarse meshes (4 LGR intervals x 4 points per phase) keep each solve to a few seconds; the
 assertions are about the physics of the solution, which does not depend on the mesh:
 take-off and apex events, the static start, zero flight GRF, the ballistic flight, the COM
 band, the friction ratio of Eq 3.6 and the bookkeeping of failed solves.
@@ -18,7 +18,7 @@ import pytest
 from gaitlib import conventions as cv, ocp
 from gaitlib.studies import jump as J
 
-COARSE = dict(n_intervals=5)
+COARSE = dict(n_intervals=4)
 
 
 @pytest.fixture(scope="module")
@@ -103,7 +103,7 @@ def test_jump_height_is_ballistic(toe):
     assert np.max(np.abs(fl["com_y"].to_numpy() - parabola)) < 0.01
     # the COM velocity of the collocated states errs most just after take-off, where the
     # light toe is released (the collocation error the ballistic apex constraint guards
-    # the cost against): within 15 % of v_TO on this 5-interval mesh
+    # the cost against): within 15 % of v_TO on this 4-interval mesh
     assert np.max(np.abs(fl["com_vy"].to_numpy() - (v - g * t))) < 0.15 * v
     # COM rise from standing and foot lift are consistent with the COM rise in flight
     assert h["com_rise_standing"] == pytest.approx(
