@@ -100,8 +100,8 @@ plt.show()
 #
 # **Bounds** (Table 3.5) as printed, except the ankle: we read the thesis's 50–110° as the
 # shank–foot angle, 90° standing and decreasing with dorsiflexion, i.e. −20° to +40° in
-# our convention (the other reading, −40° to +20°, would not let the knee bend to the
-# −122° and −150° the thesis reports with the foot flat).
+# our convention (the other reading, −40° to +20°, would allow only 20° of dorsiflexion,
+# little for the deep crouches with the heels down of Sec 3.4.1: knee −94° to −150°).
 #
 # **Where the thesis is silent, our choices** (all fields of `jump.JumpSpec`, listed
 # below): the jump starts from standing at rest; the welded ground only pushes
@@ -110,8 +110,7 @@ plt.show()
 # ground during the crouch ($F_y \ge$ 2 % of the weight — without it the optimum hops
 # during the "crouch"), take-off is $0 \le F_y \le 1$ N (the smoothed contact law never
 # reaches exactly 0) and $F_y \le 7$ N (1 % of the weight) throughout the flight (no
-# touch-down); phase-duration
-# ranges; a small torque-rate regularisation $w_{reg}\int\sum_j(\dot\tau_j/\dot\tau_{max})^2dt$
+# touch-down); phase-duration ranges; a small torque-rate regularisation $w_{reg}\int\sum_j(\dot\tau_j/\dot\tau_{max})^2dt$
 # (goal `reg_taud`, its share of the objective is in the goals table below: nothing in the
 # thesis's cost acts on the flight's torques, and without it the torques ring from node to
 # node); the apex node's COM is tied to the take-off

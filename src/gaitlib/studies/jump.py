@@ -46,8 +46,8 @@ Our choices where Ch 3 is silent (each one a field of :class:`JumpSpec`)
 * Table 3.5's ankle angle (50–110°) is read as the shank–foot angle, 90° when standing,
   decreasing with dorsiflexion: ours (> 0 dorsiflexion) = 90° − thesis, i.e. [−20°, 40°];
   the ankle's angular-velocity and torque bounds change sign with it (the other reading,
-  [−40°, 20°], would not let the knee bend to the −122° and −150° the thesis reports with
-  the foot flat). The other joints' bounds are used as printed (their signs match
+  [−40°, 20°], would allow only 20° of dorsiflexion, little for the deep crouches with
+  the heels down of Sec 3.4.1). The other joints' bounds are used as printed (their signs match
   :mod:`gaitlib.conventions`).
 * Phase durations (``durations``): crouch 0.1–1 s, thrust 0.05–0.5 s, flight 0.05–1.5 s.
 * Kinematic contact: the welded ground may only push (F_y ≥ 0 in preflight,
