@@ -47,7 +47,7 @@ import sys
 import tarfile
 import tempfile
 import zipfile
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -690,6 +690,29 @@ class GaitData:
         cols = list(channels) if channels is not None else self.channels
         return pd.DataFrame({c: np.interp(tt, self.time, self.sd[c].to_numpy()) for c in cols},
                             index=pd.Index(t, name="time"))
+
+
+def time_scaled(gait: GaitData, target: GaitData) -> GaitData:
+    """``gait``'s curves stretched or shrunk in time to ``target``'s cycle time (thesis Ch 7).
+
+    The thesis's semi-predictive slow/fast gaits track the natural-speed data "scaled in
+    time only": every curve keeps its magnitude, its time axis is multiplied by
+    ``target.cycle_time / gait.cycle_time``. Speed, cycle time (and their SDs) and the
+    class label are ``target``'s — these define the problem (final time, stride) — while
+    the curves, SDs, events and left-leg shift are ``gait``'s. Nothing else of
+    ``target`` is used, so its curves stay available for scoring only.
+    """
+    if gait.source != target.source:
+        raise DataError(f"time_scaled: sources differ ({gait.source!r} vs {target.source!r})")
+    k = target.cycle_time / gait.cycle_time
+    idx = pd.Index(gait.mean.index.to_numpy() * k, name="time")
+    mean = gait.mean.set_axis(idx, axis=0)
+    sd = gait.sd.set_axis(idx, axis=0)
+    note = (f"{gait.speed_class} data scaled in time by {k:.4f} to the {target.speed_class} cycle time "
+            f"({target.cycle_time:.3f} s); magnitudes unchanged")
+    return replace(gait, speed_class=target.speed_class, speed=target.speed, speed_sd=target.speed_sd,
+                   cycle_time=target.cycle_time, cycle_time_sd=target.cycle_time_sd, mean=mean, sd=sd,
+                   notes=tuple(gait.notes) + (note,))
 
 
 def _convert(kind: str, values: np.ndarray, sign: float, body_mass: float) -> np.ndarray:

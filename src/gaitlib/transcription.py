@@ -241,6 +241,18 @@ class GaitSpec:
     t_stim : NMSK Mtb — the stimulation time of Eq 5.40 (s), one value for every muscle;
         ``None``: per muscle from the initial guess's excitations (time above 10 % of the
         maximum, Sec 5.3.3), held constant in the NLP (module docstring).
+    track_class : ``""`` — the data tracked (and used for the guess and the normalising
+        ranges) are ``speed_class``'s own; a speed class name (e.g. ``"Free"``) — that
+        class's data scaled in time to ``speed_class``'s cycle time, magnitudes unchanged
+        (:func:`gaitlib.data.time_scaled`; thesis Ch 7, Eqs 7.1–7.2). ``speed_class`` then
+        supplies only the final time, the stride (speed × cycle time) and the state bounds
+        (thesis Sec 7.1); its curves are never tracked.
+    hat_reference : ``()`` — the HAT term (Eq 6.4) tracks the data's HAT estimate
+        (module docstring); otherwise ``(tau, dx, y, tilt)``: four equal-length tuples
+        sampling, on normalised time τ = t / T ∈ [0, 1), the HAT motion to track
+        (thesis Sec 6.1: the Ch 5 solution's) — ``dx`` = pelvis_tx − stride·τ (m),
+        ``y`` = pelvis_ty (m), ``tilt`` = pelvis_tilt (rad). Tracked on τ, so it scales with
+        the cycle time (Ch 7). Build one with :func:`hat_reference_of`.
     """
 
     model: str = "SK"
@@ -264,6 +276,8 @@ class GaitSpec:
     free_activation: bool = False
     excitation_guess: str = "mtg"
     t_stim: float | None = None
+    track_class: str = ""
+    hat_reference: tuple = ()
 
     def __post_init__(self):
         if self.model not in MODELS:
@@ -283,6 +297,11 @@ class GaitSpec:
                 raise ValueError(f"unknown cost term {k!r}; known {TERMS}")
         if self.speed_class not in cv.SPEED_CLASSES:
             raise ValueError(f"unknown speed class {self.speed_class!r}; known {cv.SPEED_CLASSES}")
+        if self.track_class and self.track_class not in cv.SPEED_CLASSES:
+            raise ValueError(f"unknown track_class {self.track_class!r}; known '' or {cv.SPEED_CLASSES}")
+        if self.hat_reference:
+            if len(self.hat_reference) != 4 or len({len(v) for v in self.hat_reference}) != 1:
+                raise ValueError("hat_reference must be () or four equal-length tuples (tau, dx, y, tilt)")
 
     @property
     def term_weights(self) -> dict[str, float]:
@@ -304,6 +323,7 @@ class GaitSpec:
         d["weights"] = tuple(tuple(w) for w in d.get("weights", ()))
         d["residual_bounds"] = tuple(d.get("residual_bounds", (1.0, 1.0, 0.1)))
         d["tf_bounds"] = tuple(d.get("tf_bounds", ()))
+        d["hat_reference"] = tuple(tuple(v) for v in d.get("hat_reference", ()))
         return cls(**d)
 
 
@@ -388,6 +408,58 @@ def reference(gait: data_mod.GaitData, model: ChildModel, p_contact=None, order:
     return Reference(gait=gait, q=qref, deriv=deriv, tau=tau, grf=grf, ranges=ranges)
 
 
+def _with_hat_reference(ref: Reference, hat: tuple) -> Reference:
+    """``ref`` with its HAT coordinates (and their Fourier derivatives) replaced by ``hat``
+    = (τ, pelvis_tx − stride·τ, pelvis_ty, pelvis_tilt) on normalised time (GaitSpec)."""
+    T = ref.gait.cycle_time
+    stride = ref.gait.speed * T
+    tau_h = np.asarray(hat[0], float)
+    t = ref.q.index.to_numpy()
+    q = ref.q.copy()
+    deriv = dict(ref.deriv)
+    for c, vals in zip(cv.COORDS[:3], hat[1:]):
+        v = np.asarray(vals, float)
+        # periodic samples on [0, 1): close the loop for the Fourier fit on [0, T]
+        tt = np.append(tau_h, 1.0) * T
+        vv = np.append(v, v[0])
+        f = _fourier_derivatives(np.interp(t, tt, vv), T, order=12)
+        if c == "pelvis_tx":
+            deriv[c] = (lambda x, f=f, v_=stride / T: f(x) + np.vstack([v_ * np.atleast_1d(x), v_ + 0 * np.atleast_1d(x),
+                                                                          0 * np.atleast_1d(x), 0 * np.atleast_1d(x)]))
+        else:
+            deriv[c] = f
+        q[c] = deriv[c](t)[0]
+    return replace(ref, q=q, deriv=deriv)
+
+
+def hat_reference_of(sol: "GaitSolution", n: int = 100) -> tuple:
+    """The HAT motion of a solved gait as a :attr:`GaitSpec.hat_reference` (n samples)."""
+    if not sol.spec.periodic:
+        raise ValueError("hat_reference_of needs a periodic gait solution")
+    from scipy.interpolate import CubicHermiteSpline
+
+    X = sol.solution.phase("cycle").states
+    tf = float(sol.stats["tf_s"])
+    g = data_mod.load_gait_data(sol.spec.speed_class, sol.spec.source)
+    stride = g.speed * g.cycle_time  # the periodic pelvis offset (build)
+    t = X.index.to_numpy(dtype=float)
+    x0 = X.iloc[0]
+    if t[-1] < tf - 1e-9:  # nodes stop short of t_f: close the cycle with the periodic end state
+        X = pd.concat([X, X.iloc[[0]].set_axis([tf])])
+        X.loc[tf, "pelvis_tx"] += stride
+        t = X.index.to_numpy(dtype=float)
+    tau = np.arange(n) / n
+
+    def at(c):  # cubic Hermite on the node values and velocities (both states)
+        return CubicHermiteSpline(t, X[c].to_numpy(), X[f"qd_{c}"].to_numpy())(tau * tf)
+
+    dx = at("pelvis_tx") - x0["pelvis_tx"] - stride * tau
+    ys = at("pelvis_ty")
+    tilt = at("pelvis_tilt")
+    r = lambda a: tuple(round(float(v), 9) for v in a)  # noqa: E731 (JSON-stable key)
+    return (r(tau), r(dx), r(ys), r(tilt))
+
+
 # ======================================================================================
 # Problem
 # ======================================================================================
@@ -463,10 +535,14 @@ def mtb_scale(t_f, stride: float, body_mass: float = cv.BODY_MASS):
 def build(spec: GaitSpec) -> GaitProblem:
     """Turn a :class:`GaitSpec` into an :class:`ocp.Problem` with mesh, options, guess."""
     model = ChildModel()
-    gait = data_mod.load_gait_data(spec.speed_class, spec.source)
+    gait_class = data_mod.load_gait_data(spec.speed_class, spec.source)
+    gait = (data_mod.time_scaled(data_mod.load_gait_data(spec.track_class, spec.source), gait_class)
+            if spec.track_class else gait_class)
     p_body = model.p_body_identified() if spec.body_params == "thesis" else model.default_p_body()
     p_contact = contact_mod.default_params()
     ref = reference(gait, model, p_contact)
+    if spec.hat_reference:
+        ref = _with_hat_reference(ref, spec.hat_reference)
     T = gait.cycle_time
     stride = gait.speed * T  # fixed stride length, also with a free final time
     w = spec.term_weights
@@ -678,9 +754,9 @@ def build(spec: GaitSpec) -> GaitProblem:
 
     # ---- bounds (generous, from the data; thesis: "based on the standard deviation")
     bounds = {}
-    for c in cv.COORDS[3:]:
-        lo = float((gait.mean[c] - 3 * gait.sd[c]).min()) - 15 * cv.DEG
-        hi = float((gait.mean[c] + 3 * gait.sd[c]).max()) + 15 * cv.DEG
+    for c in cv.COORDS[3:]:  # from speed_class's own data, also when tracking another class's
+        lo = float((gait_class.mean[c] - 3 * gait_class.sd[c]).min()) - 15 * cv.DEG
+        hi = float((gait_class.mean[c] + 3 * gait_class.sd[c]).max()) + 15 * cv.DEG
         bounds[c] = (lo, hi)
     bounds["pelvis_tilt"] = (-30 * cv.DEG, 30 * cv.DEG)
     bounds["pelvis_ty"] = (0.5, 1.0)
