@@ -1096,7 +1096,8 @@ def warm_start(gp: GaitProblem, guess) -> Guess:
                 a = mtg.activation_for_torque(j, tq, S[c], S[f"qd_{c}"])
                 C[f"a_{j}_ext_{s_}"] = np.asarray(a["a_ext"], float)
                 C[f"a_{j}_flex_{s_}"] = np.asarray(a["a_flex"], float)
-    if gp.spec.model == "NMSK" and not set(EXCITATION_CONTROLS) <= set(ph.controls.columns):
+    src_drives = set(MTG_CONTROLS) <= set(ph.controls.columns) or "tau_hip_r" in ph.controls.columns
+    if gp.spec.model == "NMSK" and src_drives and not set(EXCITATION_CONTROLS) <= set(ph.controls.columns):
         a_gen = {}
         for k in MTG_CONTROLS:
             v = C.pop(k, None)
