@@ -188,10 +188,8 @@ def test_failed_solve_is_reported():
 
 def test_cache_roundtrip(toe, tmp_path):
     """A cached solution reloads with the same numbers and says so."""
-    from gaitlib import cache
-
     sp = toe.spec
-    where = cache.lookup("jump", {"kind": "jump", **sp.to_dict()}, tmp_path)
+    where = J.cache_location(sp, tmp_path)
     toe.solution.save(where)
     s2 = J.solve(sp, use_cache=True, root=tmp_path)
     assert s2.from_cache and s2.stats["from_cache"]

@@ -1,12 +1,14 @@
 """Solution cache keyed by *what* was solved and *with which code*.
 
 A key is the SHA-256 of a spec (any JSON-able mapping) together with :func:`fingerprint` —
-the library version plus a hash of every ``.py`` file of the installed package that can
-change a solution (all but the presentation-only modules in :data:`PRESENTATION_ONLY`:
-plotting, command line, sweep engine, peer-model import) and of the data files (CSV and
-JSON, e.g. identified parameters). Editing any such file changes every key, so a cached
-solution is never served for code or data it was not computed with (stale entries are
-simply never hit again; ``clear`` removes them).
+the library version plus a hash of the source files that can change a solution and of the
+data files (CSV and JSON, e.g. identified parameters; not ``PROVENANCE.json``). The sources
+are the :data:`CORE` modules (physics, collocation, the gait transcription) plus the modules
+the caller declares — by default the module that calls :func:`lookup` (so a study that
+builds its own problem, e.g. the jump, keys on its own code too). Editing any such file
+changes the key, so a cached solution is never served for code or data it was not computed
+with (stale entries are simply never hit again; ``clear`` removes them). Editing a
+presentation module (plots, CLI, sweep engine, another chapter's study) keeps entries valid.
 
 Default location: ``$GAITLIB_SOLUTIONS`` or ``~/.cache/gaitlib/solutions``.
 """
@@ -14,6 +16,7 @@ Default location: ``$GAITLIB_SOLUTIONS`` or ``~/.cache/gaitlib/solutions``.
 from __future__ import annotations
 
 import hashlib
+import inspect
 import json
 import os
 import shutil
@@ -22,36 +25,50 @@ from pathlib import Path
 
 from . import __version__
 
-__all__ = ["fingerprint", "key", "default_dir", "lookup", "clear"]
+__all__ = ["CORE", "fingerprint", "key", "default_dir", "lookup", "clear"]
 
 _PKG = Path(__file__).resolve().parent
 
-#: Modules that never change what a solve returns (drawing, CLI parsing, scheduling runs,
-#: the Moco peer model): editing them keeps the cache valid.
-PRESENTATION_ONLY = frozenset({"plots.py", "cli.py", "__main__.py", "sweep.py", "peers.py"})
+#: Modules every solution depends on (paths relative to the package).
+CORE = ("__init__.py", "cache.py", "conventions.py", "data.py", "model.py", "kinematics.py", "contact.py",
+        "mtg.py", "activation.py", "metabolics.py", "collocation.py", "ocp.py", "transcription.py")
 
 
-@lru_cache(maxsize=1)
-def fingerprint() -> str:
-    """Version + hash of the solver-relevant package sources and the data files (16 hex digits)."""
+def _module_path(m) -> str:
+    """Package-relative path of a module given as a relative path or an absolute file."""
+    p = Path(m)
+    if p.is_absolute():
+        p = p.resolve().relative_to(_PKG)
+    return p.as_posix()
+
+
+@lru_cache(maxsize=64)
+def _fingerprint(modules: tuple) -> str:
     from . import data
 
     h = hashlib.sha256(__version__.encode())
-    files = [(f"gaitlib/{f.relative_to(_PKG).as_posix()}", f) for f in sorted(_PKG.rglob("*.py"))
-             if f.relative_to(_PKG).as_posix() not in PRESENTATION_ONLY]
+    files = [(f"gaitlib/{m}", _PKG / m) for m in sorted(set(CORE) | set(modules))]
     data_dir = Path(data.DATA_DIR)
     if data_dir.is_dir():
         files += [(f"data/{f.relative_to(data_dir).as_posix()}", f) for f in sorted(data_dir.rglob("*"))
                   if f.suffix in (".csv", ".json") and f.name != "PROVENANCE.json"]
     for name, f in files:
+        if not f.is_file():
+            raise FileNotFoundError(f"cache.fingerprint: module {name} not found in the package")
         h.update(name.encode())
         h.update(f.read_bytes())
     return h.hexdigest()[:16]
 
 
-def key(spec: dict) -> str:
-    """Cache key of a JSON-able spec under the current code and data (16 hex digits)."""
-    blob = json.dumps({"spec": spec, "code": fingerprint()}, sort_keys=True, default=str)
+def fingerprint(modules=()) -> str:
+    """Version + hash of the :data:`CORE` sources, ``modules`` (package-relative paths or
+    absolute files inside the package) and the data files (16 hex digits)."""
+    return _fingerprint(tuple(sorted(_module_path(m) for m in modules)))
+
+
+def key(spec: dict, modules=()) -> str:
+    """Cache key of a JSON-able spec under the current code (CORE + ``modules``) and data."""
+    blob = json.dumps({"spec": spec, "code": fingerprint(modules)}, sort_keys=True, default=str)
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
@@ -59,10 +76,16 @@ def default_dir() -> Path:
     return Path(os.environ.get("GAITLIB_SOLUTIONS", Path.home() / ".cache" / "gaitlib" / "solutions"))
 
 
-def lookup(kind: str, spec: dict, root=None) -> Path:
-    """Directory where a solution of ``spec`` is (or would be) stored."""
+def lookup(kind: str, spec: dict, root=None, modules=None) -> Path:
+    """Directory where a solution of ``spec`` is (or would be) stored.
+
+    ``modules``: the sources (besides :data:`CORE`) the solution depends on; ``None`` — the
+    calling module if it is part of gaitlib."""
+    if modules is None:
+        caller = Path(inspect.stack()[1].filename).resolve()
+        modules = (caller,) if _PKG in caller.parents else ()
     root = Path(root) if root is not None else default_dir()
-    return root / kind / key(spec)
+    return root / kind / key(spec, modules)
 
 
 def clear(root=None) -> None:

@@ -65,7 +65,7 @@ def solve_cached(spec: tr.GaitSpec, *, use_cache: bool = True, root=None, guess=
     desc = {"kind": "gait", **spec.to_dict()}
     if guess is not None:
         desc["warm_start"] = _guess_signature(guess)
-    where = cache.lookup("gait", desc, root)
+    where = cache.lookup("gait", desc, root, modules=())  # gait solutions depend on the CORE sources only
     if use_cache and (where / "spec.json").exists():
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ocp.SolveFailedWarning)

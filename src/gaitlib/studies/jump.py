@@ -891,6 +891,12 @@ def _result(sp: JumpSpec, model: JumpModel, p_contact, sol: ocp.Solution) -> Jum
     return JumpSolution(sp, model, sol, tr, _heights(sp, tr, model.g), req, p_contact)
 
 
+def cache_location(sp: "JumpSpec", root=None):
+    """Where the solution of ``sp`` is (or would be) cached: keyed by the spec, the core
+    sources, the jump model and this study (:mod:`gaitlib.cache`)."""
+    return cache.lookup("jump", {"kind": "jump", **sp.to_dict()}, root, modules=("jump.py", "studies/jump.py"))
+
+
 def solve(sp: JumpSpec | str, guess: ocp.Guess | ocp.Solution | None = None, *,
           use_cache: bool = False, root=None) -> JumpSolution:
     """Build and solve one jump; returns a :class:`JumpSolution` whatever IPOPT's verdict
@@ -905,7 +911,7 @@ def solve(sp: JumpSpec | str, guess: ocp.Guess | ocp.Solution | None = None, *,
         sp = SPECS[sp]
     where = None
     if use_cache and guess is None:
-        where = cache.lookup("jump", {"kind": "jump", **sp.to_dict()}, root)
+        where = cache_location(sp, root)
         if (where / "solution.json").exists():
             import warnings
 
