@@ -8,6 +8,10 @@ Commands
                      natural-gait data tracking, e.g.
                      ``gaitlib run gait --model MSK --cost DT --speed Free --out DIR``
                      (full mesh 20 × 5 LGR unless ``--intervals/--degree`` say otherwise).
+``sweep --model M --costs C1,C2 --speeds S1,S2 --out DIR``   solve every cost × speed
+                     class on dask.distributed (gaitlib.sweep; a LocalCluster, or an existing
+                     cluster with ``--scheduler tcp://host:port``; ``--serial`` without dask)
+                     and write ``sweep.csv`` plus each run's outputs in ``DIR/<model>_<cost>_<speed>``.
 """
 
 from __future__ import annotations
@@ -47,6 +51,71 @@ def _cmd_run(args) -> int:
     return 0 if sol.success else 2
 
 
+def _cmd_sweep(args) -> int:
+    """``gaitlib sweep``: cost functions × speed classes of one model as one sweep."""
+    import math
+
+    import pandas as pd
+
+    from . import sweep as sw
+    from . import transcription as tr
+    from .studies import gait
+
+    costs = [c.strip() for c in args.costs.split(",") if c.strip()]
+    speeds = [s.strip() for s in args.speeds.split(",") if s.strip()]
+    if not costs or not speeds:
+        raise SystemExit("--costs and --speeds need at least one comma-separated name each")
+    kw = dict(n_intervals=args.intervals, degree=args.degree, max_iter=args.max_iter)
+    try:
+        specs = {f"{args.model}_{c}_{s}": tr.GaitSpec(model=args.model, cost=c, speed_class=s, **kw)
+                 for c in costs for s in speeds}
+    except ValueError as e:
+        raise SystemExit(f"gaitlib sweep: {e}") from None
+    recs = sw.solve_specs(specs, use_cache=not args.no_cache, cache_root=args.cache, scheduler=args.scheduler,
+                          n_workers=args.workers, serial=args.serial, progress=True)
+    from pathlib import Path
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    rows = []
+    for name, r in recs.items():
+        st = r.value.stats if r.value is not None else {}
+        rows.append({"name": name, "status": r.status, "ok": r.ok, "iterations": st.get("iterations"),
+                     "wall": r.wall_s, "solve_time_s": st.get("solve_time_s"),
+                     "time_per_iteration_s": st.get("time_per_iteration_s"), "objective": st.get("objective", math.nan),
+                     "from_cache": st.get("from_cache"), "worker": r.worker,
+                     "error": (r.error or "").strip().splitlines()[-1] if r.error else ""})
+        if r.value is not None:
+            gait.write_outputs(r.value, out / name, figures=not args.no_figures)
+        elif r.error:
+            (out / name).mkdir(parents=True, exist_ok=True)
+            (out / name / "error.txt").write_text(r.error)
+    pd.DataFrame(rows).to_csv(out / "sweep.csv", index=False)
+    print(f"wrote {out / 'sweep.csv'} ({sum(r.ok for r in recs.values())}/{len(recs)} ok)")
+    return 0 if all(r.ok for r in recs.values()) else 2
+
+
+def _add_sweep_parser(sub) -> None:
+    w = sub.add_parser("sweep", help="solve cost functions x speed classes as one (distributed) sweep")
+    w.add_argument("--model", default="MSK", choices=["SK", "MSK", "NMSK"])
+    w.add_argument("--costs", required=True, help="comma-separated cost functions, e.g. DT,SDT1,SP1")
+    w.add_argument("--speeds", default="Free", help="comma-separated speed classes, e.g. VerySlow,Slow,Free")
+    w.add_argument("--intervals", type=int, default=20, help="mesh intervals (thesis: 20)")
+    w.add_argument("--degree", type=int, default=5, help="collocation points per interval (thesis: 5)")
+    w.add_argument("--max-iter", type=int, default=1000)
+    w.add_argument("--scheduler", default=None,
+                   help="address (tcp://host:port) or scheduler file of an existing dask cluster "
+                        "(default: a LocalCluster over the machine's cores)")
+    w.add_argument("--workers", type=int, default=None, help="LocalCluster worker processes (default: cores)")
+    w.add_argument("--serial", action="store_true", help="run in this process without dask")
+    w.add_argument("--cache", default=None, help="solutions cache (default: $GAITLIB_SOLUTIONS or "
+                                                 "~/.cache/gaitlib/solutions), passed to every worker")
+    w.add_argument("--no-cache", action="store_true", help="solve even if cached solutions exist")
+    w.add_argument("--no-figures", action="store_true")
+    w.add_argument("--out", required=True, help="output directory")
+    w.set_defaults(func=_cmd_sweep)
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="gaitlib", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -75,6 +144,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--no-figures", action="store_true")
     r.add_argument("--quiet", action="store_true", help="no IPOPT progress log")
     r.set_defaults(func=_cmd_run)
+    _add_sweep_parser(sub)
     return p
 
 
