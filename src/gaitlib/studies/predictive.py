@@ -1,0 +1,322 @@
+"""Chapters 6 and 7: from data tracking to prediction, and to other walking speeds.
+
+Ch 6 (thesis Sec 6.1) — natural-speed gait with the MSK and NMSK models under eight cost
+functions (Tables 6.1–6.2: ``DT SDT1 SDT2 SDT3 SP1 SP2 SP3 FP``), i.e. 16 optimal control
+problems. As in the thesis:
+
+- the HAT term (Eq 6.4) tracks the HAT motion of the model's Ch 5 data-tracking solution
+  (MSK Eq 5.33, NMSK Eq 5.55), not the data's pelvis estimate (``GaitSpec.hat_reference``);
+- the initial guess is the data-based guess with the HAT coordinates, the metatarsal angles
+  and torques — and, for MSK, the 12 MTG activations — taken from that Ch 5 solution
+  (:func:`thesis_guess`); NMSK excitations start from the EMG where the data have the
+  muscle (``excitation_guess="emg"``, Sec 5.3.4);
+- no parameter is identified (contact, MTG and activation parameters fixed).
+
+Ch 7 (thesis Sec 7.1) — semi-predictive slow and fast gaits: the DT cost function (Table
+7.1 = the DT row of Table 6.2) of each model for the four non-natural speed classes. The
+*Free* data scaled in time to the class's cycle time are tracked and give the guess
+(``GaitSpec.track_class="Free"``); the class's own data give only the final time, the
+stride and the state bounds, and are used afterwards to score (NRMSE, thesis Figs 7.1–7.4).
+The cost of transport (Eq 5.57) of the NMSK solutions against speed is the thesis's Fig 7.5.
+
+Our speed classes are Schwartz et al. (2008)'s (Very Slow … Very Fast); the thesis used the
+XS/S/M/L classes of its own reference [18] at 0.9/1.09/1.29/1.58 m/s. Thesis numbers appear
+only in columns labelled with their table or figure.
+
+All runs go through :func:`gaitlib.sweep.solve_specs` (dask.distributed; ``serial=True``
+in-process) and the solution cache, so a rerun only reloads.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import pandas as pd
+
+from .. import conventions as cv
+from .. import data as data_mod
+from .. import ocp
+from .. import transcription as tr
+from . import gait as sg
+
+__all__ = ["CH6_COSTS", "CH7_CLASSES", "THESIS_CLASS", "THESIS_HOURS_TABLE_6_3", "THESIS_HOURS_TABLE_7_2",
+           "THESIS_COT_FIG_7_5", "BASELINE_COST", "baseline", "thesis_guess", "ch6_specs", "ch7_specs",
+           "score", "excitation_score", "StudyResult", "cost_function_study", "speed_study", "cot_table",
+           "times_table"]
+
+CH6_COSTS = ("DT", "SDT1", "SDT2", "SDT3", "SP1", "SP2", "SP3", "FP")
+CH7_CLASSES = ("VerySlow", "Slow", "Fast", "VeryFast")
+#: Our Schwartz 2008 class beside the thesis's class of the same rank (Ch 7).
+THESIS_CLASS = {"VerySlow": "XS", "Slow": "S", "Free": "N", "Fast": "M", "VeryFast": "L"}
+#: Ch 5 data-tracking cost function whose solution supplies the HAT reference and guess.
+BASELINE_COST = {"MSK": "Eq5.33", "NMSK": "Eq5.55"}
+#: Thesis Table 6.3, hours (GPOPS-II, i7-6700).
+THESIS_HOURS_TABLE_6_3 = {
+    "MSK": dict(zip(CH6_COSTS, (2, 10, 8, 3, 14, 3, 15, 10))),
+    "NMSK": dict(zip(CH6_COSTS, (2, 3, 3, 1, 2, 2, 2, 6))),
+}
+#: Thesis Table 7.2, hours, by the thesis's class.
+THESIS_HOURS_TABLE_7_2 = {"MSK": {"XS": 18, "S": 12, "M": 10, "L": 12}, "NMSK": {"XS": 8, "S": 6, "M": 4, "L": 5}}
+#: Thesis Sec 5.3.5 / 7.2 and Fig 7.5: (class, speed m/s, COT J kg⁻¹ m⁻¹).
+THESIS_COT_FIG_7_5 = (("XS", 0.90, 2.18), ("S", 1.09, 1.99), ("N", 1.26, 1.53), ("M", 1.29, 1.96), ("L", 1.58, 1.99))
+
+_HAT = cv.COORDS[:3]
+
+
+def _mesh(n_intervals, degree):
+    return dict(n_intervals=n_intervals, degree=degree)
+
+
+def baseline(model: str, *, n_intervals: int = 20, degree: int = 5, root=None, progress: bool = False,
+             **kw) -> tr.GaitSolution:
+    """The model's Ch 5 natural-gait data-tracking solution (MSK Eq 5.33, NMSK Eq 5.55),
+    solved or reloaded from the cache; ``kw`` go to the spec."""
+    return sg.natural_gait(model, BASELINE_COST[model], "Free", root=root, progress=progress,
+                           **_mesh(n_intervals, degree), **kw)
+
+
+def thesis_guess(base: tr.GaitSolution, *, cycle_time: float | None = None, stride: float | None = None) -> ocp.Solution:
+    """The part of a Ch 5 solution the thesis carries into Chs 6–7 as initial guess.
+
+    States: HAT coordinates and metatarsal angles with their velocities and accelerations;
+    controls: metatarsal torques and, for an MSK source, the 12 MTG activations (Sec 6.1).
+    Everything else comes from the target problem's own data-based guess
+    (:func:`gaitlib.transcription.warm_start` overrides by name).
+
+    With ``cycle_time`` (s) the guess is scaled in time to that cycle (Sec 7.1: "scaled
+    ... while keeping the magnitudes unchanged"): times × k, k = cycle_time / t_f, with
+    velocities ÷ k and accelerations ÷ k² so the guess stays a consistent trajectory; the
+    horizontal pelvis position is rescaled to ``stride`` (m) so it meets the periodic
+    offset of the target problem.
+    """
+    sol = base.solution
+    ph = sol.phase("cycle")
+    coords = list(_HAT) + ["mtp_r", "mtp_l"]
+    xs = [c for c in ph.states.columns if any(c in (k, f"qd_{k}", f"qdd_{k}") for k in coords)]
+    us = [c for c in ph.controls.columns if c.startswith("tau_mtp_") or c in tr.MTG_CONTROLS]
+    X, U = ph.states[xs].copy(), ph.controls[us].copy()
+    tf = float(ph.tf)
+    if cycle_time is not None:
+        k = float(cycle_time) / tf
+        X.index = X.index * k
+        U.index = U.index * k
+        for c in xs:
+            if c.startswith("qdd_"):
+                X[c] = X[c] / k**2
+            elif c.startswith("qd_"):
+                X[c] = X[c] / k
+        tf = tf * k
+    if stride is not None:
+        g = data_mod.load_gait_data(base.spec.speed_class, base.spec.source)
+        s0 = g.speed * g.cycle_time
+        x0 = X["pelvis_tx"].iloc[0]
+        X["pelvis_tx"] = x0 + (X["pelvis_tx"] - x0) * (stride / s0)
+        for c in ("qd_pelvis_tx", "qdd_pelvis_tx"):
+            X[c] = X[c] * (stride / s0)
+    phase = ocp.PhaseSolution("cycle", X, U, float(ph.t0), tf)
+    return replace(sol, phases={"cycle": phase}, parameters={})
+
+
+def ch6_specs(model: str, base: tr.GaitSolution, costs=CH6_COSTS, *, n_intervals: int = 20, degree: int = 5,
+              **kw) -> dict[str, tr.GaitSpec]:
+    """The Ch 6 problems of ``model`` (Table 6.2 weights), HAT reference from ``base``."""
+    hat = tr.hat_reference_of(base)
+    extra = {"excitation_guess": "emg"} if model == "NMSK" else {}
+    return {f"{model} {c}": tr.GaitSpec(model=model, cost=c, speed_class="Free", hat_reference=hat,
+                                        **_mesh(n_intervals, degree), **extra, **kw)
+            for c in costs}
+
+
+def ch7_specs(model: str, base: tr.GaitSolution, classes=CH7_CLASSES, *, n_intervals: int = 20, degree: int = 5,
+              **kw) -> dict[str, tr.GaitSpec]:
+    """The Ch 7 problems of ``model``: DT (Eqs 7.1–7.2, Table 7.1) per speed class on the
+    Free data scaled in time; HAT reference = ``base``'s HAT on normalised time."""
+    hat = tr.hat_reference_of(base)
+    extra = {"excitation_guess": "emg"} if model == "NMSK" else {}
+    return {f"{model} {c}": tr.GaitSpec(model=model, cost="DT", speed_class=c, track_class="Free",
+                                        hat_reference=hat, **_mesh(n_intervals, degree), **extra, **kw)
+            for c in classes}
+
+
+# ======================================================================================
+# Scoring against a data set (any class), independent of what was tracked
+# ======================================================================================
+def score(sol: tr.GaitSolution, gait: data_mod.GaitData) -> pd.DataFrame:
+    """RMSE and NRMSE (RMSE / data range, thesis Ch 7) of angles, net torques and foot
+    forces against ``gait``'s mean, on normalised time (so a solution of another cycle
+    time is compared phase by phase). Hip = thigh in the laboratory, as tracked
+    (:func:`gaitlib.studies.gait.tracking_data`). Also the mean |error| in SD units.
+
+    Returns a DataFrame with columns ``kind, channel, side, unit, rmse, nrmse, mean_z``
+    (angles in deg, torques N·m, forces N; nrmse dimensionless)."""
+    g = sg.tracking_data(gait)
+    sim = sg.channels_frame(sol)
+    tau = sim.index.to_numpy() / float(sol.stats["tf_s"])
+    tg = g.time / g.cycle_time
+    rows = []
+    chans = [("angle", j, j, 1 / cv.DEG, "deg") for j in tr.LEG_JOINTS]
+    chans += [("torque", j, f"tau_{j}", 1.0, "N*m") for j in tr.LEG_JOINTS]
+    chans += [("grf", f"{ch.split('_')[1]}_{ch[-1]}", ch, 1.0, "N") for ch in tr.GRF_CHANNELS]
+    for kind, name, col, scale, unit in chans:
+        d = np.interp(tau, tg, g.mean[col].to_numpy())
+        sd = np.interp(tau, tg, g.sd[col].to_numpy())
+        e = sim[col].to_numpy() - d
+        rmse = float(np.sqrt(np.mean(e**2)))
+        rows.append({"kind": kind, "channel": name.rsplit("_", 1)[0], "side": name[-1], "unit": unit,
+                     "rmse": rmse * scale, "nrmse": rmse / float(np.ptp(g.mean[col])),
+                     "mean_z": float(np.mean(np.abs(e) / np.maximum(sd, 1e-9)))})
+    return pd.DataFrame(rows)
+
+
+#: NMSK muscle → data EMG channel (Schwartz 2008 has RF, MH, LH, TA, MG; gaitutils all 8).
+EMG_MAP = {"schwartz2008": {"RF": "RF", "BF": "LH", "GAM": "MG", "TA": "TA"},
+           "gaitutils": {m: m for m in ("GM", "RF", "VM", "BF", "SOL", "PL", "GAM", "TA")}}
+
+
+def excitation_score(sol: tr.GaitSolution, gait: data_mod.GaitData) -> pd.DataFrame:
+    """RMSE and NRMSE of the NMSK excitations e(t) against the data's EMG envelopes (both
+    dimensionless, on normalised time) for the muscles the data set has
+    (:data:`EMG_MAP`: biceps femoris ↔ lateral hamstrings, medial gastrocnemius ↔ GAM)."""
+    if sol.excitations is None:
+        raise ValueError("excitation_score needs an NMSK solution")
+    tau = sol.excitations.index.to_numpy() / float(sol.stats["tf_s"])
+    tg = gait.time / gait.cycle_time
+    rows = []
+    for m, ch in EMG_MAP[gait.source].items():
+        for s in cv.SIDES:
+            col = f"emg_{ch}_{s}"
+            if col not in gait.mean.columns:
+                continue
+            d = np.interp(tau, tg, gait.mean[col].to_numpy())
+            e = sol.excitations[f"{m}_{s}"].to_numpy() - d
+            rmse = float(np.sqrt(np.mean(e**2)))
+            rows.append({"kind": "excitation", "channel": m, "side": s, "emg": ch, "unit": "1", "rmse": rmse,
+                         "nrmse": rmse / max(float(np.ptp(gait.mean[col])), 1e-9)})
+    return pd.DataFrame(rows)
+
+
+# ======================================================================================
+# Studies
+# ======================================================================================
+@dataclass
+class StudyResult:
+    """Runs of a Ch 6 or Ch 7 study.
+
+    ``records``: name → :class:`gaitlib.sweep.RunRecord` (status of every run, failed ones
+    included); ``solutions``: name → GaitSolution (every run that returned one, converged
+    or not — check ``stats["success"]``); ``specs``: name → GaitSpec; ``baselines``: model →
+    the Ch 5 solution used for HAT reference and guess; ``scores``: long table (run, model,
+    cost/class, kind, channel, side, rmse, nrmse, mean_z) against the scoring data."""
+
+    specs: dict
+    records: dict
+    solutions: dict
+    baselines: dict
+    scores: pd.DataFrame = field(default_factory=pd.DataFrame)
+
+    def stats(self) -> pd.DataFrame:
+        rows = []
+        for name, rec in self.records.items():
+            sol = self.solutions.get(name)
+            st = sol.stats if sol is not None else {}
+            rows.append({"run": name, "status": rec.status, "converged": bool(st.get("success", False)),
+                         "iterations": st.get("iterations"), "solve (s)": st.get("solve_time_s"),
+                         "ms/iteration": 1e3 * st["time_per_iteration_s"] if st else np.nan,
+                         "build (s)": st.get("build_time_s"), "objective": st.get("objective"),
+                         "max violation": st.get("max_violation"), "from cache": st.get("from_cache"),
+                         "COT (J/kg/m)": st.get("COT", np.nan), "error": rec.error})
+        return pd.DataFrame(rows).set_index("run")
+
+
+def _run(specs: dict, guesses: dict, *, root, scheduler, n_workers, serial, progress) -> tuple[dict, dict]:
+    from .. import sweep
+
+    recs = sweep.solve_specs(specs, guesses=guesses, cache_root=root, scheduler=scheduler, n_workers=n_workers,
+                             serial=serial, progress=progress)
+    sols = {k: r.value for k, r in recs.items() if r.value is not None}
+    return recs, sols
+
+
+def _scores(sols: dict, gaits: dict, key_of) -> pd.DataFrame:
+    parts = []
+    for name, sol in sols.items():
+        model, label = name.split(" ", 1)
+        g = gaits[key_of(sol)]
+        df = score(sol, g)
+        if model == "NMSK":
+            df = pd.concat([df, excitation_score(sol, g)], ignore_index=True)
+        df.insert(0, "run", name)
+        df.insert(1, "model", model)
+        df.insert(2, "case", label)
+        parts.append(df)
+    return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame()
+
+
+def cost_function_study(models=("MSK", "NMSK"), costs=CH6_COSTS, *, n_intervals: int = 20, degree: int = 5,
+                        root=None, scheduler: str | None = None, n_workers: int | None = None, serial: bool = False,
+                        progress: bool = True, source: str = "schwartz2008") -> StudyResult:
+    """Thesis Ch 6: the ``models`` × ``costs`` runs, scored against the Free data."""
+    bases = {m: baseline(m, n_intervals=n_intervals, degree=degree, root=root, source=source) for m in models}
+    specs, guesses = {}, {}
+    for m in models:
+        sp = ch6_specs(m, bases[m], costs, n_intervals=n_intervals, degree=degree, source=source)
+        specs.update(sp)
+        guesses.update({k: thesis_guess(bases[m]) for k in sp})
+    recs, sols = _run(specs, guesses, root=root, scheduler=scheduler, n_workers=n_workers, serial=serial,
+                      progress=progress)
+    gaits = {"Free": data_mod.load_gait_data("Free", source)}
+    return StudyResult(specs, recs, sols, bases, _scores(sols, gaits, lambda s: "Free"))
+
+
+def speed_study(models=("MSK", "NMSK"), classes=CH7_CLASSES, *, n_intervals: int = 20, degree: int = 5,
+                root=None, scheduler: str | None = None, n_workers: int | None = None, serial: bool = False,
+                progress: bool = True, source: str = "schwartz2008") -> StudyResult:
+    """Thesis Ch 7: DT per model and speed class on time-scaled Free data, scored against
+    each class's own data (never tracked)."""
+    bases = {m: baseline(m, n_intervals=n_intervals, degree=degree, root=root, source=source) for m in models}
+    gaits = {c: data_mod.load_gait_data(c, source) for c in classes}
+    specs, guesses = {}, {}
+    for m in models:
+        sp = ch7_specs(m, bases[m], classes, n_intervals=n_intervals, degree=degree, source=source)
+        specs.update(sp)
+        for k, s in sp.items():
+            g = gaits[s.speed_class]
+            guesses[k] = thesis_guess(bases[m], cycle_time=g.cycle_time, stride=g.speed * g.cycle_time)
+    recs, sols = _run(specs, guesses, root=root, scheduler=scheduler, n_workers=n_workers, serial=serial,
+                      progress=progress)
+    return StudyResult(specs, recs, sols, bases, _scores(sols, gaits, lambda s: s.spec.speed_class))
+
+
+def cot_table(ch7: StudyResult, natural: tr.GaitSolution | None = None) -> pd.DataFrame:
+    """COT (Eq 5.57) of the NMSK runs against walking speed, ours beside the thesis's
+    Fig 7.5 point of the class of the same rank (labelled; different classes and speeds)."""
+    thesis = {c: (v, cot) for c, v, cot in THESIS_COT_FIG_7_5}
+    rows = []
+    items = [(s.spec.speed_class, s) for k, s in ch7.solutions.items() if k.startswith("NMSK ")]
+    if natural is not None:
+        items.append(("Free", natural))
+    for cls, s in items:
+        g = data_mod.load_gait_data(cls, s.spec.source)
+        tc = THESIS_CLASS[cls]
+        rows.append({"class": cls, "speed (m/s)": g.speed, "converged": bool(s.stats.get("success")),
+                     "COT (J/kg/m)": s.stats.get("COT", np.nan), "thesis class": tc,
+                     "thesis speed (m/s, Fig 7.5)": thesis[tc][0], "thesis COT (Fig 7.5)": thesis[tc][1]})
+    return pd.DataFrame(rows).sort_values("speed (m/s)").set_index("class")
+
+
+def times_table(result: StudyResult, thesis_hours: dict, label_of=lambda spec: spec.cost) -> pd.DataFrame:
+    """Our wall time, iterations and time per iteration per run beside the thesis's hours
+    (Table 6.3 or 7.2; labelled) and the speed-up."""
+    rows = []
+    for name, spec in result.specs.items():
+        sol = result.solutions.get(name)
+        lab = label_of(spec)
+        h = thesis_hours.get(spec.model, {}).get(lab, np.nan)
+        st = sol.stats if sol is not None else {}
+        t = st.get("solve_time_s", np.nan)
+        rows.append({"model": spec.model, "case": lab, "status": result.records[name].status,
+                     "iterations": st.get("iterations"), "solve (s)": t,
+                     "ms/iteration": 1e3 * st.get("time_per_iteration_s", np.nan), "thesis (h)": h,
+                     "speed-up": 3600 * h / t if t and np.isfinite(t) else np.nan})
+    return pd.DataFrame(rows)
