@@ -567,3 +567,47 @@ def animate_jump(jump_model, t, Q, p_contact=None, grf=None, cop=None, fps: floa
     anim.frame_indices = idx
     plt.close(fig)
     return anim
+
+
+def score_bars(scores, kind: str, value: str = "rmse", cases=None, models=None, ncols: int = 4,
+               figsize_per=(3.0, 2.1), title=None, colors=None):
+    """Grouped bars of a per-channel error for several runs (thesis Figs 6.1–6.4, 7.1–7.4).
+
+    Parameters
+    ----------
+    scores : long DataFrame with columns ``model, case, kind, channel, side, unit`` and
+        ``value`` (e.g. :attr:`gaitlib.studies.predictive.StudyResult.scores`).
+    kind : ``"angle"``, ``"torque"``, ``"grf"`` or ``"excitation"`` — one panel per
+        channel and side; x = the cases (cost functions or speed classes) in order, one bar
+        per model. A run missing from ``scores`` leaves a gap.
+    """
+    import matplotlib.pyplot as plt
+
+    df = scores[scores["kind"] == kind]
+    cases = list(cases) if cases is not None else list(dict.fromkeys(df["case"]))
+    models = list(models) if models is not None else list(dict.fromkeys(df["model"]))
+    panels = list(dict.fromkeys(zip(df["channel"], df["side"])))
+    fig, axes = _panel_grid(len(panels), ncols, figsize_per)
+    cmap = plt.get_cmap("tab10")
+    colors = colors or {m: cmap(i) for i, m in enumerate(models)}
+    width = 0.8 / max(len(models), 1)
+    x = np.arange(len(cases))
+    for ax, (ch, side) in zip(axes.flat, panels):
+        sub = df[(df["channel"] == ch) & (df["side"] == side)]
+        for i, m in enumerate(models):
+            vals = [sub[(sub["model"] == m) & (sub["case"] == c)][value] for c in cases]
+            vals = [float(v.iloc[0]) if len(v) else np.nan for v in vals]
+            ax.bar(x + (i - (len(models) - 1) / 2) * width, vals, width, color=colors[m], label=m)
+        ax.set_xticks(x, cases, rotation=60, fontsize=7)
+        unit = sub["unit"].iloc[0] if value == "rmse" and len(sub) else ""
+        ax.set_title(f"{ch} ({'right' if side == 'r' else 'left'})", fontsize=9)
+        ax.set_ylabel(f"{value} {unit}".strip(), fontsize=8)
+        ax.tick_params(axis="y", labelsize=7)
+    for ax in axes.flat[len(panels):]:
+        ax.axis("off")
+    h, lab = axes.flat[0].get_legend_handles_labels()
+    if h:
+        fig.legend(h, lab, loc="outside upper right", fontsize=8, ncols=len(models))
+    if title:
+        fig.suptitle(title, fontsize=10)
+    return fig
