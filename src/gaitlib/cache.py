@@ -10,7 +10,10 @@ changes the key, so a cached solution is never served for code or data it was no
 with (stale entries are simply never hit again; ``clear`` removes them). Editing a
 presentation module (plots, CLI, sweep engine, another chapter's study) keeps entries valid.
 
-Default location: ``$GAITLIB_SOLUTIONS`` or ``~/.cache/gaitlib/solutions``.
+Default location: ``$GAITLIB_SOLUTIONS`` or ``~/.cache/gaitlib/solutions``. Read-only
+fallback: the solutions stored in the repository (:func:`store_dir`), so that the book
+builds from a clean clone without re-solving; refresh them with ``tools/store_solutions.py``
+after a change to the CORE sources (stale entries are ignored, never served).
 """
 
 from __future__ import annotations
@@ -25,7 +28,7 @@ from pathlib import Path
 
 from . import __version__
 
-__all__ = ["CORE", "fingerprint", "key", "default_dir", "lookup", "clear"]
+__all__ = ["CORE", "fingerprint", "key", "default_dir", "store_dir", "find", "lookup", "clear"]
 
 _PKG = Path(__file__).resolve().parent
 
@@ -70,6 +73,37 @@ def key(spec: dict, modules=()) -> str:
     """Cache key of a JSON-able spec under the current code (CORE + ``modules``) and data."""
     blob = json.dumps({"spec": spec, "code": fingerprint(modules)}, sort_keys=True, default=str)
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+
+def store_dir() -> Path | None:
+    """The read-only store of solutions shipped with the repository (``<repo>/solutions``,
+    or ``$GAITLIB_STORE``; ``GAITLIB_STORE=""`` disables it), or None. Entries there carry
+    the same keys, so a stale one is never hit; :func:`find` falls back to it."""
+    env = os.environ.get("GAITLIB_STORE")
+    if env is not None:
+        return Path(env) if env else None
+    repo = _PKG.parents[1] / "solutions"
+    return repo if repo.is_dir() else None
+
+
+def find(where: Path, marker: str) -> Path | None:
+    """``where`` (a :func:`lookup` result) if it holds ``marker``; else the same entry in
+    :func:`store_dir` if present there; else None."""
+    where = Path(where)
+    found = None
+    if (where / marker).exists():
+        found = where
+    else:
+        store = store_dir()
+        if store is not None:
+            cand = store / where.parent.name / where.name
+            if (cand / marker).exists():
+                found = cand
+    log = os.environ.get("GAITLIB_CACHE_LOG")
+    if log and found is not None:  # tools/store_solutions.py: which entries a build used
+        with open(log, "a") as f:
+            f.write(f"{found}\n")
+    return found
 
 
 def default_dir() -> Path:

@@ -66,10 +66,11 @@ def solve_cached(spec: tr.GaitSpec, *, use_cache: bool = True, root=None, guess=
     if guess is not None:
         desc["warm_start"] = _guess_signature(guess)
     where = cache.lookup("gait", desc, root, modules=())  # gait solutions depend on the CORE sources only
-    if use_cache and (where / "spec.json").exists():
+    found = cache.find(where, "spec.json") if use_cache else None
+    if found is not None:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ocp.SolveFailedWarning)
-            sol = tr.GaitSolution.load(where)
+            sol = tr.GaitSolution.load(found)
         sol.stats["from_cache"] = True
         return sol
     sol = tr.solve(spec, guess=guess, progress=progress)

@@ -912,12 +912,13 @@ def solve(sp: JumpSpec | str, guess: ocp.Guess | ocp.Solution | None = None, *,
     where = None
     if use_cache and guess is None:
         where = cache_location(sp, root)
-        if (where / "solution.json").exists():
+        found = cache.find(where, "solution.json")
+        if found is not None:
             import warnings
 
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", ocp.SolveFailedWarning)
-                sol = ocp.Solution.load(where)
+                sol = ocp.Solution.load(found)
             model = JumpModel(toe=sp.toe, damping=sp.damping)
             p_contact = contact_mod.default_params() if sp.contact == "ellipsoid" else None
             out = _result(sp, model, p_contact, sol)

@@ -1,0 +1,76 @@
+"""Refresh the repository's solution store (``solutions/``) from a run of the book.
+
+Usage: python tools/store_solutions.py [book/chNN_x.ipynb ...]   (default: every notebook
+in book/_toc.yml order)
+
+Every notebook is executed with an empty writable cache (``GAITLIB_SOLUTIONS`` = a fresh
+temporary directory) and the current store as read-only fallback. Afterwards the store is
+replaced by exactly the entries the run used: those it reloaded from the store and those it
+had to solve. Stale entries (older code or data) are never hit, so they drop out. Prints the
+wall time per notebook — with a fresh store it is the from-scratch time of the book.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+STORE = REPO / "solutions"
+
+
+def notebooks(argv) -> list[Path]:
+    if argv:
+        return [Path(a).resolve() for a in argv]
+    import yaml
+
+    toc = yaml.safe_load((REPO / "book" / "_toc.yml").read_text())
+    files = [c["file"] for c in toc.get("chapters", [])]
+    return [REPO / "book" / f"{f}.ipynb" for f in files if (REPO / "book" / f"{f}.ipynb").exists()]
+
+
+def main(argv) -> int:
+    nbs = notebooks(argv)
+    tmp = Path(tempfile.mkdtemp(prefix="gaitlib-store-"))
+    log = tmp / "used.log"
+    env = dict(os.environ, GAITLIB_SOLUTIONS=str(tmp / "cache"), GAITLIB_CACHE_LOG=str(log),
+               GAITLIB_STORE=str(STORE) if STORE.is_dir() else "")
+    times = {}
+    failed = []
+    for nb in nbs:
+        t0 = time.time()
+        r = subprocess.run([sys.executable, "-m", "jupyter", "nbconvert", "--to", "notebook", "--execute",
+                            "--ExecutePreprocessor.timeout=-1", "--output-dir", str(tmp / "nb"), str(nb)],
+                           env=env, cwd=nb.parent)
+        times[nb.name] = time.time() - t0
+        print(f"{nb.name}: {times[nb.name]:.0f} s{'' if r.returncode == 0 else ' — FAILED'}", flush=True)
+        if r.returncode:
+            failed.append(nb.name)
+    if failed:
+        print(f"not refreshing the store: {failed} failed", file=sys.stderr)
+        return 1
+    used = {Path(p) for p in log.read_text().split()} if log.exists() else set()
+    new = tmp / "store"
+    for entry in used:
+        dest = new / entry.parent.name / entry.name
+        if not dest.exists():
+            shutil.copytree(entry, dest)
+    if STORE.exists():
+        shutil.rmtree(STORE)
+    shutil.move(str(new) if new.exists() else str(new.mkdir(parents=True) or new), STORE)
+    (STORE / "README.md").write_text(
+        "Solutions the book loads instead of re-solving, keyed by spec + code + data hash\n"
+        "(gaitlib.cache). Written by tools/store_solutions.py; never edit by hand.\n\n"
+        + "\n".join(f"- {k}: {v:.0f} s" for k, v in times.items()) + "\n")
+    print(f"store: {len(used)} entries, total {sum(times.values()):.0f} s")
+    shutil.rmtree(tmp, ignore_errors=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
