@@ -34,7 +34,7 @@ _PKG = Path(__file__).resolve().parent
 
 #: Modules every solution depends on (paths relative to the package).
 CORE = ("__init__.py", "cache.py", "conventions.py", "data.py", "model.py", "kinematics.py", "contact.py",
-        "mtg.py", "activation.py", "metabolics.py", "collocation.py", "ocp.py", "transcription.py")
+        "mtg.py", "activation.py", "metabolics.py", "collocation.py", "ocp.py", "transcription.py", "params.py")
 
 
 def _module_path(m) -> str:

@@ -131,6 +131,7 @@ from . import contact as contact_mod
 from . import conventions as cv
 from . import data as data_mod
 from . import kinematics
+from . import params as params_mod
 from .collocation import Mesh
 from .model import ChildModel
 from .ocp import Goal, Guess, Named, Parameter, PathConstraint, Periodic, Phase, PhaseGuess, Problem, SolverOptions
@@ -224,7 +225,14 @@ class GaitSpec:
     periodic : impose a periodic cycle (our departure, see module docstring).
     normal_force_constraint : each ellipsoid's normal force ≥ 0 (Sec 4.4.1).
     free_contact, free_body : identify the 39 contact / 25 body parameters (Ch 4).
-    body_params : ``"default"`` (Tables 4.1–4.3 scaled) or ``"thesis"`` (Tables 4.15–4.16).
+    body_params : ``"default"`` (Tables 4.1–4.3 scaled), ``"thesis"`` (Tables 4.15–4.16) or
+        ``"ch4"`` (ours, Ch 4 approach (c), ``data/identified/ch4_child.json``,
+        :func:`gaitlib.params.load_identified`). The fixed values, or the guess when free.
+    contact_params : ``"default"`` (the thesis's Tables 4.17–4.18) or ``"ch4"`` (ours, as
+        ``body_params``). The fixed values, or the guess when free; also the geometry of the
+        HAT-height reference.
+    contact_bounds : with ``free_contact``: ``"widened"`` — Table 4.7 widened to contain the
+        guess (Table 4.17 lies partly outside Table 4.7); ``"table4.7"`` — Table 4.7 verbatim.
     tol, max_iter : IPOPT settings (thesis: tol 1e-5).
     tf_bounds : ``()`` — final time fixed to the data's cycle time T; ``(lo, hi)`` (s) — free
         final time within the bounds. The stride length stays the data's (speed × T) in the
@@ -268,6 +276,8 @@ class GaitSpec:
     free_contact: bool = False
     free_body: bool = False
     body_params: str = "default"
+    contact_params: str = "default"
+    contact_bounds: str = "widened"
     residual_bounds: tuple = (1.0, 1.0, 0.1)
     tol: float = 1e-5
     max_iter: int = 1000
@@ -288,6 +298,12 @@ class GaitSpec:
                 raise ValueError(f"tf_bounds must be () or (lo, hi) with 0 < lo <= hi, got {self.tf_bounds!r}")
         if self.model != "NMSK" and (self.free_activation or self.excitation_guess != "mtg" or self.t_stim is not None):
             raise ValueError("free_activation, excitation_guess and t_stim apply to the NMSK model only")
+        if self.body_params not in ("default", "thesis", "ch4"):
+            raise ValueError(f"body_params must be 'default', 'thesis' or 'ch4', got {self.body_params!r}")
+        if self.contact_params not in ("default", "ch4"):
+            raise ValueError(f"contact_params must be 'default' or 'ch4', got {self.contact_params!r}")
+        if self.contact_bounds not in ("widened", "table4.7"):
+            raise ValueError(f"contact_bounds must be 'widened' or 'table4.7', got {self.contact_bounds!r}")
         if self.excitation_guess not in ("mtg", "emg"):
             raise ValueError(f"excitation_guess must be 'mtg' or 'emg', got {self.excitation_guess!r}")
         if self.cost not in COST_FUNCTIONS[self.model]:
@@ -538,8 +554,8 @@ def build(spec: GaitSpec) -> GaitProblem:
     gait_class = data_mod.load_gait_data(spec.speed_class, spec.source)
     gait = (data_mod.time_scaled(data_mod.load_gait_data(spec.track_class, spec.source), gait_class)
             if spec.track_class else gait_class)
-    p_body = model.p_body_identified() if spec.body_params == "thesis" else model.default_p_body()
-    p_contact = contact_mod.default_params()
+    p_body = params_mod.body_params(spec.body_params, model)
+    p_contact = params_mod.contact_params(spec.contact_params)
     ref = reference(gait, model, p_contact)
     if spec.hat_reference:
         ref = _with_hat_reference(ref, spec.hat_reference)
@@ -557,7 +573,9 @@ def build(spec: GaitSpec) -> GaitProblem:
     # ---- static parameters
     params: list[Parameter] = []
     if spec.free_contact:
-        lo, hi = contact_mod.bounds(include_defaults=True)
+        lo, hi = contact_mod.bounds()  # Table 4.7
+        if spec.contact_bounds == "widened":  # … widened to contain the guess
+            lo, hi = np.minimum(lo, p_contact), np.maximum(hi, p_contact)
         for n_, l_, h_, g_ in zip(contact_mod.param_names(), lo, hi, p_contact):
             params.append(Parameter(f"c.{n_}", float(l_), float(h_), float(g_)))
     if spec.free_body:
