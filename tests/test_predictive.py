@@ -1,0 +1,100 @@
+"""Ch 6/7 study (gaitlib.studies.predictive): guesses, specs and scoring, on coarse meshes."""
+
+import dataclasses
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from gaitlib import data
+from gaitlib import transcription as tr
+from gaitlib.studies import gait as sg
+from gaitlib.studies import predictive as pr
+
+MESH = dict(n_intervals=5, degree=3)
+
+
+@pytest.fixture(scope="module")
+def root(tmp_path_factory):
+    return tmp_path_factory.mktemp("sol")
+
+
+@pytest.fixture(scope="module")
+def base(root):
+    b = pr.baseline("MSK", root=root, **MESH)
+    assert b.stats["status"] == "Solve_Succeeded"
+    return b
+
+
+def test_specs_follow_tables_6_2_and_7_1(base):
+    s6 = pr.ch6_specs("MSK", base, **MESH)
+    assert list(s6) == [f"MSK {c}" for c in pr.CH6_COSTS]
+    fp = s6["MSK FP"].term_weights
+    assert not {"Trq", "Ang", "GRF", "Q"} & set(fp) and fp["HAT"] == 1 / 4 and fp["Imp"] == 1 / 4
+    assert s6["MSK DT"].term_weights == tr.COST_FUNCTIONS["MSK"]["DT"]
+    s7 = pr.ch7_specs("MSK", base, **MESH)
+    for name, sp in s7.items():
+        assert sp.cost == "DT" and sp.track_class == "Free" and sp.speed_class == name.split()[1]
+        assert sp.hat_reference == s6["MSK DT"].hat_reference
+
+
+def test_thesis_guess_keeps_only_hat_mtp_and_activations(base):
+    g = pr.thesis_guess(base)
+    ph = g.phase("cycle")
+    assert set(ph.states.columns) == {f"{p}{c}" for p in ("", "qd_", "qdd_")
+                                      for c in ("pelvis_tx", "pelvis_ty", "pelvis_tilt", "mtp_r", "mtp_l")}
+    assert set(ph.controls.columns) == set(tr.MTG_CONTROLS) | {"tau_mtp_r", "tau_mtp_l"}
+    assert g.parameters == {}
+
+
+def test_time_scaled_guess_is_a_consistent_trajectory(base):
+    """Scaling time by k divides velocities by k and accelerations by k² — the scaled
+    positions' derivative is the scaled velocity — and the pelvis advances one target stride."""
+    slow = data.load_gait_data("VerySlow")
+    stride = slow.speed * slow.cycle_time
+    src = base.solution.phase("cycle").states
+    ph = pr.thesis_guess(base, cycle_time=slow.cycle_time, stride=stride).phase("cycle")
+    k = slow.cycle_time / base.solution.phase("cycle").tf
+    assert ph.tf == pytest.approx(slow.cycle_time)
+    np.testing.assert_allclose(ph.states.index, src.index * k)
+    np.testing.assert_allclose(ph.states["qd_pelvis_ty"], src["qd_pelvis_ty"] / k)
+    np.testing.assert_allclose(ph.states["qdd_mtp_r"], src["qdd_mtp_r"] / k**2)
+    # mean horizontal speed of the guess = stride / cycle time
+    x = ph.states["pelvis_tx"]
+    s0 = data.load_gait_data("Free").speed * data.load_gait_data("Free").cycle_time
+    np.testing.assert_allclose(x - x.iloc[0], (src["pelvis_tx"] - src["pelvis_tx"].iloc[0]) * stride / s0)
+
+
+def test_score_is_zero_against_its_own_channels_and_grows_with_an_offset(base):
+    """score() of a solution against data built from that solution's own channels is 0;
+    a constant offset of 5° on one angle gives RMSE 5° and NRMSE 5°/range on it only."""
+    free = data.load_gait_data("Free")
+    sim = sg.channels_frame(base)
+    idx = pd.Index(sim.index.to_numpy() / base.stats["tf_s"] * free.cycle_time, name="time")
+    mean = sim.set_axis(idx, axis=0)
+    for s in "rl":  # score() converts data hip to thigh-in-lab by adding pelvic tilt: undo it
+        mean[f"hip_{s}"] = mean[f"hip_{s}"] - mean["pelvis_tilt"]
+    sd = mean * 0 + 1.0
+    g = dataclasses.replace(free, mean=mean, sd=sd)
+    sc = pr.score(base, g)
+    assert sc["rmse"].abs().max() < 1e-9
+    off = mean.copy()
+    off["knee_r"] += np.deg2rad(5.0)
+    sc2 = pr.score(base, dataclasses.replace(free, mean=off, sd=sd)).set_index(["kind", "channel", "side"])
+    sc1 = sc.set_index(["kind", "channel", "side"])
+    assert sc2.loc[("angle", "knee", "r"), "rmse"] == pytest.approx(5.0, abs=1e-9)
+    diff = (sc2["rmse"] - sc1["rmse"]).drop(("angle", "knee", "r"))
+    assert np.abs(diff).max() < 1e-9
+
+
+def test_fully_predictive_fits_the_data_worse_than_data_tracking(base, root):
+    """Direction of change: dropping the data terms (FP) cannot fit the data better than DT."""
+    specs = pr.ch6_specs("MSK", base, ("DT", "FP"), **MESH)
+    sols = {k: sg.solve_cached(s, guess=pr.thesis_guess(base), root=root) for k, s in specs.items()}
+    for s in sols.values():
+        assert s.stats["status"] == "Solve_Succeeded"
+    free = data.load_gait_data("Free")
+    nr = {k: pr.score(s, free).groupby("kind")["nrmse"].mean() for k, s in sols.items()}
+    assert nr["MSK DT"]["angle"] < nr["MSK FP"]["angle"]
+    assert nr["MSK DT"]["torque"] < nr["MSK FP"]["torque"]
+    assert set(sols["MSK FP"].solution.goals["goal"]) == {"Jrk", "Rsd", "Imp", "HAT", "Act"}
