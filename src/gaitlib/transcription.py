@@ -153,6 +153,8 @@ EXCITATION_CONTROLS = tuple(f"ed_{m}" for m in NMSK_MUSCLES)
 NEURAL_STATES = tuple(f"u_{m}" for m in NMSK_MUSCLES)
 #: Activation parameters γ of Eq 5.53, in NLP order (names of the free Parameters: ``act.<name>``).
 ACTIVATION_PARAMS = ("tau_act", "c3", "s1", "s2")
+#: MTG fitting-parameter sets of ``GaitSpec.mtg_params`` (:func:`mtg_params_of`).
+MTG_PARAM_SETS = ("default", "ch5", "thesis")
 #: Mtb normalisation (Eq 5.56): COT_N (J kg⁻¹ m⁻¹, adult natural speed) and the thesis's
 #: subjects' largest and smallest body masses BM_max, BM_min (kg).
 MTB_COT_N = 1.6
@@ -231,6 +233,11 @@ class GaitSpec:
     contact_params : ``"default"`` (the thesis's Tables 4.17–4.18) or ``"ch4"`` (ours, as
         ``body_params``). The fixed values, or the guess when free; also the geometry of the
         HAT-height reference.
+    mtg_params : MSK/NMSK MTG fitting parameters (Eq 5.9) of the 12 generators (left leg =
+        right leg): ``"default"`` — Eq 5.22, the adult Gymnast curves scaled to the child
+        (Eq 5.21); ``"ch5"`` — ours, identified on our data (Sec 5.1.1,
+        ``data/identified/ch5_mtg.json``, :mod:`gaitlib.studies.mtg_id`); ``"thesis"`` —
+        Table 5.2. See :func:`mtg_params_of`.
     contact_bounds : with ``free_contact``: ``"widened"`` — Table 4.7 widened to contain the
         guess (Table 4.17 lies partly outside Table 4.7); ``"table4.7"`` — Table 4.7 verbatim.
     tol, max_iter : IPOPT settings (thesis: tol 1e-5).
@@ -277,6 +284,7 @@ class GaitSpec:
     free_body: bool = False
     body_params: str = "default"
     contact_params: str = "default"
+    mtg_params: str = "default"
     contact_bounds: str = "widened"
     residual_bounds: tuple = (1.0, 1.0, 0.1)
     tol: float = 1e-5
@@ -300,6 +308,8 @@ class GaitSpec:
             raise ValueError("free_activation, excitation_guess and t_stim apply to the NMSK model only")
         if self.body_params not in ("default", "thesis", "ch4"):
             raise ValueError(f"body_params must be 'default', 'thesis' or 'ch4', got {self.body_params!r}")
+        if self.mtg_params not in MTG_PARAM_SETS:
+            raise ValueError(f"mtg_params must be one of {MTG_PARAM_SETS}, got {self.mtg_params!r}")
         if self.contact_params not in ("default", "ch4"):
             raise ValueError(f"contact_params must be 'default' or 'ch4', got {self.contact_params!r}")
         if self.contact_bounds not in ("widened", "table4.7"):
@@ -526,6 +536,51 @@ def _states(spec: GaitSpec) -> tuple[str, ...]:
     return x + NEURAL_STATES if spec.model == "NMSK" else x
 
 
+def load_mtg_params(path) -> dict:
+    """MTG fitting parameters from a JSON file ``{"params": {generator: {Eq 5.9 name: value}},
+    "provenance": …}`` (written by :func:`gaitlib.studies.mtg_id.save_params`; Δ^P in rad)
+    → generator → :class:`gaitlib.mtg.MTGParams`. Errors name the file and the entry."""
+    from . import mtg
+
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"MTG parameter file {path} not found: it is written by "
+                                f"gaitlib.studies.mtg_id.save_params (python -m gaitlib.studies.mtg_id)")
+    try:
+        raw = json.loads(path.read_text())
+    except json.JSONDecodeError as e:
+        raise ValueError(f"{path}: not valid JSON ({e})") from None
+    if "params" not in raw or "provenance" not in raw:
+        raise ValueError(f"{path}: needs 'params' and 'provenance' entries")
+    out = {}
+    for g in mtg.GENERATORS:
+        d = raw["params"].get(g)
+        if d is None or set(d) != set(mtg.MTGParams._fields):
+            raise ValueError(f"{path}: params[{g!r}] must have exactly {mtg.MTGParams._fields}")
+        v = [float(d[k]) for k in mtg.MTGParams._fields]
+        if not all(math.isfinite(x) for x in v):
+            raise ValueError(f"{path}: params[{g!r}] has non-finite values")
+        out[g] = mtg.MTGParams(*v)
+    return out
+
+
+def mtg_params_of(spec_or_name) -> dict | None:
+    """The MTG fitting parameters of a spec (or a :data:`MTG_PARAM_SETS` name), in the form
+    :func:`gaitlib.mtg.joint_torque` takes: None for ``"default"`` (Eq 5.22), else
+    generator → MTGParams (``"ch5"``: ``data/identified/ch5_mtg.json``; ``"thesis"``:
+    Table 5.2). A missing file is an error (no fallback)."""
+    from . import mtg
+
+    name = spec_or_name.mtg_params if isinstance(spec_or_name, GaitSpec) else spec_or_name
+    if name == "default":
+        return None
+    if name == "thesis":
+        return dict(mtg.THESIS_PARAMS)
+    if name == "ch5":
+        return load_mtg_params(Path(data_mod.DATA_DIR) / "identified" / "ch5_mtg.json")
+    raise ValueError(f"mtg_params must be one of {MTG_PARAM_SETS}, got {name!r}")
+
+
 def activation_values(spec: GaitSpec) -> dict[str, float]:
     """Numeric activation parameters γ (Eq 5.53) of an NMSK spec: Table 5.10's identified
     values, or its initial guesses when ``free_activation`` (then they are NLP variables)."""
@@ -564,6 +619,7 @@ def build(spec: GaitSpec) -> GaitProblem:
     w = spec.term_weights
     nmsk = spec.model == "NMSK"
     free_tf = bool(spec.tf_bounds)
+    mtgp = mtg_params_of(spec) if spec.model != "SK" else None
 
     states = _states(spec)
     controls = _controls(spec)
@@ -636,7 +692,7 @@ def build(spec: GaitSpec) -> GaitProblem:
             for s in cv.SIDES:
                 for j in ("hip", "knee", "ankle"):
                     c = f"{j}_{s}"
-                    tin[c] = mtg.joint_torque(j, x[c], x[f"qd_{c}"], u[f"a_{j}_ext_{s}"], u[f"a_{j}_flex_{s}"])
+                    tin[c] = mtg.joint_torque(j, x[c], x[f"qd_{c}"], u[f"a_{j}_ext_{s}"], u[f"a_{j}_flex_{s}"], mtgp)
                 tin[f"mtp_{s}"] = u[f"tau_mtp_{s}"]
             tau_in = ca.vertcat(*[tin[j] for j in cv.JOINTS])
         else:  # NMSK: muscle activations → 12 generator activations (Eq 5.54) → MTGs
@@ -649,7 +705,7 @@ def build(spec: GaitSpec) -> GaitProblem:
                 ag = activation.generator_activations(am, ap["s1"], ap["s2"], side=s)
                 for j in ("hip", "knee", "ankle"):
                     c = f"{j}_{s}"
-                    tin[c] = mtg.joint_torque(j, x[c], x[f"qd_{c}"], ag[f"{j}_ext"], ag[f"{j}_flex"])
+                    tin[c] = mtg.joint_torque(j, x[c], x[f"qd_{c}"], ag[f"{j}_ext"], ag[f"{j}_flex"], mtgp)
                 tin[f"mtp_{s}"] = u[f"tau_mtp_{s}"]
             tau_in = ca.vertcat(*[tin[j] for j in cv.JOINTS])
             extra["a_muscle"] = am
@@ -702,7 +758,7 @@ def build(spec: GaitSpec) -> GaitProblem:
         ap_ = act_of(pn_)
         r = metabolics.nmsk_metabolic_rate(
             {j: xn_[j] for j in cv.JOINTS}, {j: xn_[f"qd_{j}"] for j in cv.JOINTS},
-            {m: un_[f"ed_{m}"] for m in NMSK_MUSCLES}, muscle_activations(xn_, pn_),
+            {m: un_[f"ed_{m}"] for m in NMSK_MUSCLES}, muscle_activations(xn_, pn_), mtgp,
             s1=ap_["s1"], s2=ap_["s2"], mtp_torques={f"mtp_{s}": un_[f"tau_mtp_{s}"] for s in cv.SIDES},
             t_stim={m: ts_[i] for i, m in enumerate(NMSK_MUSCLES)})
         parts = ("total", "activation", "maintenance", "shortening", "basal", "work")
@@ -853,7 +909,7 @@ def initial_guess(spec: GaitSpec, model: ChildModel, ref: Reference, p_body, p_c
             C[f"tau_mtp_{s}"] = np.zeros_like(t)
             for j in ("hip", "knee", "ankle"):
                 c = f"{j}_{s}"
-                a = mtg.activation_for_torque(j, tau[c], S[c], S[f"qd_{c}"])
+                a = mtg.activation_for_torque(j, tau[c], S[c], S[f"qd_{c}"], mtg_params_of(spec))
                 C[f"a_{j}_ext_{s}"] = np.asarray(a["a_ext"], float)
                 C[f"a_{j}_flex_{s}"] = np.asarray(a["a_flex"], float)
         if spec.model == "NMSK":
@@ -1111,7 +1167,7 @@ def warm_start(gp: GaitProblem, guess) -> Guess:
             for j in ("hip", "knee", "ankle"):
                 c = f"{j}_{s_}"
                 tq = np.interp(base.time, tc, ph.controls[f"tau_{c}"])
-                a = mtg.activation_for_torque(j, tq, S[c], S[f"qd_{c}"])
+                a = mtg.activation_for_torque(j, tq, S[c], S[f"qd_{c}"], mtg_params_of(gp.spec))
                 C[f"a_{j}_ext_{s_}"] = np.asarray(a["a_ext"], float)
                 C[f"a_{j}_flex_{s_}"] = np.asarray(a["a_flex"], float)
     src_drives = set(MTG_CONTROLS) <= set(ph.controls.columns) or "tau_hip_r" in ph.controls.columns
@@ -1181,7 +1237,8 @@ def postprocess(gp: GaitProblem, sol: ocp.Solution) -> GaitSolution:
             for j in ("hip", "knee", "ankle"):
                 c = f"{j}_{s}"
                 tq[c] = np.asarray(mtg.joint_torque(j, q[c].to_numpy(), qd[c].to_numpy(),
-                                                    U[f"a_{j}_ext_{s}"].to_numpy(), U[f"a_{j}_flex_{s}"].to_numpy()), float).ravel()
+                                                    U[f"a_{j}_ext_{s}"].to_numpy(), U[f"a_{j}_flex_{s}"].to_numpy(),
+                                                    mtg_params_of(spec)), float).ravel()
             tq[f"mtp_{s}"] = U[f"tau_mtp_{s}"].to_numpy()
         torques = pd.DataFrame({j: tq[j] for j in cv.JOINTS}, index=q.index)
         acts = U[list(MTG_CONTROLS)].copy()
@@ -1225,7 +1282,7 @@ def _postprocess_nmsk(gp: GaitProblem, sol: ocp.Solution, Xu, U, q, qd):
             c = f"{j}_{s}"
             acts[f"a_{j}_ext_{s}"], acts[f"a_{j}_flex_{s}"] = ag[f"{j}_ext"], ag[f"{j}_flex"]
             tq[c] = np.asarray(mtg.joint_torque(j, q[c].to_numpy(), qd[c].to_numpy(), ag[f"{j}_ext"],
-                                                ag[f"{j}_flex"]), float).ravel()
+                                                ag[f"{j}_flex"], mtg_params_of(gp.spec)), float).ravel()
         tq[f"mtp_{s}"] = U[f"tau_mtp_{s}"].to_numpy()
     torques = pd.DataFrame({j: tq[j] for j in cv.JOINTS}, index=q.index)
     acts = pd.DataFrame({k: acts[k] for k in MTG_CONTROLS}, index=q.index)
