@@ -611,3 +611,86 @@ def score_bars(scores, kind: str, value: str = "rmse", cases=None, models=None, 
     if title:
         fig.suptitle(title, fontsize=10)
     return fig
+
+
+# =====================================================================================
+# Contact geometry on the foot (thesis Figs 4.10, 4.11, 4.14)
+# =====================================================================================
+
+
+def foot_contact_geometry(param_sets: dict, model=None, colors=None, styles=None, title=None,
+                          figsize=(10.0, 3.6)):
+    """The left foot's three contact ellipsoids in side and top view, standing posture.
+
+    Parameters
+    ----------
+    param_sets : ``{label: p_contact}`` — 39-vectors (SI, left foot,
+        :func:`gaitlib.contact.default_params` order) drawn over each other, e.g. ours and
+        the thesis's identified values.
+    model : gaitlib.model.ChildModel (default: a new one).
+    colors, styles : optional ``{label: colour}`` / ``{label: linestyle}``.
+
+    Coordinates are those of the contact parameters (thesis Sec 4.1.2): the foot frame with
+    its origin on the ground below the ankle in the standing posture, X forward, Y up,
+    Z = X × Y (to the walker's right; for the left foot +Z is medial), in mm. Side view:
+    the exact orthographic outline of each ellipsoid on the X–Y plane
+    (:func:`ellipse_outline`) with the foot's skeleton (heel → ankle → metatarsal point →
+    toe tip) and the ground; top view: outlines on the X–Z plane, the skeleton along
+    Z = 0 (the model is planar).
+
+    Returns
+    -------
+    matplotlib Figure with two axes (side, top).
+    """
+    import matplotlib.pyplot as plt
+
+    from .model import ChildModel
+
+    model = ChildModel() if model is None else model
+    q = np.zeros(len(cv.COORDS))
+    q[cv.COORDS.index("pelvis_ty")] = model.standing_leg_length
+    P = model.points(q)
+    origin = np.array([float(np.asarray(P["ankle_l"])[0]), 0.0])
+    skel = np.array([np.asarray(P[k], float).ravel() for k in ("heel_l", "ankle_l", "mtp_l", "toe_tip_l")]) - origin
+    perm = np.array([[1.0, 0, 0], [0, 0, 1.0], [0, 1.0, 0]])  # (x, y, z) -> (x, z, y): top view
+    fig, (ax_s, ax_t) = plt.subplots(1, 2, figsize=figsize, constrained_layout=True)
+    cmap = plt.get_cmap("tab10")
+    labels = list(param_sets)
+    colors = colors or {lab: cmap(i) for i, lab in enumerate(labels)}
+    styles = styles or {lab: ("-", "--", ":", "-.")[i % 4] for i, lab in enumerate(labels)}
+    ax_s.axhline(0.0, color=FIGURE_COLORS["ground"], lw=1.0, zorder=0)
+    ax_s.plot(1e3 * skel[:, 0], 1e3 * skel[:, 1], "-o", color="0.3", lw=2.0, ms=3, zorder=1)
+    ax_t.plot(1e3 * skel[[0, 3], 0], [0.0, 0.0], "-", color="0.3", lw=2.0, zorder=1)
+    from .kinematics import ellipsoid_radii
+    from .model import ELLIPSOID_LABELS
+
+    for lab in labels:
+        p = np.asarray(param_sets[lab], float)
+        centres, Rs = model.ellipsoid_poses(q, p)
+        radii = ellipsoid_radii(p)
+        first = True
+        for k, el in enumerate(ELLIPSOID_LABELS):
+            if not el.endswith("_l"):
+                continue
+            c = np.asarray(centres[k], float) - np.array([origin[0], 0.0, 0.0])
+            R = np.asarray(Rs[k], float)
+            side = 1e3 * ellipse_outline(c, R, radii[k])
+            top = 1e3 * ellipse_outline(perm @ c, perm @ R, radii[k])
+            kw = dict(color=colors[lab], ls=styles[lab], lw=1.4)
+            ax_s.plot(side[:, 0], side[:, 1], label=lab if first else None, **kw)
+            ax_t.plot(top[:, 0], top[:, 1], **kw)
+            ax_s.annotate(el[:-2], (1e3 * c[0], 1e3 * c[1]), fontsize=7, color=colors[lab], ha="center")
+            first = False
+    ax_s.set_title("side view (X–Y)", fontsize=9)
+    ax_s.set_xlabel("X forward (mm)", fontsize=8)
+    ax_s.set_ylabel("Y up (mm)", fontsize=8)
+    ax_t.set_title("top view (X–Z)", fontsize=9)
+    ax_t.set_xlabel("X forward (mm)", fontsize=8)
+    ax_t.set_ylabel("Z (mm, + medial for the left foot)", fontsize=8)
+    for ax in (ax_s, ax_t):
+        ax.set_aspect("equal")
+        ax.tick_params(labelsize=7)
+    fig.legend(loc="outside lower center", ncols=min(len(labels), 4), fontsize=8)
+    if title:
+        fig.suptitle(title, fontsize=10)
+    return fig

@@ -1,0 +1,832 @@
+"""Ch 4: foot–ground contact parameter identification (thesis Secs 4.3–4.4) on our data.
+
+Three approaches identify the 39 contact parameters of the left foot's toe, ball and heel
+ellipsoids (Table 4.5; the right foot is the mirror image) on the Free-speed data of
+Schwartz et al. 2008, both legs (left leg by the Fourier phase shift of Eqs 4.1–4.3):
+
+(a) :func:`trajectory_optimization` — Sec 4.3.1. The kinematics are fixed to the data (our
+    reference coordinates and their analytic Fourier derivatives); inverse dynamics gives
+    the joint torques and pelvis residual loads, the contact model the GRFs, and the 39
+    parameters minimise Eq 4.5 (weights Table 4.8: w1 = w2 = 1/4) within the Table 4.7
+    bounds and the friction-ratio constraint Eq 4.4 (0.55 ≤ μ_d/μ_s ≤ 0.99). The thesis used
+    MATLAB's GlobalSearch; we use a multistart in its spirit (:class:`TrajOptSpec`): one
+    local solve from a neutral start x0, then local solves from the best-scoring points of a
+    seeded Latin-hypercube scatter of trial points. Each local solve is IPOPT with exact
+    first and second derivatives (CasADi AD) in scaled variables z ∈ [0, 1]³⁹ (k_v
+    log-scaled: it spans three decades).
+(b) :func:`optimal_control` — Sec 4.3.2. The SK data-tracking optimal control problem
+    (Eqs 4.6–4.11, Table 4.8 weights, Eq 4.8 residual bounds) with the 39 parameters as
+    static NLP variables within Table 4.7 (verbatim) and Eq 4.4.
+(c) :func:`optimal_control_body` — Sec 4.4. As (b) plus the 25 mass and joint parameters
+    (Table 4.14 bounds), a non-negative normal force at each of the six ellipsoids
+    (Sec 4.4.1), and the Imp and Rsd cost terms (Eqs 4.12–4.13, w5 = w6 = 1/4).
+
+Starting points (our choice; the thesis started (a) and (b) from Brown & McPhee's published
+parameters, which we could not obtain — ``shared/design/model-facts.md``): the *neutral*
+start :func:`neutral_start` — the centre of each Table 4.7 box (k_v at its geometric
+centre, 3.2·10⁶ N/m³) with the thesis's friction guess μ_s = 0.40, μ_d = 0.35 (Sec 4.3.1) —
+is (a)'s first start and (b)'s guess. (c) is warm-started from (b)'s solution (states,
+controls and contact parameters; the body parameters start at their Sec 4.1.1 values).
+The thesis's identified values (Tables 4.17–4.18) are **not** used as a start; they enter
+only through the HAT-height reference of the tracked kinematics (the height at which that
+contact, at rest, carries the data's vertical GRF — the public data have no pelvis marker),
+which is also (a)'s fixed pelvis trajectory.
+
+Every solve is cached (:mod:`gaitlib.cache`; key = spec + start + code + data), so a rerun
+reloads. :func:`save_identified` writes (c)'s parameters with their provenance to
+``data/identified/ch4_child.json`` (:mod:`gaitlib.params`), the values later chapters load
+with ``GaitSpec(contact_params="ch4", body_params="ch4")``.
+
+Thesis values appear only as labelled references (:data:`THESIS_RMSE`,
+:data:`THESIS_GEOMETRY`, :data:`THESIS_CONTACT`, :data:`THESIS_TIME`); they were obtained on
+different data (Bovi et al. 2011, 0.98 s cycle).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import datetime as _dt
+import json
+import time
+import warnings
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+import pandas as pd
+
+from .. import __version__
+from .. import cache
+from .. import contact as contact_mod
+from .. import conventions as cv
+from .. import data as data_mod
+from .. import ocp
+from .. import params as params_mod
+from .. import transcription as tr
+from ..model import P_BODY_NAMES, P_BODY_UNITS, ChildModel
+
+__all__ = [
+    "APPROACHES", "THESIS_RMSE", "THESIS_GEOMETRY", "THESIS_CONTACT", "THESIS_TIME",
+    "TrajOptSpec", "InverseDynamicsID", "ApproachResult",
+    "neutral_start", "trajectory_optimization", "spec_b", "spec_c", "optimal_control",
+    "optimal_control_body", "run_all",
+    "rmse_table", "rmse_beside_thesis", "solver_table", "geometry_table", "contact_table",
+    "body_table", "at_bounds", "friction_ratios", "residual_rms", "grf_fit",
+    "save_identified", "identified_vs_result",
+]
+
+#: The three approaches: key → label used in tables and figures.
+APPROACHES = {"a": "(a) trajectory optimisation", "b": "(b) optimal control",
+              "c": "(c) optimal control + body parameters"}
+
+#: Friction-ratio bounds of Eq 4.4 (μ_d / μ_s), thesis Sec 4.3.1.
+MU_RATIO = (0.55, 0.99)
+
+# --------------------------------------------------------------------------------------
+# Thesis values (references, on Bovi 2011 data)
+# --------------------------------------------------------------------------------------
+
+#: Thesis RMSEs: approach → {(quantity, side): value}. Table 4.9 for (a) and (b) (torques
+#: N·m, GRFs N, residuals R_x, R_y N, R_z N·m; side "" for the residuals); Sec 4.4.2 for (c)
+#: (GRFs only: "3.37 N and 2.71 N" tangential, "9.94 N and 10.72 N" normal, right and left).
+THESIS_RMSE = {
+    "a": {("tau_hip", "r"): 16.46, ("tau_hip", "l"): 18.07, ("tau_knee", "r"): 11.06, ("tau_knee", "l"): 11.18,
+          ("tau_ankle", "r"): 17.29, ("tau_ankle", "l"): 17.09, ("grf_x", "r"): 36.42, ("grf_x", "l"): 36.60,
+          ("grf_y", "r"): 234.67, ("grf_y", "l"): 232.46, ("R_x", ""): 94.35, ("R_y", ""): 349.03,
+          ("R_z", ""): 18.12},
+    "b": {("tau_hip", "r"): 0.42, ("tau_hip", "l"): 0.42, ("tau_knee", "r"): 0.35, ("tau_knee", "l"): 0.35,
+          ("tau_ankle", "r"): 0.66, ("tau_ankle", "l"): 0.66, ("grf_x", "r"): 19.81, ("grf_x", "l"): 8.33,
+          ("grf_y", "r"): 26.49, ("grf_y", "l"): 26.38, ("R_x", ""): 0.0, ("R_y", ""): 0.0, ("R_z", ""): 0.0},
+    "c": {("grf_x", "r"): 3.37, ("grf_x", "l"): 2.71, ("grf_y", "r"): 9.94, ("grf_y", "l"): 10.72},
+}
+THESIS_RMSE_SOURCE = {"a": "thesis Table 4.9", "b": "thesis Table 4.9", "c": "thesis Sec 4.4.2"}
+
+#: Thesis identified geometry of the left foot, table units (mm, deg), Table 4.5 order
+#: (a, b, c, r_x, r_y, r_z, γ, β, α): Table 4.10 (a), 4.11 (b), 4.17 (c; printed in m there).
+THESIS_GEOMETRY = {
+    "a": {"toe": (11.4, 46.4, 14.8, 153.5, 10.0, 23.5, -46.3, -21.4, 151.3),
+          "ball": (137.7, 22.6, 3.9, 88.2, 4.2, -6.0, -74.6, -3.9, -89.2),
+          "heel": (37.4, 35.8, 21.3, -4.7, -3.7, 0.0, -79.1, -28.3, -91.7)},
+    "b": {"toe": (11.8, 20.0, 11.0, 145.4, 18.3, 23.5, -47.3, -29.5, 152.5),
+          "ball": (80.0, 21.8, 17.9, 67.5, 8.9, -6.0, -57.0, -18.0, -95.5),
+          "heel": (24.5, 30.0, 13.5, -21.2, 11.6, 0.0, -68.9, -17.2, -91.6)},
+    "c": {"toe": (17.7, 30.0, 16.5, 163.2, 4.1, 23.5, -33.38, -28.89, 155.39),
+          "ball": (80.0, 20.6, 17.9, 67.5, 8.9, -6.0, -58.49, -12.45, -89.10),
+          "heel": (30.9, 40.0, 13.5, -25.6, 3.5, 0.3, -83.00, -20.36, -91.08)},
+}
+THESIS_GEOMETRY_SOURCE = {"a": "thesis Table 4.10", "b": "thesis Table 4.11", "c": "thesis Table 4.17"}
+
+#: Thesis identified k_v (N/m³), a_v (s/m), μ_s, μ_d: Table 4.12 (a), 4.13 (b), 4.18 (c).
+THESIS_CONTACT = {
+    "a": {"toe": (1.67e7, 0.9161, 0.0200, 0.0139), "ball": (1.04e7, 0.6881, 0.6256, 0.4245),
+          "heel": (0.07e7, 1.4732, 0.2207, 0.1592)},
+    "b": {"toe": (4.60e7, 0.0654, 0.0102, 0.0100), "ball": (0.12e7, 3.0000, 1.2000, 1.1871),
+          "heel": (0.95e7, 2.1490, 0.1765, 0.1121)},
+    "c": {"toe": (0.75e7, 1.1355, 0.3404, 0.2819), "ball": (2.40e7, 1.89e-5, 0.0101, 0.0100),
+          "heel": (1.54e7, 2.4271, 0.1703, 0.1686)},
+}
+THESIS_CONTACT_SOURCE = {"a": "thesis Table 4.12", "b": "thesis Table 4.13", "c": "thesis Table 4.18"}
+
+#: Thesis compute times (Intel i7-6700, MATLAB): Sec 4.3.3 and Sec 4.4.2.
+THESIS_TIME = {"a": "6 min (Sec 4.3.3, GlobalSearch)", "b": "11 min (Sec 4.3.3, GPOPS-II)",
+               "c": "5 h (Sec 4.4.2, GPOPS-II)"}
+
+_GEOM = ("a", "b", "c", "r_x", "r_y", "r_z", "gamma", "beta", "alpha")
+_GEOM_UNIT = ("mm",) * 6 + ("deg",) * 3
+_FRIC = ("k_v", "a_v", "mu_s", "mu_d")
+_FRIC_UNIT = ("N/m^3", "s/m", "-", "-")
+
+
+def _table_scale(name: str) -> float:
+    """SI → table units (mm, deg) for a contact parameter name."""
+    if name in ("a", "b", "c", "r_x", "r_y", "r_z"):
+        return 1e3
+    if name in ("gamma", "beta", "alpha"):
+        return 1 / cv.DEG
+    return 1.0
+
+
+# --------------------------------------------------------------------------------------
+# Starting point
+# --------------------------------------------------------------------------------------
+
+
+def neutral_start() -> np.ndarray:
+    """The neutral start (39,), SI: the centre of each Table 4.7 box, k_v at the geometric
+    centre of its box (√(10⁵·10⁸) ≈ 3.16·10⁶ N/m³), μ_s = 0.40 and μ_d = 0.35 (the thesis's
+    friction guess, Sec 4.3.1: "the required friction coefficient for walking is 0.3")."""
+    lo, hi = contact_mod.bounds()
+    p = 0.5 * (lo + hi)
+    for e in cv.ELLIPSOIDS:
+        i = contact_mod.param_index(e, "k_v")
+        p[i] = float(np.sqrt(lo[i] * hi[i]))
+        p[contact_mod.param_index(e, "mu_s")] = 0.40
+        p[contact_mod.param_index(e, "mu_d")] = 0.35
+    return p
+
+
+# --------------------------------------------------------------------------------------
+# Approach (a): trajectory optimisation on fixed kinematics
+# --------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class TrajOptSpec:
+    """Approach (a): what to solve and how to search.
+
+    Parameters
+    ----------
+    speed_class, source : the data (:func:`gaitlib.data.load_gait_data`).
+    n_time : samples of the cycle, uniform on [0, T) (T the data's cycle time); Eq 4.5's
+        (1/t_f)∫ dt is their mean (exact for the periodic trigonometric polynomials the
+        kinematics are). The thesis sampled 101 points.
+    n_trial : Latin-hypercube trial points scored by the cost (+ a penalty on Eq 4.4).
+    n_local : local solves from the best-scoring trial points (after the one from x0).
+    seed : seed of the scatter (reproducible).
+    tol, max_iter : IPOPT settings of each local solve.
+    """
+
+    speed_class: str = "Free"
+    source: str = "schwartz2008"
+    n_time: int = 100
+    n_trial: int = 200
+    n_local: int = 10
+    seed: int = 0
+    tol: float = 1e-8
+    max_iter: int = 1000
+
+    def to_dict(self) -> dict:
+        return dataclasses.asdict(self)
+
+
+class InverseDynamicsID:
+    """The inverse-dynamics identification problem of approach (a) (Sec 4.3.1).
+
+    With the kinematics fixed to the data, for contact parameters p (39,) at each of the
+    ``n_time`` samples t_k: GRFs from the contact model, joint torques τ and pelvis residuals
+    R from inverse dynamics (:meth:`gaitlib.model.ChildModel.function` ``"inverse_dynamics"``)
+    with the default body parameters (Sec 4.1.1); the net joint torque (actuator + the
+    joints' spring–damper, what the data report) is compared with the data.
+
+    Cost Eq 4.5: ``J(p) = (1/N) Σ_k [¼ Σ_6 ((τ_net − τ_exp)/range)² + ¼ Σ_4 ((GRF − GRF_exp)/range)²]``
+    (ranges = max − min of the data; 6 = hip, knee, ankle of both legs; 4 = tangential and
+    normal force of both feet).
+
+    Scaled variables z ∈ [0, 1]³⁹ (:meth:`p_of_z`): p = lo + (hi − lo) z, except
+    k_v = lo (hi/lo)^z. Constraint Eq 4.4: μ_d − 0.55 μ_s ≥ 0 and 0.99 μ_s − μ_d ≥ 0 per
+    ellipsoid (linear in p).
+    """
+
+    def __init__(self, spec: TrajOptSpec = TrajOptSpec()):
+        self.spec = spec
+        self.model = ChildModel()
+        self.gait = data_mod.load_gait_data(spec.speed_class, spec.source)
+        self.ref = tr.reference(self.gait, self.model, contact_mod.default_params())
+        T = self.gait.cycle_time
+        N = spec.n_time
+        self.t = np.arange(N) * T / N
+        d = {c: self.ref.deriv[c](self.t) for c in cv.COORDS}
+        self.Q = np.array([d[c][0] for c in cv.COORDS])
+        self.QD = np.array([d[c][1] for c in cv.COORDS])
+        self.QDD = np.array([d[c][2] for c in cv.COORDS])
+        self.p_body = self.model.default_p_body()
+        g = self.gait
+        self.tau_data = np.array([np.interp(self.t, g.time, g.mean[f"tau_{j}"]) for j in tr.LEG_JOINTS])
+        self.grf_data = np.array([np.interp(self.t, g.time, g.mean[c]) for c in tr.GRF_CHANNELS])
+        self.tau_range = np.array([self.ref.ranges[f"tau_{j}"] for j in tr.LEG_JOINTS])
+        self.grf_range = np.array([self.ref.ranges[c] for c in tr.GRF_CHANNELS])
+        self.lo, self.hi = contact_mod.bounds()
+        self.log = np.zeros(39, bool)
+        for e in cv.ELLIPSOIDS:
+            self.log[contact_mod.param_index(e, "k_v")] = True
+
+    # ---- scaling
+    def p_of_z(self, z):
+        """Parameters (SI) of scaled variables z (numpy or CasADi)."""
+        lo, hi = self.lo, self.hi
+        llo, lhi = np.log(np.where(self.log, lo, 1.0)), np.log(np.where(self.log, hi, 1.0))
+        if isinstance(z, (ca.SX, ca.MX)):
+            lin = ca.DM(lo) + ca.DM(hi - lo) * z
+            ex = ca.exp(ca.DM(llo) + ca.DM(lhi - llo) * z)
+            return ca.vertcat(*[ex[i] if self.log[i] else lin[i] for i in range(39)])
+        z = np.asarray(z, float)
+        return np.where(self.log, np.exp(llo + (lhi - llo) * z), lo + (hi - lo) * z)
+
+    def z_of_p(self, p) -> np.ndarray:
+        """Scaled variables of parameters p (SI)."""
+        p = np.asarray(p, float)
+        lo, hi = self.lo, self.hi
+        z = (p - lo) / (hi - lo)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            zl = np.log(p / lo) / np.log(hi / lo)
+        return np.where(self.log, zl, z)
+
+    # ---- symbolic functions
+    @cached_property
+    def _expressions(self) -> dict:
+        N = self.spec.n_time
+        p = ca.SX.sym("p", 39)
+        P = ca.repmat(p, 1, N)
+        f_id = self.model.function("inverse_dynamics").map(N)
+        f_ct = self.model.function("contact").map(N)
+        f_pas = self.model.function("passive").map(N)
+        tau, R = f_id(self.Q, self.QD, self.QDD, self.p_body, P)
+        ct = dict(zip(self.model.function("contact").name_out(), f_ct(self.Q, self.QD, P)))
+        grf = ca.vertcat(ct["grf_x"][0, :], ct["grf_y"][0, :], ct["grf_x"][1, :], ct["grf_y"][1, :])
+        net = tau + f_pas(self.Q, self.QD, self.p_body)
+        rows = [cv.JOINTS.index(j) for j in tr.LEG_JOINTS]
+        e_tau = (net[rows, :] - ca.DM(self.tau_data)) / ca.repmat(ca.DM(self.tau_range), 1, N)
+        e_grf = (grf - ca.DM(self.grf_data)) / ca.repmat(ca.DM(self.grf_range), 1, N)
+        j_trq = ca.sumsqr(e_tau) / N
+        j_grf = ca.sumsqr(e_grf) / N
+        return {"p": p, "J": 0.25 * j_trq + 0.25 * j_grf, "Trq": j_trq, "GRF": j_grf, "net": net, "R": R,
+                "grf": grf, "fn": ct["fn"], "fx": ct["fx"], "fn_raw": ct["fn_raw"]}
+
+    @cached_property
+    def cost_function(self) -> ca.Function:
+        """p (39,) SI → J (Eq 4.5), Trq and GRF (the unweighted mean squared normalised errors)."""
+        E = self._expressions
+        return ca.Function("eq4_5", [E["p"]], [E["J"], E["Trq"], E["GRF"]], ["p"], ["J", "Trq", "GRF"])
+
+    @cached_property
+    def gradient_function(self) -> ca.Function:
+        """p (39,) SI → dJ/dp (39,), exact (algorithmic differentiation)."""
+        E = self._expressions
+        return ca.Function("eq4_5_grad", [E["p"]], [ca.gradient(E["J"], E["p"])], ["p"], ["dJdp"])
+
+    @cached_property
+    def frames_function(self) -> ca.Function:
+        E = self._expressions
+        return ca.Function("frames", [E["p"]], [E["net"], E["R"], E["grf"], E["fn"], E["fx"], E["fn_raw"]],
+                           ["p"], ["tau_net", "R", "grf", "fn", "fx", "fn_raw"])
+
+    def cost(self, p) -> float:
+        """Eq 4.5 at p (SI)."""
+        return float(self.cost_function(np.asarray(p, float))[0])
+
+    def ratio_violation(self, p) -> float:
+        """Total violation of Eq 4.4 at p (0 when satisfied)."""
+        p = np.asarray(p, float)
+        v = 0.0
+        for e in cv.ELLIPSOIDS:
+            ms, md = p[contact_mod.param_index(e, "mu_s")], p[contact_mod.param_index(e, "mu_d")]
+            v += max(0.0, MU_RATIO[0] * ms - md) + max(0.0, md - MU_RATIO[1] * ms)
+        return v
+
+    @cached_property
+    def solver(self) -> ca.Function:
+        """IPOPT on z ∈ [0, 1]³⁹ with the Eq 4.4 constraints (exact Hessian)."""
+        z = ca.SX.sym("z", 39)
+        p = self.p_of_z(z)
+        J = ca.substitute(self._expressions["J"], self._expressions["p"], p)
+        g = []
+        for e in cv.ELLIPSOIDS:
+            ms, md = p[contact_mod.param_index(e, "mu_s")], p[contact_mod.param_index(e, "mu_d")]
+            g += [md - MU_RATIO[0] * ms, MU_RATIO[1] * ms - md]
+        opts = {"ipopt": {"tol": self.spec.tol, "max_iter": self.spec.max_iter, "print_level": 0, "sb": "yes",
+                          "mu_strategy": "monotone", "linear_solver": "mumps"},
+                "print_time": False, "error_on_fail": False}
+        return ca.nlpsol("traj_opt", "ipopt", {"x": z, "f": J, "g": ca.vertcat(*g)}, opts)
+
+    def local_solve(self, p0) -> dict:
+        """One local solve from p0 (SI, clipped into the bounds): p, cost, status, iterations, s."""
+        z0 = np.clip(self.z_of_p(np.clip(p0, self.lo, self.hi)), 0.0, 1.0)
+        t0 = time.perf_counter()
+        r = self.solver(x0=z0, lbx=0.0, ubx=1.0, lbg=0.0, ubg=np.inf)
+        dt = time.perf_counter() - t0
+        st = self.solver.stats()
+        p = self.p_of_z(np.clip(np.asarray(r["x"]).ravel(), 0.0, 1.0))
+        return {"p": p, "cost": self.cost(p), "status": str(st["return_status"]), "success": bool(st["success"]),
+                "iterations": int(st["iter_count"]), "time_s": dt, "ratio_violation": self.ratio_violation(p)}
+
+    def scatter(self) -> np.ndarray:
+        """The seeded Latin-hypercube trial points (n_trial, 39), SI. The μ_d coordinate is
+        sampled as the ratio μ_d/μ_s within Eq 4.4's bounds (then clipped to μ_d's box), so
+        that trial points respect Eq 4.4 where the box allows."""
+        from scipy.stats import qmc
+
+        U = qmc.LatinHypercube(d=39, seed=self.spec.seed).random(self.spec.n_trial)
+        P = np.array([self.p_of_z(u) for u in U])
+        for e in cv.ELLIPSOIDS:
+            i_s, i_d = contact_mod.param_index(e, "mu_s"), contact_mod.param_index(e, "mu_d")
+            ratio = MU_RATIO[0] + (MU_RATIO[1] - MU_RATIO[0]) * U[:, i_d]
+            P[:, i_d] = np.clip(ratio * P[:, i_s], self.lo[i_d], self.hi[i_d])
+        return P
+
+    def score(self, p) -> float:
+        """GlobalSearch-style score: cost + 1000 × Eq 4.4 violation."""
+        return self.cost(p) + 1e3 * self.ratio_violation(p)
+
+    def frames(self, p) -> dict:
+        """Frames at p (SI): ``q``, ``torques`` (8 net), ``residuals``, ``grf``, ``ellipsoids``."""
+        from ..model import ELLIPSOID_LABELS
+
+        out = self.frames_function(np.asarray(p, float))
+        idx = pd.Index(self.t, name="time")
+        net, R, grf, fn, fx = (np.asarray(v) for v in out[:5])
+        q = pd.DataFrame(self.Q.T, index=idx, columns=list(cv.COORDS))
+        torques = pd.DataFrame(net.T, index=idx, columns=list(cv.JOINTS))
+        residuals = pd.DataFrame(R.T, index=idx, columns=list(cv.RESIDUALS))
+        grf_f = pd.DataFrame(grf.T, index=idx, columns=list(tr.GRF_CHANNELS))
+        ell = {}
+        for i, lab in enumerate(ELLIPSOID_LABELS):
+            ell[f"fn_{lab}"] = fn[i]
+            ell[f"fx_{lab}"] = fx[i]
+        return {"q": q, "torques": torques, "residuals": residuals, "grf": grf_f,
+                "ellipsoids": pd.DataFrame(ell, index=idx)}
+
+
+# --------------------------------------------------------------------------------------
+# Results
+# --------------------------------------------------------------------------------------
+
+
+@dataclass(eq=False)
+class ApproachResult:
+    """One identification: parameters, frames on the data's channels, RMSEs, solver stats.
+
+    Attributes
+    ----------
+    key : ``"a"``, ``"b"`` or ``"c"`` (:data:`APPROACHES`).
+    p_contact : (39,) identified contact parameters, SI (left foot).
+    p_body : (25,) body/joint parameters used or identified, SI.
+    q, torques, residuals, grf, ellipsoids : frames indexed by time (s): coordinates,
+        net joint torques (N·m), pelvis residual loads (N, N, N·m), foot forces (N),
+        per-ellipsoid normal and friction forces (N).
+    rmse : RMSE per channel (format of :attr:`gaitlib.transcription.GaitSolution.rmse`).
+    stats : ``status``, ``success``, ``iterations``, ``wall_s`` (build + solve),
+        ``solve_s``, ``time_per_iteration_s``, ``objective``, ``eq4_5`` (the Eq 4.5 part:
+        ¼ Trq + ¼ GRF), ``from_cache``; (a) also ``n_local``, ``n_trial``, ``best_start``.
+    solution : the :class:`~gaitlib.transcription.GaitSolution` of (b)/(c), else None.
+    starts : (a) one row per local solve (start, score at start, cost, status, iterations, s).
+    """
+
+    key: str
+    p_contact: np.ndarray
+    p_body: np.ndarray
+    q: pd.DataFrame
+    torques: pd.DataFrame
+    residuals: pd.DataFrame
+    grf: pd.DataFrame
+    ellipsoids: pd.DataFrame
+    rmse: pd.DataFrame
+    stats: dict
+    solution: tr.GaitSolution | None = None
+    starts: pd.DataFrame | None = None
+
+    @property
+    def label(self) -> str:
+        return APPROACHES[self.key]
+
+    @property
+    def success(self) -> bool:
+        return bool(self.stats["success"])
+
+    def channels(self) -> pd.DataFrame:
+        """Angles, net torques and foot forces on the data's channel names (as
+        :func:`gaitlib.studies.gait.channels_frame`) for :func:`gaitlib.plots.tracking_figure`."""
+        out = pd.DataFrame(index=self.q.index)
+        for c in cv.JOINTS:
+            out[c] = self.q[c]
+            out[f"tau_{c}"] = self.torques[c]
+        for g in tr.GRF_CHANNELS:
+            out[g] = self.grf[g]
+        return out
+
+
+def _result_from_gait(key: str, sol: tr.GaitSolution) -> ApproachResult:
+    gp_spec = sol.spec
+    pars = sol.solution.parameters
+    pc = np.array([pars[f"c.{n}"] for n in contact_mod.param_names()])
+    pb = (np.array([pars[f"b.{n}"] for n in P_BODY_NAMES]) if gp_spec.free_body
+          else params_mod.body_params(gp_spec.body_params))
+    st = sol.stats
+    goals = sol.solution.goals.set_index("goal")["value"]
+    stats = {"status": st["status"], "success": bool(st["success"]), "iterations": int(st["iterations"]),
+             "solve_s": float(st["solve_time_s"]), "build_s": float(st["build_time_s"]),
+             "wall_s": float(st["solve_time_s"]) + float(st["build_time_s"]),
+             "time_per_iteration_s": float(st["time_per_iteration_s"]), "objective": float(st["objective"]),
+             "eq4_5": 0.25 * float(goals.get("Trq", np.nan)) + 0.25 * float(goals.get("GRF", np.nan)),
+             "max_violation": float(st["max_violation"]), "n_variables": st["n_variables"],
+             "n_constraints": st["n_constraints"], "from_cache": bool(st.get("from_cache", False)),
+             "goals": {k: float(v) for k, v in goals.items()}}
+    return ApproachResult(key, pc, pb, sol.q, sol.torques, sol.residuals, sol.grf, sol.ellipsoids, sol.rmse,
+                          stats, solution=sol)
+
+
+def _cache_dir(kind: str, desc: dict, root, modules) -> Path:
+    return cache.lookup(kind, desc, root, modules=modules)
+
+
+def trajectory_optimization(spec: TrajOptSpec = TrajOptSpec(), *, use_cache: bool = True, root=None,
+                            problem: InverseDynamicsID | None = None) -> ApproachResult:
+    """Approach (a): multistart identification on fixed kinematics (Sec 4.3.1; class docs).
+
+    Search (GlobalSearch in spirit): stage 1, a local solve from :func:`neutral_start`;
+    stage 2, the ``n_local`` best-scoring of ``n_trial`` Latin-hypercube trial points
+    (score = cost + 1000 × Eq 4.4 violation) as starts of further local solves. The result
+    is the lowest-cost converged local solution. Cached on the spec and this module's code.
+    """
+    desc = {"kind": "contact_id_a", **spec.to_dict()}
+    where = _cache_dir("contact_id", desc, root, modules=None)
+    prob = problem
+    f = where / "result.json"
+    if use_cache and f.exists():
+        rec = json.loads(f.read_text())
+        prob = prob or InverseDynamicsID(spec)
+        return _result_a(prob, rec, from_cache=True)
+    prob = prob or InverseDynamicsID(spec)
+    t_wall = time.perf_counter()
+    t0 = time.perf_counter()
+    _ = prob.solver  # symbolic Hessian, IPOPT set-up
+    build_s = time.perf_counter() - t0
+    starts = [("x0 (neutral)", neutral_start())]
+    trial = prob.scatter()
+    scores = np.array([prob.score(p) for p in trial])
+    order = np.argsort(scores, kind="stable")[:spec.n_local]
+    starts += [(f"scatter #{int(i)}", trial[i]) for i in order]
+    rows = []
+    for name, p0 in starts:
+        r = prob.local_solve(p0)
+        rows.append({"start": name, "score at start": prob.score(np.clip(p0, prob.lo, prob.hi)),
+                     "cost": r["cost"], "status": r["status"], "success": r["success"],
+                     "iterations": r["iterations"], "time (s)": r["time_s"],
+                     "Eq 4.4 violation": r["ratio_violation"], "p": [float(v) for v in r["p"]]})
+    rec = {"rows": rows, "build_s": build_s, "wall_s": time.perf_counter() - t_wall,
+           "trial_scores": [float(s) for s in scores], "spec": spec.to_dict()}
+    if use_cache:
+        where.mkdir(parents=True, exist_ok=True)
+        f.write_text(json.dumps(rec, indent=1))
+    return _result_a(prob, rec, from_cache=False)
+
+
+def _result_a(prob: InverseDynamicsID, rec: dict, from_cache: bool) -> ApproachResult:
+    rows = rec["rows"]
+    ok = [i for i, r in enumerate(rows) if r["success"] and r["Eq 4.4 violation"] <= 1e-6]
+    pool = ok if ok else list(range(len(rows)))
+    best = min(pool, key=lambda i: rows[i]["cost"])
+    p = np.array(rows[best]["p"])
+    fr = prob.frames(p)
+    rmse = tr._rmse_table(fr["q"], fr["torques"], fr["grf"], prob.ref)
+    c = prob.cost_function(p)
+    its = int(sum(r["iterations"] for r in rows))
+    solve_s = float(sum(r["time (s)"] for r in rows))
+    stats = {"status": rows[best]["status"], "success": bool(ok), "iterations": its,
+             "iterations_best": int(rows[best]["iterations"]), "solve_s": solve_s, "build_s": rec["build_s"],
+             "wall_s": rec["wall_s"], "time_per_iteration_s": solve_s / max(its, 1),
+             "objective": float(c[0]), "eq4_5": float(c[0]), "goals": {"Trq": float(c[1]), "GRF": float(c[2])},
+             "n_local": len(rows), "n_converged": len(ok), "n_trial": len(rec["trial_scores"]),
+             "best_start": rows[best]["start"], "from_cache": from_cache, "max_violation": rows[best]["Eq 4.4 violation"]}
+    starts = pd.DataFrame([{k: v for k, v in r.items() if k != "p"} for r in rows])
+    return ApproachResult("a", p, prob.p_body.copy(), fr["q"], fr["torques"], fr["residuals"], fr["grf"],
+                          fr["ellipsoids"], rmse, stats, starts=starts)
+
+
+def spec_b(n_intervals: int = 20, degree: int = 5, **kw) -> tr.GaitSpec:
+    """Approach (b): SK, Eq 4.11 (Table 4.8 weights), 39 contact parameters free within
+    Table 4.7 verbatim and Eq 4.4; Eq 4.8 residual bounds; thesis mesh 20 × 5 LGR."""
+    return tr.GaitSpec(model="SK", cost="Eq4.11", free_contact=True, contact_bounds="table4.7",
+                       n_intervals=n_intervals, degree=degree, **kw)
+
+
+def spec_c(n_intervals: int = 20, degree: int = 5, **kw) -> tr.GaitSpec:
+    """Approach (c): (b) + the 25 body/joint parameters free (Table 4.14), per-ellipsoid
+    normal force ≥ 0 (Sec 4.4.1), cost Eq 4.13 (Eq 4.11 + Imp Eq 4.12 + Rsd Eq 4.13,
+    w5 = w6 = 1/4)."""
+    return tr.GaitSpec(model="SK", cost="Eq4.13", free_contact=True, free_body=True,
+                       normal_force_constraint=True, contact_bounds="table4.7",
+                       n_intervals=n_intervals, degree=degree, **kw)
+
+
+def _solve_gait_cached(spec: tr.GaitSpec, start: dict, warm: tr.GaitSolution | None, use_cache: bool, root,
+                       progress: bool = False) -> tr.GaitSolution:
+    """Solve ``spec`` from the data-based guess with the parameters ``start`` (name → value)
+    or warm-started from ``warm``; cached on spec + start + warm start's identity + code."""
+    desc = {"kind": "contact_id_gait", **spec.to_dict(),
+            "start": {k: float(np.format_float_positional(v, 12)) for k, v in sorted(start.items())}}
+    if warm is not None:
+        ws = warm.solution
+        desc["warm_start"] = {"spec": warm.spec.to_dict(), "status": ws.status,
+                              "objective": float(f"{ws.objective:.12g}"), "iterations": ws.iterations}
+    where = _cache_dir("contact_id", desc, root, modules=())
+    if use_cache and (where / "spec.json").exists():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ocp.SolveFailedWarning)
+            sol = tr.GaitSolution.load(where)
+        sol.stats["from_cache"] = True
+        return sol
+    gp = tr.build(spec)
+    if warm is not None:
+        g = tr.warm_start(gp, warm)
+        guess = ocp.Guess(phases=g.phases, parameters={**dict(g.parameters), **start})
+    else:
+        guess = ocp.Guess(phases=gp.guess.phases, parameters=dict(start))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ocp.SolveFailedWarning)
+        sol = tr.solve(gp, guess=guess, progress=progress)
+    if use_cache:
+        sol.save(where)
+    sol.stats["from_cache"] = False
+    return sol
+
+
+def optimal_control(spec: tr.GaitSpec | None = None, start=None, *, use_cache: bool = True, root=None,
+                    progress: bool = False) -> ApproachResult:
+    """Approach (b) (Sec 4.3.2): :func:`spec_b` from the data-based guess (Sec 4.3.2) with
+    the contact parameters starting at ``start`` (39,) SI (default :func:`neutral_start`)."""
+    spec = spec or spec_b()
+    p0 = neutral_start() if start is None else np.asarray(start, float)
+    st = {f"c.{n}": float(v) for n, v in zip(contact_mod.param_names(), p0)}
+    return _result_from_gait("b", _solve_gait_cached(spec, st, None, use_cache, root, progress))
+
+
+def optimal_control_body(spec: tr.GaitSpec | None = None, warm: ApproachResult | None = None, start=None, *,
+                         use_cache: bool = True, root=None, progress: bool = False) -> ApproachResult:
+    """Approach (c) (Sec 4.4): :func:`spec_c`, warm-started from (b)'s solution ``warm``
+    (states, controls, contact parameters; body parameters from their Sec 4.1.1 values), or
+    — without ``warm`` — from the data-based guess with contact parameters ``start``
+    (default :func:`neutral_start`)."""
+    spec = spec or spec_c()
+    if warm is not None:
+        if warm.solution is None:
+            raise ValueError("optimal_control_body: warm must be an optimal-control result ((b))")
+        sol = _solve_gait_cached(spec, {}, warm.solution, use_cache, root, progress)
+    else:
+        p0 = neutral_start() if start is None else np.asarray(start, float)
+        st = {f"c.{n}": float(v) for n, v in zip(contact_mod.param_names(), p0)}
+        sol = _solve_gait_cached(spec, st, None, use_cache, root, progress)
+    return _result_from_gait("c", sol)
+
+
+def run_all(n_intervals: int = 20, degree: int = 5, traj: TrajOptSpec = TrajOptSpec(), *, use_cache: bool = True,
+            root=None, progress: bool = False) -> dict[str, ApproachResult]:
+    """The chapter's three identifications: ``{"a": …, "b": …, "c": …}`` ((c) warm-started
+    from (b))."""
+    a = trajectory_optimization(traj, use_cache=use_cache, root=root)
+    b = optimal_control(spec_b(n_intervals, degree), use_cache=use_cache, root=root, progress=progress)
+    c = optimal_control_body(spec_c(n_intervals, degree), warm=b, use_cache=use_cache, root=root, progress=progress)
+    return {"a": a, "b": b, "c": c}
+
+
+# --------------------------------------------------------------------------------------
+# Tables
+# --------------------------------------------------------------------------------------
+
+
+def residual_rms(res: ApproachResult) -> dict:
+    """RMS of the pelvis residual loads over the cycle (R_x, R_y N; R_z N·m)."""
+    return {r: float(np.sqrt(np.mean(res.residuals[r].to_numpy() ** 2))) for r in cv.RESIDUALS}
+
+
+def rmse_table(results: dict[str, ApproachResult]) -> pd.DataFrame:
+    """Tidy RMSE table: approach, quantity (``tau_hip``, ``grf_x``, ``R_x`` …), side, unit,
+    ours, thesis (labelled source)."""
+    rows = []
+    for k, res in results.items():
+        th = THESIS_RMSE.get(k, {})
+        for _, r in res.rmse.iterrows():
+            if r["kind"] == "angle":
+                continue
+            ch = r["channel"]
+            side = ch[-1]
+            qty = ("tau_" + ch.rsplit("_", 1)[0]) if r["kind"] == "torque" else ch[:-2]
+            rows.append({"approach": k, "quantity": qty, "side": side, "unit": r["unit"], "ours": r["rmse"],
+                         "thesis": th.get((qty, side), np.nan), "thesis source": THESIS_RMSE_SOURCE[k]})
+        for r, v in residual_rms(res).items():
+            qty = {"pelvis_fx": "R_x", "pelvis_fy": "R_y", "pelvis_mz": "R_z"}.get(r, r)
+            rows.append({"approach": k, "quantity": qty, "side": "", "unit": "N·m" if qty == "R_z" else "N",
+                         "ours": v, "thesis": th.get((qty, ""), np.nan), "thesis source": THESIS_RMSE_SOURCE[k]})
+    return pd.DataFrame(rows)
+
+
+def rmse_beside_thesis(results: dict[str, ApproachResult]) -> pd.DataFrame:
+    """Table 4.9 layout: one row per approach and source (ours / thesis), one column per
+    quantity and side (torques N·m, GRFs N, residuals N, N·m)."""
+    t = rmse_table(results)
+    t["column"] = t["quantity"] + np.where(t["side"] != "", " " + t["side"].str.upper(), "")
+    cols = list(dict.fromkeys(t["column"]))
+    ours = t.pivot(index="approach", columns="column", values="ours")[cols]
+    ours.index = [f"{APPROACHES[k]} — ours" for k in ours.index]
+    th = t.pivot(index="approach", columns="column", values="thesis")[cols]
+    th.index = [f"{APPROACHES[k]} — {THESIS_RMSE_SOURCE[k]}" for k in th.index]
+    out = pd.concat([ours, th]).sort_index(key=lambda s: s.str[:3], kind="stable")
+    return out
+
+
+def grf_fit(results: dict[str, ApproachResult]) -> pd.DataFrame:
+    """How well each approach fits the GRFs: RMSE per foot force (N), their mean, and the
+    GRF term of Eq 4.5 (mean squared range-normalised error)."""
+    rows = []
+    for k, res in results.items():
+        r = res.rmse.set_index("channel")["rmse"]
+        row = {"approach": APPROACHES[k]}
+        for g in tr.GRF_CHANNELS:
+            row[f"{g} (N)"] = float(r[g])
+        row["mean GRF RMSE (N)"] = float(np.mean([r[g] for g in tr.GRF_CHANNELS]))
+        row["GRF term (Eq 4.5, unweighted)"] = res.stats["goals"].get("GRF", np.nan)
+        rows.append(row)
+    return pd.DataFrame(rows).set_index("approach")
+
+
+def solver_table(results: dict[str, ApproachResult]) -> pd.DataFrame:
+    """Status, iterations, wall time and time per iteration of each approach beside the
+    thesis's compute times (different machine and software: labelled)."""
+    rows = []
+    for k, res in results.items():
+        s = res.stats
+        rows.append({"approach": APPROACHES[k], "status": s["status"], "iterations": s["iterations"],
+                     "build (s)": s["build_s"], "solve (s)": s["solve_s"], "wall (s)": s["wall_s"],
+                     "ms / iteration": 1e3 * s["time_per_iteration_s"], "objective": s["objective"],
+                     "Eq 4.5 part": s["eq4_5"], "from cache": s["from_cache"],
+                     "thesis time": THESIS_TIME[k]})
+    return pd.DataFrame(rows).set_index("approach")
+
+
+def geometry_table(results: dict[str, ApproachResult]) -> pd.DataFrame:
+    """Tables 4.10 / 4.11 / 4.17: left-foot ellipsoid geometry (mm, deg), ours beside the
+    thesis's, rows (approach, ellipsoid, source)."""
+    rows = []
+    for k, res in results.items():
+        for e in cv.ELLIPSOIDS:
+            ours = {f"{n} ({u})": res.p_contact[contact_mod.param_index(e, n)] * _table_scale(n)
+                    for n, u in zip(_GEOM, _GEOM_UNIT)}
+            rows.append({"approach": APPROACHES[k], "ellipsoid": e, "source": "ours", **ours})
+            th = dict(zip([f"{n} ({u})" for n, u in zip(_GEOM, _GEOM_UNIT)], THESIS_GEOMETRY[k][e]))
+            rows.append({"approach": APPROACHES[k], "ellipsoid": e, "source": THESIS_GEOMETRY_SOURCE[k], **th})
+    return pd.DataFrame(rows).set_index(["approach", "ellipsoid", "source"])
+
+
+def contact_table(results: dict[str, ApproachResult]) -> pd.DataFrame:
+    """Tables 4.12 / 4.13 / 4.18: k_v, a_v, μ_s, μ_d per ellipsoid, ours beside the thesis's."""
+    rows = []
+    for k, res in results.items():
+        for e in cv.ELLIPSOIDS:
+            ours = {f"{n} ({u})" if u != "-" else n: res.p_contact[contact_mod.param_index(e, n)]
+                    for n, u in zip(_FRIC, _FRIC_UNIT)}
+            rows.append({"approach": APPROACHES[k], "ellipsoid": e, "source": "ours", **ours})
+            th = dict(zip([f"{n} ({u})" if u != "-" else n for n, u in zip(_FRIC, _FRIC_UNIT)], THESIS_CONTACT[k][e]))
+            rows.append({"approach": APPROACHES[k], "ellipsoid": e, "source": THESIS_CONTACT_SOURCE[k], **th})
+    return pd.DataFrame(rows).set_index(["approach", "ellipsoid", "source"])
+
+
+def body_table(res: ApproachResult) -> pd.DataFrame:
+    """Tables 4.15 / 4.16: the 25 body/joint parameters — initial (Sec 4.1.1, ours), ours
+    identified, Table 4.14 bounds, and the thesis's initial/tuned values (Tables 4.15–4.16;
+    the thesis does not report the HAT COM, which is not identified)."""
+    m = ChildModel()
+    p0 = m.default_p_body()
+    lo, hi = m.p_body_bounds()
+    th = m.p_body_identified()
+    th_init = _thesis_body_initial()
+    rows = []
+    for i, (n, u) in enumerate(zip(P_BODY_NAMES, P_BODY_UNITS)):
+        rows.append({"parameter": n, "unit": u.replace(" ", "·"), "initial (Sec 4.1.1)": p0[i],
+                     "ours identified": res.p_body[i], "lower (Table 4.14)": lo[i], "upper (Table 4.14)": hi[i],
+                     "thesis initial (Tables 4.15–4.16)": th_init[i], "thesis tuned (Tables 4.15–4.16)": th[i]})
+    return pd.DataFrame(rows).set_index("parameter")
+
+
+def _thesis_body_initial() -> np.ndarray:
+    """Thesis Tables 4.15–4.16 'initial' rows, as printed (COMs in mm → m)."""
+    return np.array([28.1, 4.14, 1.93, 0.0858, 0.257, 0.257,
+                     1.24, 0.0494, 0.0230, 0.32e-4, 4e-4, 4e-4,
+                     0.1559, 0.1566, 0.0316, 0.0477, 0.0320,
+                     2.89, 1.59, 6.039, 6.039,
+                     3e-4, 2.98, 3.68, 3.68])
+
+
+def at_bounds(res: ApproachResult, rtol: float = 1e-3) -> pd.DataFrame:
+    """Identified parameters within ``rtol`` × (box width) of a bound (contact: Table 4.7;
+    body: Table 4.14)."""
+    rows = []
+    lo, hi = contact_mod.bounds()
+    for i, n in enumerate(contact_mod.param_names()):
+        w = hi[i] - lo[i]
+        v = res.p_contact[i]
+        for side, b in (("lower", lo[i]), ("upper", hi[i])):
+            if abs(v - b) <= rtol * w:
+                rows.append({"parameter": n, "bound": side, "value (SI)": v})
+    if res.key == "c":
+        m = ChildModel()
+        blo, bhi = m.p_body_bounds()
+        for i, n in enumerate(P_BODY_NAMES):
+            w = bhi[i] - blo[i]
+            for side, b in (("lower", blo[i]), ("upper", bhi[i])):
+                if abs(res.p_body[i] - b) <= rtol * w:
+                    rows.append({"parameter": n, "bound": side, "value (SI)": res.p_body[i]})
+    return pd.DataFrame(rows, columns=["parameter", "bound", "value (SI)"])
+
+
+def friction_ratios(results: dict[str, ApproachResult]) -> pd.DataFrame:
+    """μ_d / μ_s per ellipsoid and approach (Eq 4.4: within [0.55, 0.99])."""
+    return pd.DataFrame({APPROACHES[k]: {e: r.p_contact[contact_mod.param_index(e, "mu_d")]
+                                        / r.p_contact[contact_mod.param_index(e, "mu_s")] for e in cv.ELLIPSOIDS}
+                         for k, r in results.items()})
+
+
+# --------------------------------------------------------------------------------------
+# Identified parameters for later chapters
+# --------------------------------------------------------------------------------------
+
+
+def save_identified(res: ApproachResult, path=None) -> Path:
+    """Write (c)'s identified parameters with their provenance (:mod:`gaitlib.params` format).
+
+    Refuses a result that did not converge (IPOPT status other than Solve_Succeeded).
+    ``path`` default: :func:`gaitlib.params.identified_path` (``data/identified/ch4_child.json``).
+    Note: data JSON files are part of the solution-cache fingerprint, so writing this file
+    makes every stored solution unreachable (they are recomputed on next use).
+    """
+    if res.key != "c" or res.solution is None:
+        raise ValueError("save_identified: expects the approach (c) result")
+    if not res.success:
+        raise ValueError(f"save_identified: approach (c) did not converge ({res.stats['status']}); not saving")
+    path = Path(path) if path is not None else params_mod.identified_path("ch4_child")
+    m = ChildModel()
+    clo, chi = contact_mod.bounds()
+    blo, bhi = m.p_body_bounds()
+    st = res.stats
+    out = {
+        "name": "ch4_child",
+        "description": ("Contact (39, left foot) and body/joint (25) parameters identified by approach (c) of "
+                        "thesis Sec 4.4 (optimal control, Eq 4.13, per-ellipsoid normal force >= 0, Table 4.7 and "
+                        "Table 4.14 bounds) on the Schwartz 2008 Free-speed data, both legs."),
+        "p_contact": {n: float(v) for n, v in zip(contact_mod.param_names(), res.p_contact)},
+        "p_body": {n: float(v) for n, v in zip(P_BODY_NAMES, res.p_body)},
+        "units": {"p_contact": {n: u for n, u in zip(contact_mod.param_names(),
+                                                     contact_mod.PARAM_UNITS * len(cv.ELLIPSOIDS))},
+                  "p_body": dict(zip(P_BODY_NAMES, P_BODY_UNITS))},
+        "bounds": {"p_contact": {n: [float(a), float(b)] for n, a, b in zip(contact_mod.param_names(), clo, chi)},
+                   "p_body": {n: [float(a), float(b)] for n, a, b in zip(P_BODY_NAMES, blo, bhi)}},
+        "provenance": {
+            "study": "gaitlib.studies.contact_id.optimal_control_body (warm start: approach (b))",
+            "spec": res.solution.spec.to_dict(),
+            "gaitlib_version": __version__,
+            "cache_fingerprint": cache.fingerprint(),
+            "spec_key": res.solution.stats.get("spec_key"),
+            "ipopt_status": st["status"],
+            "iterations": st["iterations"],
+            "objective": st["objective"],
+            "solve_time_s": st["solve_s"],
+            "date": _dt.date.today().isoformat(),
+        },
+    }
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(out, indent=1) + "\n")
+    return path
+
+
+def identified_vs_result(res: ApproachResult, name: str = "ch4_child") -> dict:
+    """Compare the stored identified set with a (c) result: max relative difference of the
+    contact and body parameters (relative to each parameter's bound width) and the stored
+    provenance."""
+    stored = params_mod.load_identified(name)
+    m = ChildModel()
+    clo, chi = contact_mod.bounds()
+    blo, bhi = m.p_body_bounds()
+    dc = np.max(np.abs(stored["p_contact"] - res.p_contact) / (chi - clo))
+    db = np.max(np.abs(stored["p_body"] - res.p_body) / np.maximum(bhi - blo, 1e-12))
+    return {"max_rel_diff_contact": float(dc), "max_rel_diff_body": float(db), "provenance": stored["provenance"],
+            "path": str(stored["path"])}

@@ -1,0 +1,185 @@
+"""Ch 4 contact identification study (gaitlib.studies.contact_id): approach (a)'s problem
+and multistart, the (b)/(c) specs, and the identified-parameter file round trip."""
+
+import json
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from gaitlib import cache, contact, params
+from gaitlib import conventions as cv
+from gaitlib import transcription as tr
+from gaitlib.model import P_BODY_NAMES, ChildModel
+from gaitlib.studies import contact_id as ci
+
+
+@pytest.fixture(scope="module")
+def small():
+    """Approach (a)'s problem on a coarse time grid (20 samples), a small search."""
+    return ci.InverseDynamicsID(ci.TrajOptSpec(n_time=20, n_trial=24, n_local=2, seed=3))
+
+
+def test_scaling_round_trip_and_log_kv(small):
+    lo, hi = contact.bounds()
+    p = ci.neutral_start()
+    z = small.z_of_p(p)
+    assert np.all((z >= 0) & (z <= 1))
+    np.testing.assert_allclose(small.p_of_z(z), p, rtol=1e-12)
+    np.testing.assert_allclose(small.p_of_z(np.zeros(39)), lo)
+    np.testing.assert_allclose(small.p_of_z(np.ones(39)), hi)
+    i = contact.param_index("ball", "k_v")
+    # geometric centre of the k_v box at z = 1/2 (log scaling)
+    assert small.p_of_z(np.full(39, 0.5))[i] == pytest.approx(np.sqrt(lo[i] * hi[i]))
+
+
+def test_neutral_start_inside_table_4_7_and_eq_4_4():
+    lo, hi = contact.bounds()
+    p = ci.neutral_start()
+    assert np.all(p >= lo) and np.all(p <= hi)
+    for e in cv.ELLIPSOIDS:
+        r = p[contact.param_index(e, "mu_d")] / p[contact.param_index(e, "mu_s")]
+        assert ci.MU_RATIO[0] <= r <= ci.MU_RATIO[1]
+
+
+def test_eq_4_5_gradient_matches_finite_differences(small):
+    """Exact gradient (AD) of the Eq 4.5 cost vs central differences at the neutral start."""
+    p = ci.neutral_start()
+    g = np.asarray(small.gradient_function(p)).ravel()
+    lo, hi = contact.bounds()
+    fd = np.zeros(39)
+    for i in range(39):
+        h = 1e-6 * (hi[i] - lo[i])
+        e = np.zeros(39)
+        e[i] = h
+        fd[i] = (small.cost(p + e) - small.cost(p - e)) / (2 * h)
+    scale = np.abs(g) * (hi - lo)  # sensitivity over the box, comparable across units
+    big = scale > 1e-6 * scale.max()
+    np.testing.assert_allclose(g[big] * (hi - lo)[big], fd[big] * (hi - lo)[big], rtol=1e-4,
+                               atol=1e-7 * scale.max())
+
+
+def test_eq_4_5_is_zero_for_data_and_positive_otherwise(small):
+    """The cost is the mean of squared range-normalised errors: J = ¼ Trq + ¼ GRF, J ≥ 0."""
+    J, trq, grf = (float(v) for v in small.cost_function(ci.neutral_start()))
+    assert J == pytest.approx(0.25 * trq + 0.25 * grf)
+    assert trq > 0 and grf > 0
+
+
+def test_scatter_is_seeded_and_respects_eq_4_4_where_possible(small):
+    A, B = small.scatter(), small.scatter()
+    np.testing.assert_array_equal(A, B)
+    assert A.shape == (24, 39)
+    lo, hi = contact.bounds()
+    assert np.all(A >= lo - 1e-12) and np.all(A <= hi + 1e-12)
+    other = ci.InverseDynamicsID(ci.TrajOptSpec(n_time=20, n_trial=24, seed=4)).scatter()
+    assert not np.allclose(A, other)
+
+
+def test_multistart_optimum_below_every_start_and_feasible(small, tmp_path):
+    res = ci.trajectory_optimization(small.spec, use_cache=False, root=tmp_path, problem=small)
+    assert res.success and res.stats["status"] == "Solve_Succeeded"
+    st = res.starts
+    assert len(st) == 1 + small.spec.n_local
+    best = res.stats["objective"]
+    # the best local optimum is at most the cost of every start point (and every local result)
+    for start in [ci.neutral_start()] + [small.scatter()[int(s.split("#")[1])] for s in st["start"][1:]]:
+        assert best <= small.cost(np.clip(start, small.lo, small.hi)) + 1e-12
+    assert best <= st["cost"].min() + 1e-12
+    lo, hi = contact.bounds()
+    assert np.all(res.p_contact >= lo - 1e-9) and np.all(res.p_contact <= hi + 1e-9)
+    ratios = ci.friction_ratios({"a": res})[ci.APPROACHES["a"]]
+    assert np.all(ratios >= ci.MU_RATIO[0] - 1e-6) and np.all(ratios <= ci.MU_RATIO[1] + 1e-6)
+    # frames are the problem's: inverse dynamics torques and contact forces at the optimum
+    out = small.frames_function(res.p_contact)
+    np.testing.assert_allclose(res.grf.to_numpy().T, np.asarray(out[2]))
+    # the RMSE table is consistent with the frames (right vertical GRF)
+    g = small.grf_data[1]
+    rm = res.rmse.set_index("channel").loc["grf_y_r", "rmse"]
+    assert rm == pytest.approx(np.sqrt(np.mean((res.grf["grf_y_r"].to_numpy() - g) ** 2)), rel=1e-9)
+    # cached: the same result comes back
+    res2 = ci.trajectory_optimization(small.spec, root=tmp_path, problem=small)
+    res3 = ci.trajectory_optimization(small.spec, root=tmp_path, problem=small)
+    assert not res2.stats["from_cache"] and res3.stats["from_cache"]
+    np.testing.assert_allclose(res3.p_contact, res2.p_contact)
+
+
+def test_specs_b_and_c_follow_the_thesis():
+    b, c = ci.spec_b(4, 3), ci.spec_c(4, 3)
+    assert b.term_weights == {"Trq": 0.25, "GRF": 0.25, "Q": 0.25, "Jrk": 1 / 40}  # Table 4.8
+    assert c.term_weights == {**b.term_weights, "Imp": 0.25, "Rsd": 0.25}  # Sec 4.4.2: w5 = w6 = 1/4
+    assert b.free_contact and not b.free_body and not b.normal_force_constraint
+    assert c.free_contact and c.free_body and c.normal_force_constraint
+    gp = tr.build(c)
+    lo, hi = contact.bounds()
+    P = {p.name: p for p in gp.problem.parameters}
+    for i, n in enumerate(contact.param_names()):  # Table 4.7 verbatim
+        assert (P[f"c.{n}"].lower, P[f"c.{n}"].upper) == (lo[i], hi[i])
+    blo, bhi = ChildModel().p_body_bounds()  # Table 4.14
+    for i, n in enumerate(P_BODY_NAMES):
+        assert (P[f"b.{n}"].lower, P[f"b.{n}"].upper) == (blo[i], bhi[i])
+    names = [pc.name for pc in gp.problem.phases[0].path_constraints]
+    assert "normal_force" in names
+    assert "friction_ratio" in [e.name for e in gp.problem.phases[0].endpoint_constraints]
+
+
+def _fake_c_result(p_contact, p_body):
+    """A (c) result carrying real parameter vectors and a solution stub (spec, stats): enough
+    for the file round trip, which does not depend on how the numbers were obtained."""
+    spec = ci.spec_c(4, 3)
+    sol = SimpleNamespace(spec=spec, stats={"spec_key": "test"})
+    stats = {"status": "Solve_Succeeded", "success": True, "iterations": 7, "objective": 0.1, "solve_s": 1.0}
+    return ci.ApproachResult("c", np.asarray(p_contact, float), np.asarray(p_body, float), None, None, None, None,
+                             None, None, stats, solution=sol)
+
+
+def test_identified_file_round_trip_with_provenance(tmp_path, monkeypatch):
+    m = ChildModel()
+    pc = contact.default_params()  # a contact that carries the body (the gait reference needs it)
+    pc[contact.param_index("ball", "mu_s")] = 0.5
+    pb = 1.1 * m.default_p_body()
+    monkeypatch.setattr(params, "IDENTIFIED_DIR", tmp_path)
+    path = ci.save_identified(_fake_c_result(pc, pb), path=params.identified_path("ch4_child"))
+    assert path == tmp_path / "ch4_child.json"
+    raw = json.loads(path.read_text())
+    prov = raw["provenance"]
+    for k in ("spec", "gaitlib_version", "cache_fingerprint", "ipopt_status", "iterations", "date"):
+        assert k in prov
+    assert prov["cache_fingerprint"] == cache.fingerprint()
+    assert prov["spec"]["cost"] == "Eq4.13"
+    assert raw["units"]["p_contact"]["toe.k_v"] == "N/m^3" and raw["units"]["p_body"]["mass_hat"] == "kg"
+    lo, hi = contact.bounds()
+    assert raw["bounds"]["p_contact"]["heel.a"] == [lo[contact.param_index("heel", "a")],
+                                                    hi[contact.param_index("heel", "a")]]
+    got = params.load_identified("ch4_child")
+    np.testing.assert_array_equal(got["p_contact"], pc)
+    np.testing.assert_array_equal(got["p_body"], pb)
+    np.testing.assert_array_equal(params.contact_params("ch4"), pc)
+    np.testing.assert_array_equal(params.body_params("ch4"), pb)
+    # a gait spec loads them as its fixed parameters
+    gp = tr.build(tr.GaitSpec(model="SK", cost="Eq4.11", n_intervals=3, degree=2, contact_params="ch4",
+                              body_params="ch4"))
+    np.testing.assert_array_equal(gp.p_contact, pc)
+    np.testing.assert_array_equal(gp.p_body, pb)
+    cmp = ci.identified_vs_result(_fake_c_result(pc, pb))
+    assert cmp["max_rel_diff_contact"] == 0 and cmp["max_rel_diff_body"] == 0
+
+
+def test_identified_file_missing_or_bad_is_a_clear_error(tmp_path, monkeypatch):
+    monkeypatch.setattr(params, "IDENTIFIED_DIR", tmp_path)
+    with pytest.raises(FileNotFoundError, match="ch4_child.json"):
+        params.load_identified("ch4_child")
+    with pytest.raises(FileNotFoundError, match="ch4_child.json"):
+        tr.build(tr.GaitSpec(model="SK", n_intervals=3, degree=2, contact_params="ch4"))
+    (tmp_path / "ch4_child.json").write_text(json.dumps({"p_contact": {}, "p_body": {}, "provenance": {}}))
+    with pytest.raises(ValueError, match="p_contact has missing"):
+        params.load_identified("ch4_child")
+    with pytest.raises(ValueError, match="contact_params"):
+        tr.GaitSpec(contact_params="thesis")
+
+
+def test_save_refuses_unconverged(tmp_path):
+    r = _fake_c_result(ci.neutral_start(), ChildModel().default_p_body())
+    r.stats.update(status="Maximum_Iterations_Exceeded", success=False)
+    with pytest.raises(ValueError, match="did not converge"):
+        ci.save_identified(r, path=tmp_path / "x.json")
