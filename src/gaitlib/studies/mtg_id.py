@@ -74,7 +74,7 @@ from .. import transcription as tr
 from ..collocation import Mesh
 from ..model import ChildModel
 
-__all__ = ["IdentSpec", "MTGIdentification", "GAMMA", "W1", "W2", "THESIS_RMSE_DEG", "PARAMS_FILE",
+__all__ = ["IdentSpec", "MTGIdentification", "chapter_spec", "GAMMA", "W1", "W2", "THESIS_RMSE_DEG", "PARAMS_FILE",
            "split", "demanded_torques", "build", "identify", "save_params", "load_params",
            "evaluate", "table_beside_thesis", "margins_table", "envelope_figure", "velocity_figure"]
 
@@ -103,7 +103,9 @@ class IdentSpec:
     demand : ``"actuator"`` (net data torque − joint spring–damper; module docstring) or
         ``"net"`` (the data's net torque).
     body_params : the body parameter set whose joint spring–dampers define the actuator
-        demand (``"default"``: Tables 4.1–4.3 scaled; see :class:`~gaitlib.transcription.GaitSpec`).
+        demand (see :class:`~gaitlib.transcription.GaitSpec`). Default ``"thesis"`` (Tables
+        4.15–4.16: the thesis built Ch 5 on its Ch 4 identified body, whose knee and ankle
+        dampers are ≈ 0); :func:`chapter_spec` uses ``"ch4"`` (ours) when that file exists.
     """
 
     speed_class: str = "Free"
@@ -116,13 +118,23 @@ class IdentSpec:
     w1: float = W1
     w2: float = W2
     demand: str = "actuator"
-    body_params: str = "default"
+    body_params: str = "thesis"
 
     def __post_init__(self):
         if self.demand not in ("actuator", "net"):
             raise ValueError(f"demand must be 'actuator' or 'net', got {self.demand!r}")
         if self.side not in cv.SIDES:
             raise ValueError(f"side must be one of {cv.SIDES}, got {self.side!r}")
+
+
+def chapter_spec(**kw) -> IdentSpec:
+    """The book's identification spec: the defaults, with the body parameters the Ch 5 gait
+    solves use — ours from Ch 4 (``"ch4"``, ``data/identified/ch4_child.json``) if that file
+    exists, else the thesis's identified ones (``"thesis"``). ``kw`` override fields."""
+    from .. import params as params_mod
+
+    body = "ch4" if params_mod.identified_path("ch4_child").is_file() else "thesis"
+    return IdentSpec(**{"body_params": body, **kw})
 
 
 def split(joint: str, tau):
@@ -476,7 +488,7 @@ def velocity_figure(res: MTGIdentification, sets: dict | None = None):
 
 
 if __name__ == "__main__":  # python -m gaitlib.studies.mtg_id → solve and write the file
-    r = identify()
+    r = identify(chapter_spec())
     print(r.solution.summary())
     print(table_beside_thesis(r).to_string())
     if r.success:
