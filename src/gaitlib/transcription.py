@@ -268,6 +268,11 @@ class GaitSpec:
         (thesis Sec 6.1: the Ch 5 solution's) — ``dx`` = pelvis_tx − stride·τ (m),
         ``y`` = pelvis_ty (m), ``tilt`` = pelvis_tilt (rad). Tracked on τ, so it scales with
         the cycle time (Ch 7). Build one with :func:`hat_reference_of`.
+    effects : candidate unmodelled effects switched on (:data:`gaitlib.gap.EFFECTS`), a
+        tuple of ``(name, magnitude)`` pairs: a float fixes the effect's magnitude (its
+        first parameter), ``None`` makes its parameters NLP variables ``fx.<name>.<param>``
+        (identified with the motion). Magnitude 0 is the baseline model. See
+        :mod:`gaitlib.gap.effects`.
     """
 
     model: str = "SK"
@@ -296,6 +301,7 @@ class GaitSpec:
     t_stim: float | None = None
     track_class: str = ""
     hat_reference: tuple = ()
+    effects: tuple = ()
 
     def __post_init__(self):
         if self.model not in MODELS:
@@ -328,6 +334,10 @@ class GaitSpec:
         if self.hat_reference:
             if len(self.hat_reference) != 4 or len({len(v) for v in self.hat_reference}) != 1:
                 raise ValueError("hat_reference must be () or four equal-length tuples (tau, dx, y, tilt)")
+        if self.effects:
+            from .gap import effects as _fx
+
+            object.__setattr__(self, "effects", _fx.validate(self.effects, self.model))
 
     @property
     def term_weights(self) -> dict[str, float]:
@@ -350,6 +360,7 @@ class GaitSpec:
         d["residual_bounds"] = tuple(d.get("residual_bounds", (1.0, 1.0, 0.1)))
         d["tf_bounds"] = tuple(d.get("tf_bounds", ()))
         d["hat_reference"] = tuple(tuple(v) for v in d.get("hat_reference", ()))
+        d["effects"] = tuple((n, m) for n, m in d.get("effects", ()))
         return cls(**d)
 
 
@@ -496,8 +507,10 @@ class GaitProblem:
     """A built gait problem: the spec, the ocp Problem, mesh, options and guess.
 
     ``t_stim`` (NMSK): the stimulation time per muscle (s, :data:`NMSK_MUSCLES` order) held
-    constant in the Mtb term; ``functions``: per-node CasADi functions of the formulation
-    (NMSK ``"edot"``: (x, u, p, t_stim) → Ė and its components, W).
+    constant in the Mtb term; ``functions``: per-node functions of the formulation
+    (NMSK ``"edot"``: CasADi (x, u, p, t_stim) → Ė and its components, W; ``"node"``: the
+    Python closure (x, u, p) → dict of inverse-dynamics, contact and torque expressions;
+    ``"effects"``: the spec's bound effects, :class:`gaitlib.gap.effects.Bound`, or None).
     """
 
     spec: GaitSpec
@@ -651,9 +664,18 @@ def build(spec: GaitSpec) -> GaitProblem:
             for k in ACTIVATION_PARAMS:
                 params.append(Parameter(f"act.{k}", *map(float, activation.ACTIVATION_BOUNDS[k]), act_fixed[k]))
 
+    fx = None  # candidate unmodelled effects (gaitlib.gap.effects)
+    if spec.effects:
+        from .gap import effects as effects_mod
+
+        fx = effects_mod.bind(spec, effects_mod.Context(spec, model, ref, T, p_body, p_contact))
+        params += fx.parameters
+
     def pvec(p: Named):
         pc = ca.vertcat(*[p[f"c.{n}"] for n in contact_mod.param_names()]) if spec.free_contact else ca.DM(p_contact)
         pb = ca.vertcat(*[p[f"b.{n}"] for n in model.p_body_names]) if spec.free_body else ca.DM(p_body)
+        if fx is not None:
+            pb, pc = fx.body(pb, p), fx.contact(pc, p)
         return pb, pc
 
     def tf_of(p: Named):
@@ -695,14 +717,16 @@ def build(spec: GaitSpec) -> GaitProblem:
                     tin[c] = mtg.joint_torque(j, x[c], x[f"qd_{c}"], u[f"a_{j}_ext_{s}"], u[f"a_{j}_flex_{s}"], mtgp)
                 tin[f"mtp_{s}"] = u[f"tau_mtp_{s}"]
             tau_in = ca.vertcat(*[tin[j] for j in cv.JOINTS])
+            extra["a_gen"] = {k[2:]: u[k] for k in MTG_CONTROLS}
         else:  # NMSK: muscle activations → 12 generator activations (Eq 5.54) → MTGs
             from . import mtg
 
             am = muscle_activations(x, p)
             ap = act_of(p)
-            tin = {}
+            tin, extra["a_gen"] = {}, {}
             for s in cv.SIDES:
                 ag = activation.generator_activations(am, ap["s1"], ap["s2"], side=s)
+                extra["a_gen"].update({f"{g}_{s}": v for g, v in ag.items()})
                 for j in ("hip", "knee", "ankle"):
                     c = f"{j}_{s}"
                     tin[c] = mtg.joint_torque(j, x[c], x[f"qd_{c}"], ag[f"{j}_ext"], ag[f"{j}_flex"], mtgp)
@@ -710,6 +734,9 @@ def build(spec: GaitSpec) -> GaitProblem:
             tau_in = ca.vertcat(*[tin[j] for j in cv.JOINTS])
             extra["a_muscle"] = am
         R_in = ca.vertcat(*[u[r] for r in cv.RESIDUALS])
+        load = fx.root_load(x, p) if fx is not None else None
+        if load is not None:
+            R_id = R_id + load  # an effect's extra load on the HAT (gaitlib.gap.effects)
         # net joint torque = actuators + joint spring–dampers: what the data report
         tau_net = tau_in + f_pas(q, qd, pb)
         out = {"tau_id": tau_id, "R_id": R_id, "tau_in": tau_in, "R_in": R_in, "tau_net": tau_net,
@@ -724,6 +751,11 @@ def build(spec: GaitSpec) -> GaitProblem:
                            0.0, 0.0)]
     if spec.normal_force_constraint:
         path.append(PathConstraint("normal_force", lambda x, u, p, t: node(x, u, p)["fn_raw"], 0.0, np.inf))
+    if fx is not None:  # effects' path constraints, each expr ≥ 0 (co-contraction)
+        for e_, m_ in fx.items:
+            if e_.path is not None:
+                path.append(PathConstraint(f"fx_{e_.name}", lambda x, u, p, t, e_=e_, m_=m_: e_.path(
+                    node(x, u, p), fx.theta(e_, m_, p), fx.ctx), 0.0, np.inf))
     endpoint = []
     if spec.free_contact:
         def ratio(x0, xf, p, t0, tf):
@@ -738,7 +770,9 @@ def build(spec: GaitSpec) -> GaitProblem:
 
     # ---- initial guess (before the goals: the NMSK Mtb term's t_stim comes from it)
     guess = initial_guess(spec, model, ref, p_body, p_contact)
-    functions: dict = {}
+    # "node": the per-node closure (x, u, p) → dict (tau_id, R_id, tau_in, R_in, tau_net, grf,
+    # …) and "effects": the bound effects or None — for goals added outside (gaitlib.gap)
+    functions: dict = {"node": node, "effects": fx}
     t_stim: tuple = ()
     if nmsk:
         if spec.t_stim is not None:
@@ -786,6 +820,8 @@ def build(spec: GaitSpec) -> GaitProblem:
 
     def goal(name, f):
         if name in w:
+            if fx is not None and ocp._accepts_data(f):  # effects may override references
+                f = (lambda f_: lambda x, u, p, t, d: f_(x, u, p, t, fx.wrap_data(d, p, t)))(f)
             goals.append(Goal(name, weight=w[name], integrand=f, divide_by_duration=True))
 
     goal("Jrk", lambda x, u, p, t: tf_of(p)**6 * sum(sq(u[f"jerk_{c}"], rg[f"jerk_{c}"]) for c in cv.COORDS))
@@ -820,11 +856,7 @@ def build(spec: GaitSpec) -> GaitProblem:
         raise ValueError(f"cost terms {sorted(unused)} are not defined for model {spec.model}")
 
     # ---- data on normalised time τ ∈ [0, 1]
-    tau_grid = ref.q.index.to_numpy() / T
-    dat = {f"ref_{c}": ref.q[c].to_numpy() for c in cv.COORDS}
-    dat.update({f"ref_tau_{j}": ref.tau[j].to_numpy() for j in LEG_JOINTS})
-    dat.update({f"ref_{g}": ref.grf[g].to_numpy() for g in GRF_CHANNELS})
-    data_frame = pd.DataFrame(dat, index=tau_grid)
+    data_frame = tracking_frame(spec, ref)
 
     # ---- bounds (generous, from the data; thesis: "based on the standard deviation")
     bounds = {}
@@ -879,6 +911,22 @@ def build(spec: GaitSpec) -> GaitProblem:
     mesh = Mesh(spec.n_intervals, spec.scheme, spec.degree)
     options = SolverOptions(tol=spec.tol, max_iter=spec.max_iter, hessian=spec.hessian)
     return GaitProblem(spec, model, ref, problem, mesh, options, guess, p_body, p_contact, t_stim, functions)
+
+
+def tracking_frame(spec: GaitSpec, ref: Reference) -> pd.DataFrame:
+    """The phase's per-node data (NLP parameters) on normalised time τ = t / T: the
+    references ``ref_<coordinate>``, ``ref_tau_<joint>``, ``ref_<grf>`` and any columns
+    the spec's effects need. ``Transcription.solve(data={"cycle": frame})`` with the frame
+    of another data set re-solves the same NLP on it (:func:`gaitlib.gap.diagnose`)."""
+    tau_grid = ref.q.index.to_numpy() / ref.gait.cycle_time
+    dat = {f"ref_{c}": ref.q[c].to_numpy() for c in cv.COORDS}
+    dat.update({f"ref_tau_{j}": ref.tau[j].to_numpy() for j in LEG_JOINTS})
+    dat.update({f"ref_{g}": ref.grf[g].to_numpy() for g in GRF_CHANNELS})
+    if spec.effects:
+        from .gap import effects as effects_mod
+
+        dat.update(effects_mod.data_columns(spec, ref, tau_grid))
+    return pd.DataFrame(dat, index=tau_grid)
 
 
 def initial_guess(spec: GaitSpec, model: ChildModel, ref: Reference, p_body, p_contact) -> Guess:
@@ -1211,6 +1259,11 @@ def postprocess(gp: GaitProblem, sol: ocp.Solution) -> GaitSolution:
         Xu = X.reindex(t_u)
     pb = np.array([sol.parameters[f"b.{n}"] for n in model.p_body_names]) if spec.free_body else gp.p_body
     pc = np.array([sol.parameters[f"c.{n}"] for n in contact_mod.param_names()]) if spec.free_contact else gp.p_contact
+    if spec.effects:  # effects acting on body/contact parameters, at the solution's values
+        from .gap import effects as effects_mod
+
+        ctx = effects_mod.Context(spec, model, gp.ref, gp.ref.gait.cycle_time, gp.p_body, gp.p_contact)
+        pb, pc = effects_mod.numeric_body_contact(spec, ctx, sol.parameters, pb, pc)
     q = Xu[list(cv.COORDS)]
     qd = Xu[[f"qd_{c}" for c in cv.COORDS]]
     qd.columns = list(cv.COORDS)
@@ -1259,9 +1312,16 @@ def postprocess(gp: GaitProblem, sol: ocp.Solution) -> GaitSolution:
         "n_constraints": sol.info.get("n_constraints"), "spec_key": spec.key(),
         "tf_s": float(ph.tf),
         **nmsk_stats,
+        **({"effects": _effects_values(spec, sol)} if spec.effects else {}),
     }
     return GaitSolution(spec, sol, q, qd, torques, residuals, grf, ellipsoids, acts, rmse, stats, active,
                         **nmsk_frames)
+
+
+def _effects_values(spec: GaitSpec, sol: ocp.Solution) -> dict:
+    from .gap import effects as effects_mod
+
+    return effects_mod.theta_of(spec, sol.parameters)
 
 
 def _postprocess_nmsk(gp: GaitProblem, sol: ocp.Solution, Xu, U, q, qd):
