@@ -179,6 +179,10 @@ def _write(doc: dict) -> None:
           f"casadi {doc['meta']['versions']['casadi']}, gaitlib {doc['meta']['versions']['gaitlib_commit']}; "
           f"{'complete' if doc['complete'] else 'INCOMPLETE (interrupted or over budget)'}; "
           f"total benchmark wall time {doc['meta'].get('total_wall_s', float('nan')):.0f} s.", "",
+          *([f"Supplement {doc['meta']['supplement']['started']}: {doc['meta']['supplement']['reason']} "
+             f"({len(doc['meta']['supplement']['runs'])} runs, {doc['meta']['supplement'].get('wall_s', 0):.0f} s, "
+             f"load average at start {doc['meta']['supplement']['loadavg_start'][0]:.2f}).", ""]
+            if doc["meta"].get("supplement") else []),
           "## Mesh size and model (exact Hessian, MUMPS)", "", perf.scaling_table(doc).to_markdown(index=False),
           "", "Fitted growth exponents (quantity ∝ nodes^b, finished runs only):", "",
           perf.scaling_fits(doc).to_markdown(index=False) if doc["runs"] else "(none)", "",
@@ -196,6 +200,65 @@ def _write(doc: dict) -> None:
     (OUT / "scaling.md").write_text("\n".join(md) + "\n")
 
 
+def _measure(c: dict, rec: dict, timeout: float) -> dict:
+    one = {k: c[k] for k in ("model", "n_intervals", "degree", "hessian", "linear_solver")}
+    if "max_iter" in c:
+        one["max_iter"] = c["max_iter"]
+    res, err, _, wall = _child(["--one", json.dumps(one)], timeout)
+    rec.update(res or {})
+    rec.update(outcome="finished" if res is not None else ("timeout" if err.startswith("timeout") else "error"),
+               error=err, child_wall_s=wall, loadavg_end=list(os.getloadavg()))
+    return rec
+
+
+def _print_run(c: dict, rec: dict) -> None:
+    print(f"{c['group']:<13} {c['model']:<4} {c['n_intervals']:>3} x {c['degree']} {c['hessian']:<14} "
+          f"{c['linear_solver']:<6} {rec.get('status', rec['outcome']):<28} it {rec.get('iterations', '-'):>5}  "
+          f"{rec.get('ms_per_iteration', float('nan')):8.1f} ms/it  solve {rec.get('solve_s', float('nan')):7.1f} s"
+          f"  build {rec.get('build_s', float('nan')):6.1f} s  load {rec['loadavg_start'][0]:.2f}", flush=True)
+
+
+def _resume_skipped(args) -> int:
+    """Measure the runs of ``scaling.json`` that the main run skipped (over budget), each
+    group (hessian, linear_solver) together with a fresh MUMPS / exact-Hessian reference run
+    in the same period, so the comparison is made under the same load."""
+    doc = json.loads((OUT / "scaling.json").read_text())
+    sup = {"started": datetime.now(timezone.utc).isoformat(timespec="seconds"), "loadavg_start": list(os.getloadavg()),
+           "reason": "runs skipped by the main run's --budget, measured in a second invocation "
+                     "(bench_scaling.py --resume-skipped) with fresh reference runs", "runs": []}
+    t0 = time.perf_counter()
+    skipped = [r for r in doc["runs"] if str(r.get("outcome", "")).startswith("skipped")]
+    groups = []
+    for r in skipped:
+        if r["group"] not in groups:
+            groups.append(r["group"])
+    # keep every finished run except the old references of the groups re-measured here
+    new_runs = [r for r in doc["runs"] if not str(r.get("outcome", "")).startswith("skipped")
+                and (r["group"] not in groups or r["group"] == "mesh")]
+    for g in groups:
+        todo = [r for r in skipped if r["group"] == g]
+        ref = dict(todo[0], hessian="exact", linear_solver="mumps")
+        ref.pop("max_iter", None)
+        for c in (todo if g == "mesh" else [*todo, ref]):
+            c = {k: c[k] for k in ("group", "model", "n_intervals", "degree", "hessian", "linear_solver", "max_iter")
+                 if k in c}
+            rec = {**c, "nodes": c["n_intervals"] * c["degree"], "loadavg_start": list(os.getloadavg()),
+                   "measured_in": "supplement"}
+            rec = _measure(c, rec, args.timeout)
+            new_runs.append(rec)
+            sup["runs"].append(f"{g} {c['model']} {c['n_intervals']} {c['hessian']} {c['linear_solver']}")
+            _print_run(c, rec)
+            doc["runs"] = new_runs + [r for r in skipped if r["group"] in groups[groups.index(g) + 1:]]
+            _write(doc)
+    sup["wall_s"] = time.perf_counter() - t0
+    sup["loadavg_end"] = list(os.getloadavg())
+    doc["meta"]["supplement"] = sup
+    doc["runs"] = new_runs
+    _write(doc)
+    print((OUT / "scaling.md").read_text())
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--sk", default="5,10,20,40,80", help="SK mesh intervals")
@@ -209,6 +272,8 @@ def main(argv=None) -> int:
     ap.add_argument("--budget", type=float, default=1800, help="start no new run after this many s")
     ap.add_argument("--quick", action="store_true", help="SK 4, 8 intervals × 3 (checks the script)")
     ap.add_argument("--out", default=None, help="results directory (default benchmarks/results)")
+    ap.add_argument("--resume-skipped", action="store_true",
+                    help="measure the runs results/scaling.json marks as skipped (over budget), with fresh references")
     ap.add_argument("--one", default=None, help=argparse.SUPPRESS)
     ap.add_argument("--probe", default=None, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
@@ -261,6 +326,9 @@ def main(argv=None) -> int:
                         "outcome": "finished = IPOPT returned (any status); timeout; error"}},
            "runs": [], "linear_solvers_available": [], "complete": False}
 
+    if args.resume_skipped:
+        return _resume_skipped(args)
+
     def run_case(c):
         rec = {**c, "nodes": c["n_intervals"] * c["degree"], "loadavg_start": list(os.getloadavg())}
         if time.perf_counter() - t_start > args.budget:
@@ -268,20 +336,11 @@ def main(argv=None) -> int:
             doc["runs"].append(rec)
             print(f"skip {c}", flush=True)
             return
-        one = {k: c[k] for k in ("model", "n_intervals", "degree", "hessian", "linear_solver")}
-        if "max_iter" in c:
-            one["max_iter"] = c["max_iter"]
-        res, err, _, wall = _child(["--one", json.dumps(one)], args.timeout)
-        rec.update(res or {})
-        rec.update(outcome="finished" if res is not None else ("timeout" if err.startswith("timeout") else "error"),
-                   error=err, child_wall_s=wall, loadavg_end=list(os.getloadavg()))
+        rec = _measure(c, rec, args.timeout)
         doc["runs"].append(rec)
         doc["meta"]["total_wall_s"] = time.perf_counter() - t_start
         _write(doc)
-        print(f"{c['group']:<13} {c['model']:<4} {c['n_intervals']:>3} x {c['degree']} {c['hessian']:<14} "
-              f"{c['linear_solver']:<6} {rec.get('status', rec['outcome']):<28} it {rec.get('iterations', '-'):>5}  "
-              f"{rec.get('ms_per_iteration', float('nan')):8.1f} ms/it  solve {rec.get('solve_s', float('nan')):7.1f} s"
-              f"  build {rec.get('build_s', float('nan')):6.1f} s  load {rec['loadavg_start'][0]:.2f}", flush=True)
+        _print_run(c, rec)
 
     for c in cases:
         run_case(c)

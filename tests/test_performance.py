@@ -1,0 +1,61 @@
+"""The Performance page's arithmetic (gaitlib.studies.performance): the power-law fit
+recovers known exponents, the tables keep failed runs visible and fit finished runs only."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from gaitlib.studies import performance as perf
+
+
+def test_power_law_fit_recovers_exponent_and_prefactor():
+    n = np.array([25, 50, 100, 200, 400])
+    f = perf.fit_power_law(n, 0.7 * n ** 1.0)
+    assert f["exponent"] == pytest.approx(1.0, abs=1e-12) and f["prefactor"] == pytest.approx(0.7, rel=1e-12)
+    assert f["r2"] == pytest.approx(1.0) and f["n_points"] == 5
+    rng = np.random.default_rng(0)
+    y = 3.0 * n ** 1.3 * np.exp(rng.normal(0, 0.05, n.size))
+    f = perf.fit_power_law(n, y)
+    assert abs(f["exponent"] - 1.3) < 3 * f["exponent_se"] + 1e-3 and 0 < f["exponent_se"] < 0.1
+    # fewer than two usable points: no exponent; non-positive values are ignored
+    assert np.isnan(perf.fit_power_law([100], [1.0])["exponent"])
+    assert perf.fit_power_law([10, 20, 40], [1.0, 0.0, 4.0])["exponent"] == pytest.approx(1.0)
+
+
+def _doc():
+    def run(model, n, ms, outcome="finished", status="Solve_Succeeded", group="mesh", **kw):
+        it = 100
+        return {"group": group, "model": model, "n_intervals": n, "degree": 5, "nodes": 5 * n, "outcome": outcome,
+                "status": status, "success": status == "Solve_Succeeded", "iterations": it,
+                "solve_s": ms * it / 1e3, "ms_per_iteration": ms, "function_evals_ms_per_iteration": ms / 2,
+                "ipopt_rest_ms_per_iteration": ms / 2, "build_s": 1e-3 * n ** 2, "loadavg_start": [2.0, 1.0, 1.0],
+                "hessian": "exact", "linear_solver": "mumps", **kw}
+
+    return {"meta": {"measured": "2026-11-22T09:00:00+00:00", "machine": {"cpu": "AMD EPYC", "cores": 2},
+                     "loadavg_start": [2.5, 2.0, 1.5], "note": "shared machine"},
+            "runs": [run("SK", 10, 20.0), run("SK", 20, 40.0), run("SK", 40, 80.0),
+                     run("SK", 80, float("nan"), outcome="timeout", status=None),
+                     run("MSK", 10, 30.0, status="Maximum_Iterations_Exceeded"), run("MSK", 20, 60.0 * 2 ** 0.5),
+                     run("SK", 20, 20.0, group="hessian", hessian="limited-memory")],
+            "linear_solvers_available": [{"linear_solver": "mumps", "loads": True}]}
+
+
+def test_scaling_fits_use_finished_runs_and_report_linear_growth():
+    doc = _doc()
+    fits = perf.scaling_fits(doc).set_index(["model", "quantity"])
+    sk = fits.loc[("SK", "time per iteration")]
+    assert sk["exponent"] == pytest.approx(1.0) and sk["points"] == 3 and sk["nodes"] == "50, 100, 200"
+    assert fits.loc[("SK", "build time"), "exponent"] == pytest.approx(2.0)
+    # a run stopped by IPOPT (max iterations) is a timing measurement; a timeout is not
+    assert fits.loc[("MSK", "time per iteration"), "exponent"] == pytest.approx(1.5)
+    table = perf.scaling_table(doc)
+    assert len(table) == 6 and table["load (1 min) at start"].eq(2.0).all()  # the timeout stays listed
+    assert list(perf.hessian_table(doc)["hessian"]) == ["limited-memory"]
+    assert "2026-11-22" in perf.measured_on(doc) and "AMD EPYC (2 cores)" in perf.measured_on(doc)
+    assert "2.50" in perf.measured_on(doc) and "shared machine" in perf.measured_on(doc)
+
+
+def test_missing_results_name_the_file_and_the_script(tmp_path):
+    with pytest.raises(FileNotFoundError, match="bench_scaling.py"):
+        perf.load("scaling", root=tmp_path)
