@@ -255,12 +255,18 @@ def _scores(sols: dict, gaits: dict, key_of) -> pd.DataFrame:
 
 def cost_function_study(models=("MSK", "NMSK"), costs=CH6_COSTS, *, n_intervals: int = 20, degree: int = 5,
                         root=None, scheduler: str | None = None, n_workers: int | None = None, serial: bool = False,
-                        progress: bool = True, source: str = "schwartz2008") -> StudyResult:
-    """Thesis Ch 6: the ``models`` × ``costs`` runs, scored against the Free data."""
-    bases = {m: baseline(m, n_intervals=n_intervals, degree=degree, root=root, source=source) for m in models}
+                        progress: bool = True, source: str = "schwartz2008", params: dict | None = None) -> StudyResult:
+    """Thesis Ch 6: the ``models`` × ``costs`` runs, scored against the Free data.
+
+    ``params``: GaitSpec fields naming the parameter sets of every run and of the Ch 5
+    baselines (e.g. ``{"mtg_params": "ch5", "body_params": "ch4", "contact_params": "ch4"}``
+    — the thesis carries the identified values of Chs 4–5 into Ch 6)."""
+    params = dict(params or {})
+    bases = {m: baseline(m, n_intervals=n_intervals, degree=degree, root=root, source=source, **params)
+             for m in models}
     specs, guesses = {}, {}
     for m in models:
-        sp = ch6_specs(m, bases[m], costs, n_intervals=n_intervals, degree=degree, source=source)
+        sp = ch6_specs(m, bases[m], costs, n_intervals=n_intervals, degree=degree, source=source, **params)
         specs.update(sp)
         guesses.update({k: thesis_guess(bases[m]) for k in sp})
     recs, sols = _run(specs, guesses, root=root, scheduler=scheduler, n_workers=n_workers, serial=serial,
@@ -271,14 +277,16 @@ def cost_function_study(models=("MSK", "NMSK"), costs=CH6_COSTS, *, n_intervals:
 
 def speed_study(models=("MSK", "NMSK"), classes=CH7_CLASSES, *, n_intervals: int = 20, degree: int = 5,
                 root=None, scheduler: str | None = None, n_workers: int | None = None, serial: bool = False,
-                progress: bool = True, source: str = "schwartz2008") -> StudyResult:
+                progress: bool = True, source: str = "schwartz2008", params: dict | None = None) -> StudyResult:
     """Thesis Ch 7: DT per model and speed class on time-scaled Free data, scored against
-    each class's own data (never tracked)."""
-    bases = {m: baseline(m, n_intervals=n_intervals, degree=degree, root=root, source=source) for m in models}
+    each class's own data (never tracked). ``params`` as :func:`cost_function_study`."""
+    params = dict(params or {})
+    bases = {m: baseline(m, n_intervals=n_intervals, degree=degree, root=root, source=source, **params)
+             for m in models}
     gaits = {c: data_mod.load_gait_data(c, source) for c in classes}
     specs, guesses = {}, {}
     for m in models:
-        sp = ch7_specs(m, bases[m], classes, n_intervals=n_intervals, degree=degree, source=source)
+        sp = ch7_specs(m, bases[m], classes, n_intervals=n_intervals, degree=degree, source=source, **params)
         specs.update(sp)
         for k, s in sp.items():
             g = gaits[s.speed_class]
