@@ -130,8 +130,8 @@ def hessian_table(res: dict | None = None) -> pd.DataFrame:
     """Exact Hessian vs limited-memory (L-BFGS) on the same problem and mesh."""
     res = load("scaling") if res is None else res
     df = _runs(res, "hessian")
-    cols = ["model", "n_intervals", "degree", "hessian", "status", "iterations", "solve_s", "ms_per_iteration",
-            "build_s", "objective", "max_violation"]
+    cols = ["model", "n_intervals", "degree", "hessian", "outcome", "status", "iterations", "solve_s",
+            "ms_per_iteration", "build_s", "objective", "max_violation", "measured_in"]
     return df[[c for c in cols if c in df.columns]].reset_index(drop=True)
 
 
@@ -141,8 +141,9 @@ def linear_solver_table(res: dict | None = None) -> tuple[pd.DataFrame, pd.DataF
     res = load("scaling") if res is None else res
     avail = pd.DataFrame(res.get("linear_solvers_available", []))
     df = _runs(res, "linear_solver")
-    cols = ["model", "n_intervals", "degree", "linear_solver", "status", "iterations", "solve_s",
-            "ms_per_iteration", "function_evals_ms_per_iteration", "ipopt_rest_ms_per_iteration", "objective"]
+    cols = ["model", "n_intervals", "degree", "linear_solver", "outcome", "status", "iterations", "solve_s",
+            "ms_per_iteration", "function_evals_ms_per_iteration", "ipopt_rest_ms_per_iteration", "objective",
+            "measured_in"]
     return avail, df[[c for c in cols if c in df.columns]].reset_index(drop=True)
 
 
