@@ -1,13 +1,14 @@
 """Refresh the repository's solution store (``solutions/``) from a run of the book.
 
-Usage: python tools/store_solutions.py [book/chNN_x.ipynb ...]   (default: every notebook
+Usage: python tools/store_solutions.py [--fresh] [book/chNN_x.ipynb ...]   (default: every notebook
 in book/_toc.yml order)
 
-Every notebook is executed with an empty writable cache (``GAITLIB_SOLUTIONS`` = a fresh
-temporary directory) and the current store as read-only fallback. Afterwards the store is
-replaced by exactly the entries the run used: those it reloaded from the store and those it
-had to solve. Stale entries (older code or data) are never hit, so they drop out. Prints the
-wall time per notebook — with a fresh store it is the from-scratch time of the book.
+Every notebook is executed with the usual writable cache (``$GAITLIB_SOLUTIONS`` or
+~/.cache/gaitlib/solutions; ``--fresh``: an empty temporary one, which measures the
+from-scratch time) and the current store as read-only fallback. Afterwards the store is
+replaced by exactly the entries the run used: those it reloaded and those it had to solve.
+Stale entries (older code or data) are never hit, so they drop out. Prints the wall time
+per notebook.
 """
 
 from __future__ import annotations
@@ -35,11 +36,13 @@ def notebooks(argv) -> list[Path]:
 
 
 def main(argv) -> int:
-    nbs = notebooks(argv)
+    fresh = "--fresh" in argv
+    nbs = notebooks([a for a in argv if a != "--fresh"])
     tmp = Path(tempfile.mkdtemp(prefix="gaitlib-store-"))
     log = tmp / "used.log"
-    env = dict(os.environ, GAITLIB_SOLUTIONS=str(tmp / "cache"), GAITLIB_CACHE_LOG=str(log),
-               GAITLIB_STORE=str(STORE) if STORE.is_dir() else "")
+    env = dict(os.environ, GAITLIB_CACHE_LOG=str(log), GAITLIB_STORE=str(STORE) if STORE.is_dir() else "")
+    if fresh:
+        env["GAITLIB_SOLUTIONS"] = str(tmp / "cache")
     times = {}
     failed = []
     for nb in nbs:
