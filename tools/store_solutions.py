@@ -63,9 +63,17 @@ def main(argv) -> int:
         dest = new / entry.parent.name / entry.name
         if not dest.exists():
             shutil.copytree(entry, dest)
+    new.mkdir(parents=True, exist_ok=True)
+    subset = any(a != "--fresh" for a in argv)
+    if subset and STORE.exists():  # some notebooks only: keep the other chapters' entries
+        for kind in STORE.iterdir():
+            if kind.is_dir():
+                for e in kind.iterdir():
+                    if not (new / kind.name / e.name).exists():
+                        shutil.copytree(e, new / kind.name / e.name)
     if STORE.exists():
         shutil.rmtree(STORE)
-    shutil.move(str(new) if new.exists() else str(new.mkdir(parents=True) or new), STORE)
+    shutil.move(str(new), STORE)
     (STORE / "README.md").write_text(
         "Solutions the book loads instead of re-solving, keyed by spec + code + data hash\n"
         "(gaitlib.cache). Written by tools/store_solutions.py; never edit by hand.\n\n"
