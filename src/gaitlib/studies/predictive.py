@@ -41,7 +41,7 @@ from .. import transcription as tr
 from . import gait as sg
 
 __all__ = ["CH6_COSTS", "CH7_CLASSES", "THESIS_CLASS", "THESIS_HOURS_TABLE_6_3", "THESIS_HOURS_TABLE_7_2",
-           "THESIS_COT_FIG_7_5", "BASELINE_COST", "baseline", "thesis_guess", "ch6_specs", "ch7_specs",
+           "THESIS_COT_FIG_7_5", "BASELINE_COST", "baseline", "default_params", "thesis_guess", "ch6_specs", "ch7_specs",
            "score", "excitation_score", "StudyResult", "cost_function_study", "speed_study", "cot_table",
            "times_table"]
 
@@ -70,10 +70,21 @@ def _mesh(n_intervals, degree):
 
 def baseline(model: str, *, n_intervals: int = 20, degree: int = 5, root=None, progress: bool = False,
              **kw) -> tr.GaitSolution:
-    """The model's Ch 5 natural-gait data-tracking solution (MSK Eq 5.33, NMSK Eq 5.55),
-    solved or reloaded from the cache; ``kw`` go to the spec."""
-    return sg.natural_gait(model, BASELINE_COST[model], "Free", root=root, progress=progress,
-                           **_mesh(n_intervals, degree), **kw)
+    """The model's Ch 5 natural-gait data-tracking solution (MSK Eq 5.33, NMSK Eq 5.55 with
+    the activation parameters identified; :func:`gaitlib.studies.msk.ch5_spec`), solved or
+    reloaded from the cache; ``kw`` override spec fields."""
+    from . import msk
+
+    return sg.solve_cached(msk.ch5_spec(model, **_mesh(n_intervals, degree), **kw), root=root, progress=progress)
+
+
+def default_params() -> dict:
+    """The parameter sets the thesis carries into Chs 6–7: those of the Ch 5 solves
+    (:func:`gaitlib.studies.msk.parameter_sets`). The NMSK runs use the activation
+    parameters of thesis Table 5.10 (``GaitSpec`` has no field for ours yet)."""
+    from . import msk
+
+    return msk.parameter_sets()
 
 
 def thesis_guess(base: tr.GaitSolution, *, cycle_time: float | None = None, stride: float | None = None) -> ocp.Solution:
@@ -260,8 +271,9 @@ def cost_function_study(models=("MSK", "NMSK"), costs=CH6_COSTS, *, n_intervals:
 
     ``params``: GaitSpec fields naming the parameter sets of every run and of the Ch 5
     baselines (e.g. ``{"mtg_params": "ch5", "body_params": "ch4", "contact_params": "ch4"}``
-    — the thesis carries the identified values of Chs 4–5 into Ch 6)."""
-    params = dict(params or {})
+    — the thesis carries the identified values of Chs 4–5 into Ch 6); default
+    :func:`default_params`."""
+    params = default_params() if params is None else dict(params)
     bases = {m: baseline(m, n_intervals=n_intervals, degree=degree, root=root, source=source, **params)
              for m in models}
     specs, guesses = {}, {}
@@ -280,7 +292,7 @@ def speed_study(models=("MSK", "NMSK"), classes=CH7_CLASSES, *, n_intervals: int
                 progress: bool = True, source: str = "schwartz2008", params: dict | None = None) -> StudyResult:
     """Thesis Ch 7: DT per model and speed class on time-scaled Free data, scored against
     each class's own data (never tracked). ``params`` as :func:`cost_function_study`."""
-    params = dict(params or {})
+    params = default_params() if params is None else dict(params)
     bases = {m: baseline(m, n_intervals=n_intervals, degree=degree, root=root, source=source, **params)
              for m in models}
     gaits = {c: data_mod.load_gait_data(c, source) for c in classes}
