@@ -183,3 +183,20 @@ def test_save_refuses_unconverged(tmp_path):
     r.stats.update(status="Maximum_Iterations_Exceeded", success=False)
     with pytest.raises(ValueError, match="did not converge"):
         ci.save_identified(r, path=tmp_path / "x.json")
+
+
+def test_thesis_reference_tables_are_consistent():
+    """Table 4.17/4.18 (approach (c)) are the library's default contact parameters; every
+    thesis set respects Eq 4.4 (to the printed digits); Table 4.11's (b) lies inside Table 4.7,
+    Table 4.10's (a) except heel r_y (−3.7 mm < −3.0 mm), Table 4.17's (c) except the five
+    entries the contact module lists (Sec 4.4 used wider, unreported bounds)."""
+    np.testing.assert_allclose(ci.thesis_params("c"), contact.default_params(), rtol=0, atol=1e-15)
+    lo, hi = contact.bounds()
+    outside = {}
+    for k in ("a", "b", "c"):
+        p = ci.thesis_params(k)
+        for e in cv.ELLIPSOIDS:
+            r = p[contact.param_index(e, "mu_d")] / p[contact.param_index(e, "mu_s")]
+            assert ci.MU_RATIO[0] <= r <= ci.MU_RATIO[1] + 1e-3, (k, e, r)
+        outside[k] = {n for n, v, l, h in zip(contact.param_names(), p, lo, hi) if not l - 1e-9 <= v <= h + 1e-9}
+    assert outside == {"a": {"heel.r_y"}, "b": set(), "c": set(contact.TABLE_4_17_OUTSIDE_TABLE_4_7)}

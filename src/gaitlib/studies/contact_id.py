@@ -70,7 +70,7 @@ from ..model import P_BODY_NAMES, P_BODY_UNITS, ChildModel
 __all__ = [
     "APPROACHES", "THESIS_RMSE", "THESIS_GEOMETRY", "THESIS_CONTACT", "THESIS_TIME",
     "TrajOptSpec", "InverseDynamicsID", "ApproachResult",
-    "neutral_start", "trajectory_optimization", "spec_b", "spec_c", "optimal_control",
+    "neutral_start", "thesis_params", "trajectory_optimization", "spec_b", "spec_c", "optimal_control",
     "optimal_control_body", "run_all",
     "rmse_table", "rmse_beside_thesis", "solver_table", "geometry_table", "contact_table",
     "body_table", "at_bounds", "friction_ratios", "residual_rms", "grf_fit",
@@ -137,6 +137,19 @@ _GEOM = ("a", "b", "c", "r_x", "r_y", "r_z", "gamma", "beta", "alpha")
 _GEOM_UNIT = ("mm",) * 6 + ("deg",) * 3
 _FRIC = ("k_v", "a_v", "mu_s", "mu_d")
 _FRIC_UNIT = ("N/m^3", "s/m", "-", "-")
+
+
+def thesis_params(key: str) -> np.ndarray:
+    """The thesis's identified contact parameters of approach ``key`` as a 39-vector (SI,
+    left foot): geometry from Table 4.10 / 4.11 / 4.17, k_v, a_v, μ_s, μ_d from
+    Table 4.12 / 4.13 / 4.18 (a reference for figures and tables)."""
+    p = np.zeros(39)
+    for e in cv.ELLIPSOIDS:
+        for n, v in zip(_GEOM, THESIS_GEOMETRY[key][e]):
+            p[contact_mod.param_index(e, n)] = v / _table_scale(n)
+        for n, v in zip(_FRIC, THESIS_CONTACT[key][e]):
+            p[contact_mod.param_index(e, n)] = v
+    return p
 
 
 def _table_scale(name: str) -> float:
@@ -401,6 +414,8 @@ class ApproachResult:
         ¼ Trq + ¼ GRF), ``from_cache``; (a) also ``n_local``, ``n_trial``, ``best_start``.
     solution : the :class:`~gaitlib.transcription.GaitSolution` of (b)/(c), else None.
     starts : (a) one row per local solve (start, score at start, cost, status, iterations, s).
+    stages : (b)/(c) one row per solve on the way (continuation stages, then the problem
+        itself): residual bounds, cost terms, status, iterations, times.
     """
 
     key: str
@@ -415,6 +430,7 @@ class ApproachResult:
     stats: dict
     solution: tr.GaitSolution | None = None
     starts: pd.DataFrame | None = None
+    stages: pd.DataFrame | None = None
 
     @property
     def label(self) -> str:
@@ -572,14 +588,68 @@ def _solve_gait_cached(spec: tr.GaitSpec, start: dict, warm: tr.GaitSolution | N
     return sol
 
 
-def optimal_control(spec: tr.GaitSpec | None = None, start=None, *, use_cache: bool = True, root=None,
-                    progress: bool = False) -> ApproachResult:
+#: Continuation towards approach (b) from a start far from dynamic consistency (our device):
+#: the pelvis residual bounds (R_x, R_y N; R_z N·m) of the stages before the final problem,
+#: each stage with the Rsd term (Eq 4.13, weight 1/4) added and warm-started from the last.
+CONTINUATION = ((1000.0, 1000.0, 100.0), (100.0, 100.0, 10.0), (10.0, 10.0, 1.0))
+
+
+def _stage_spec(spec: tr.GaitSpec, bounds) -> tr.GaitSpec:
+    w = tuple(spec.weights) if "Rsd" in spec.term_weights else tuple(spec.weights) + (("Rsd", 0.25),)
+    return dataclasses.replace(spec, residual_bounds=tuple(float(b) for b in bounds), weights=w)
+
+
+def _continuation(spec: tr.GaitSpec, start: dict, warm, stages, use_cache, root, progress):
+    """Solve the ``stages`` (residual bounds) then ``spec`` itself, each warm-started from the
+    previous solution (whatever its status: every stage's status is kept and reported)."""
+    sols = []
+    prev = warm
+    for b in stages:
+        sol = _solve_gait_cached(_stage_spec(spec, b), start if prev is None else {}, prev, use_cache, root, progress)
+        sols.append(sol)
+        prev = sol
+    final = _solve_gait_cached(spec, start if prev is None else {}, prev, use_cache, root, progress)
+    return final, sols
+
+
+def _stages_frame(stages: list, final: tr.GaitSolution) -> pd.DataFrame:
+    rows = []
+    for s in list(stages) + [final]:
+        st = s.stats
+        rows.append({"residual bounds (N, N, N·m)": tuple(s.spec.residual_bounds),
+                     "cost": "+".join(sorted(s.spec.term_weights)), "status": st["status"],
+                     "iterations": st["iterations"], "solve (s)": st["solve_time_s"], "build (s)": st["build_time_s"],
+                     "objective": st["objective"], "max violation": st["max_violation"],
+                     "from cache": st.get("from_cache", False)})
+    return pd.DataFrame(rows)
+
+
+def _with_stages(res: ApproachResult, stages: list) -> ApproachResult:
+    """Attach the continuation record; wall time, iterations cover all stages."""
+    final = res.solution
+    res.stages = _stages_frame(stages, final)
+    if stages:
+        its = int(res.stages["iterations"].sum())
+        solve = float(res.stages["solve (s)"].sum())
+        build = float(res.stages["build (s)"].sum())
+        res.stats.update(iterations_final=res.stats["iterations"], iterations=its, solve_s=solve, build_s=build,
+                         wall_s=solve + build, time_per_iteration_s=solve / max(its, 1),
+                         n_stages=len(stages) + 1)
+    return res
+
+
+def optimal_control(spec: tr.GaitSpec | None = None, start=None, stages=CONTINUATION, *, use_cache: bool = True,
+                    root=None, progress: bool = False) -> ApproachResult:
     """Approach (b) (Sec 4.3.2): :func:`spec_b` from the data-based guess (Sec 4.3.2) with
-    the contact parameters starting at ``start`` (39,) SI (default :func:`neutral_start`)."""
+    the contact parameters starting at ``start`` (39,) SI (default :func:`neutral_start`),
+    reached through the residual-bound continuation ``stages`` (:data:`CONTINUATION`;
+    ``()``: solve :func:`spec_b` directly from the start). The result is the solution of
+    :func:`spec_b` itself; ``stages`` of the result records every stage."""
     spec = spec or spec_b()
     p0 = neutral_start() if start is None else np.asarray(start, float)
     st = {f"c.{n}": float(v) for n, v in zip(contact_mod.param_names(), p0)}
-    return _result_from_gait("b", _solve_gait_cached(spec, st, None, use_cache, root, progress))
+    final, sols = _continuation(spec, st, None, stages, use_cache, root, progress)
+    return _with_stages(_result_from_gait("b", final), sols)
 
 
 def optimal_control_body(spec: tr.GaitSpec | None = None, warm: ApproachResult | None = None, start=None, *,
@@ -597,7 +667,7 @@ def optimal_control_body(spec: tr.GaitSpec | None = None, warm: ApproachResult |
         p0 = neutral_start() if start is None else np.asarray(start, float)
         st = {f"c.{n}": float(v) for n, v in zip(contact_mod.param_names(), p0)}
         sol = _solve_gait_cached(spec, st, None, use_cache, root, progress)
-    return _result_from_gait("c", sol)
+    return _with_stages(_result_from_gait("c", sol), [])
 
 
 def run_all(n_intervals: int = 20, degree: int = 5, traj: TrajOptSpec = TrajOptSpec(), *, use_cache: bool = True,
