@@ -1,0 +1,345 @@
+"""Chapter 5 gait studies: the MSK (Sec 5.2) and NMSK (Sec 5.3) data-tracking solves with the
+identified MTGs, the EMG mapping and comparison, and the metabolic cost.
+
+Functions
+---------
+:func:`ch5_spec`            the Ch 5 specs: MSK Eq 5.33 (Table 5.3) and NMSK Eq 5.55
+                            (Table 5.9, τ_act, c3, s1, s2 identified, EMG guess), with our
+                            identified MTG set (``mtg_params="ch5"``) and the Ch 4 body and
+                            contact sets when they exist (:func:`parameter_sets`).
+:func:`solve`               solve or reload one of them (:func:`gaitlib.studies.gait.solve_cached`).
+:func:`emg_table`           the muscle ↔ EMG-channel mapping (thesis Table 5.5 muscles;
+                            Schwartz 2008 and gaitutils channels).
+:func:`emg_reference`       the EMG of both sources on the 16 excitations' names.
+:func:`excitation_scores`   predicted excitations against the EMG (shape and level).
+:func:`activation_table`    τ_act, c3, s1, s2: ours beside thesis Table 5.10.
+:func:`cot_breakdown`       the cost of transport (Eq 5.57) by term of Eq 5.38, and with the
+                            two readings of the shortening heat.
+:func:`mtb_scale_table`     the size of the Mtb term under its normalisation (Eq 5.56).
+:func:`excitation_figure`   thesis Fig 5.11.
+
+EMG: our data are not the thesis's (Bovi 2011, eight muscles with SD). Schwartz et al.
+2008 give rectus femoris, medial and lateral hamstrings, tibialis anterior and medial
+gastrocnemius with SD; the gaitutils normal envelopes give all eight of the thesis's
+muscles (gluteus maximus, rectus femoris, vasti, hamstrings, soleus, peronei,
+gastrocnemius, tibialis anterior) without SD, normalised to their peak. The mapping is
+:data:`EMG_MAP`; the NMSK guess uses the Schwartz EMG where it has the muscle (the
+transcription's ``excitation_guess="emg"``) and the inverse-MTG excitations elsewhere.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from .. import activation
+from .. import conventions as cv
+from .. import data as data_mod
+from .. import metabolics
+from .. import mtg
+from .. import params as params_mod
+from .. import transcription as tr
+from . import gait as sg
+
+__all__ = ["EMG_MAP", "THESIS_TABLE_5_10", "THESIS_COT", "THESIS_HOURS", "parameter_sets", "ch5_spec", "solve",
+           "emg_table", "emg_reference", "excitation_scores", "activation_table", "cot_breakdown",
+           "mtb_scale_table", "excitation_figure", "saturation", "synergy_cost_table"]
+
+#: Thesis muscle → (Schwartz 2008 channel stem, gaitutils channel stem, note). Channel stems
+#: are :class:`gaitlib.data.GaitData` columns without ``_r``/``_l``.
+EMG_MAP = {
+    "GM": (None, "emg_GM", "gaitutils 'Glut' (gluteus maximus)"),
+    "RF": ("emg_RF", "emg_RF", "rectus femoris in both"),
+    "VM": (None, "emg_VM", "gaitutils 'Vas' (vasti)"),
+    "BF": ("emg_LH", "emg_BF", "Schwartz lateral hamstrings (= biceps femoris); gaitutils 'Ham'"),
+    "SOL": (None, "emg_SOL", "gaitutils 'Sol'"),
+    "PL": (None, "emg_PL", "gaitutils 'Per' (peronei)"),
+    "GAM": ("emg_MG", "emg_GAM", "medial gastrocnemius in both"),
+    "TA": ("emg_TA", "emg_TA", "tibialis anterior in both"),
+}
+#: Thesis Table 5.10 (initial and identified activation parameters).
+THESIS_TABLE_5_10 = {"initial": dict(activation.ACTIVATION_INITIAL), "identified": dict(activation.ACTIVATION_IDENTIFIED)}
+#: Thesis Sec 5.3.5: COT of the NMSK natural-speed solve, J kg⁻¹ m⁻¹ (Eq 5.57).
+THESIS_COT = 1.53
+#: Thesis computation times (GPOPS-II, i7-6700): MSK Sec 5.2.2, NMSK Sec 5.3.5, hours.
+THESIS_HOURS = {"MSK": 2.0, "NMSK": 2.0}
+
+
+def parameter_sets() -> dict[str, str]:
+    """Body, contact and MTG parameter sets of the Ch 5 solves. The thesis builds Ch 5 on
+    its Ch 4 identified body and contact parameters: ours (``"ch4"``,
+    ``data/identified/ch4_child.json``) if that file exists, else the thesis's identified
+    values (body ``"thesis"``: Tables 4.15–4.16; contact ``"default"``: Tables 4.17–4.18).
+    MTGs: our Ch 5 identified set (``"ch5"``)."""
+    ch4 = params_mod.identified_path("ch4_child").is_file()
+    return {"body_params": "ch4" if ch4 else "thesis", "contact_params": "ch4" if ch4 else "default",
+            "mtg_params": "ch5"}
+
+
+def ch5_spec(model: str = "MSK", **kw) -> tr.GaitSpec:
+    """The Ch 5 data-tracking spec of ``model``: MSK → Eq 5.33 (Table 5.3); NMSK → Eq 5.55
+    (Table 5.9) with the activation parameters identified (``free_activation``, Eq 5.53,
+    Table 5.10 initial values) and the EMG guess (Sec 5.3.4). Parameter sets from
+    :func:`parameter_sets`; ``kw`` override any field."""
+    base = dict(parameter_sets())
+    if model == "NMSK":
+        base.update(free_activation=True, excitation_guess="emg")
+    base.update(kw)
+    return sg.natural_gait_spec(model, **base)
+
+
+#: Spec fields that only the NMSK model takes (dropped for its MSK warm start).
+_NMSK_ONLY = ("free_activation", "excitation_guess", "t_stim", "cost", "weights", "max_iter")
+
+
+def solve(model: str = "MSK", *, guess: str = "msk", root=None, progress: bool = False, **kw) -> tr.GaitSolution:
+    """Solve or reload :func:`ch5_spec` (solution cache keyed by spec, code, data and guess).
+
+    MSK: from the data-based guess (Sec 5.2.1). NMSK: ``guess="msk"`` (default) — warm
+    start from the Ch 5 MSK solution (solved or reloaded first with the same ``kw``): its
+    states, jerks, residuals and metatarsal torques, its MTG activations turned into
+    excitations through the inverted activation dynamics for GM, VM, SOL and PL, and the
+    delayed Schwartz EMG for RF, BF, GAM and TA (:func:`gaitlib.transcription.warm_start`);
+    ``guess="data"`` — the thesis's guess (Sec 5.3.4: states from the data, excitations from
+    the EMG where we have it). Measured here (2026-11-22, 2 shared cores under load, body
+    "thesis", contact "default", MTG "ch5"): from ``"data"`` IPOPT needed 2,093 iterations
+    (767 s) and stopped at objective 0.694; from ``"msk"`` 240 iterations, objective 0.296.
+    """
+    spec = ch5_spec(model, **kw)
+    if model == "NMSK" and guess == "msk":
+        base = solve("MSK", root=root, progress=progress, **{k: v for k, v in kw.items() if k not in _NMSK_ONLY})
+        return sg.solve_cached(spec, guess=base, root=root, progress=progress)
+    if guess not in ("msk", "data"):
+        raise ValueError(f"guess must be 'msk' or 'data', got {guess!r}")
+    return sg.solve_cached(spec, root=root, progress=progress)
+
+
+# --------------------------------------------------------------------------------------
+# EMG
+# --------------------------------------------------------------------------------------
+
+
+def emg_table() -> pd.DataFrame:
+    """The mapping of the thesis's eight muscles (Table 5.5) to our EMG channels."""
+    rows = []
+    for m, (sch, gu, note) in EMG_MAP.items():
+        rows.append({"muscle": m, "name": activation.MUSCLE_NAMES[m],
+                     "MTG (Table 5.5)": activation.MUSCLE_GENERATOR[m],
+                     "Schwartz 2008 (mean ± SD)": sch or "—", "gaitutils (mean, no SD)": gu,
+                     "in the NMSK guess": "Schwartz EMG" if sch else "inverse MTG", "note": note})
+    return pd.DataFrame(rows).set_index("muscle")
+
+
+def emg_reference(speed_class: str = "Free") -> dict:
+    """EMG of both sources on the excitations' names (``GM_r`` … ``TA_l``), on the Schwartz
+    data's time grid (s).
+
+    Returns ``{'schwartz': (mean, sd), 'gaitutils': (mean, None), 'gaitutils_scale': k}``;
+    absent muscles are missing columns. The left leg is the right leg's envelope shifted by
+    the data's left-leg phase (for gaitutils, whose envelopes are each on their own leg's
+    cycle; Schwartz's left is already shifted by the loader). gaitutils envelopes (peak ≈ 1)
+    are multiplied by one factor k — the mean ratio of the Schwartz to the gaitutils peak over
+    the four muscles both sources have — so both are on the Schwartz scale.
+    """
+    sch = data_mod.load_gait_data(speed_class)
+    gu = data_mod.load_gait_data("Free", "gaitutils")
+    t = np.asarray(sch.time, float)
+    frac = t / sch.cycle_time
+    mean_s, sd_s, mean_g = {}, {}, {}
+    for m, (cs, cg, _) in EMG_MAP.items():
+        for side in cv.SIDES:
+            if cs:
+                mean_s[f"{m}_{side}"] = sch.mean[f"{cs}_{side}"].to_numpy()
+                sd_s[f"{m}_{side}"] = sch.sd[f"{cs}_{side}"].to_numpy()
+        fg = np.asarray(gu.time, float) / gu.cycle_time
+        yr = np.interp(frac, fg, gu.mean[f"{cg}_r"].to_numpy())
+        mean_g[f"{m}_r"] = yr
+        mean_g[f"{m}_l"] = np.interp(np.mod(frac - sch.left_shift, 1.0), frac, yr, period=1.0)
+    ratios = [np.max(mean_s[f"{m}_r"]) / np.max(mean_g[f"{m}_r"]) for m, (cs, _, _) in EMG_MAP.items() if cs]
+    k = float(np.mean(ratios))
+    idx = pd.Index(t, name="time")
+    return {"schwartz": (pd.DataFrame(mean_s, index=idx), pd.DataFrame(sd_s, index=idx)),
+            "gaitutils": (pd.DataFrame({c: k * v for c, v in mean_g.items()}, index=idx), None),
+            "gaitutils_scale": k}
+
+
+def excitation_scores(sol: tr.GaitSolution) -> pd.DataFrame:
+    """Predicted excitations e(t) (NMSK) against the EMG, per muscle (both legs pooled):
+    Pearson correlation of the time courses (shape) and mean levels, for each source; and
+    the share of the cycle inside the Schwartz ±1 SD band."""
+    if sol.excitations is None:
+        raise ValueError("excitation_scores needs an NMSK solution")
+    ref = emg_reference(sol.spec.speed_class)
+    ex = sol.excitations
+    tf = float(sol.stats["tf_s"])
+    rows = []
+    for m in activation.MUSCLES:
+        row = {"muscle": m}
+        sims, refs = {}, {}
+        for side in cv.SIDES:
+            c = f"{m}_{side}"
+            ts = ex.index.to_numpy() / tf
+            sims[side] = ex[c].to_numpy()
+            for src in ("schwartz", "gaitutils"):
+                mean = ref[src][0]
+                if c in mean:
+                    tr_ = mean.index.to_numpy() / mean.index[-1]
+                    refs.setdefault(src, {})[side] = np.interp(ts, tr_, mean[c].to_numpy())
+            if c in ref["schwartz"][0]:
+                mean, sd = ref["schwartz"][0][c], ref["schwartz"][1][c]
+                tr_ = mean.index.to_numpy() / mean.index[-1]
+                mu, s = np.interp(ts, tr_, mean.to_numpy()), np.interp(ts, tr_, sd.to_numpy())
+                row.setdefault("_band", []).append(np.abs(sims[side] - mu) <= s)
+        e = np.concatenate([sims[s] for s in cv.SIDES])
+        row["mean e (ours)"] = float(np.mean(e))
+        for src, lab in (("schwartz", "Schwartz"), ("gaitutils", "gaitutils")):
+            if src in refs:
+                r = np.concatenate([refs[src][s] for s in cv.SIDES])
+                row[f"r ({lab})"] = float(np.corrcoef(e, r)[0, 1]) if np.std(e) > 0 else np.nan
+                row[f"mean EMG ({lab})"] = float(np.mean(r))
+            else:
+                row[f"r ({lab})"] = np.nan
+                row[f"mean EMG ({lab})"] = np.nan
+        band = row.pop("_band", None)
+        row["% in Schwartz ±1 SD"] = 100 * float(np.mean(np.concatenate(band))) if band else np.nan
+        rows.append(row)
+    return pd.DataFrame(rows).set_index("muscle")
+
+
+def excitation_figure(sol: tr.GaitSolution, side: str = "r"):
+    """Thesis Fig 5.11: predicted excitations e(t) of one leg's eight muscles, with the
+    Schwartz EMG (mean ± 1 SD) where it has the muscle and the scaled gaitutils envelope."""
+    import matplotlib.pyplot as plt
+
+    ref = emg_reference(sol.spec.speed_class)
+    fig, axes = plt.subplots(2, 4, figsize=(13, 5), constrained_layout=True, sharex=True)
+    tf = float(sol.stats["tf_s"])
+    for ax, m in zip(axes.flat, activation.MUSCLES):
+        c = f"{m}_{side}"
+        mean, sd = ref["schwartz"]
+        if c in mean:
+            pct = 100 * mean.index / mean.index[-1]
+            ax.fill_between(pct, mean[c] - sd[c], mean[c] + sd[c], color="0.85", label="Schwartz EMG ±1 SD")
+            ax.plot(pct, mean[c], ":", color="0.3", label="Schwartz EMG mean")
+        g = ref["gaitutils"][0]
+        ax.plot(100 * g.index / g.index[-1], g[c], "--", color="tab:green", lw=1,
+                label=f"gaitutils × {ref['gaitutils_scale']:.2f}")
+        ax.plot(100 * sol.excitations.index / tf, sol.excitations[c], color="tab:red", lw=1.6,
+                label="NMSK e(t)")
+        ax.set_title(f"{m} ({activation.MUSCLE_GENERATOR[m].replace('_', ' ')})")
+        ax.set_ylim(0, max(0.85, ax.get_ylim()[1]))
+    for ax in axes[1]:
+        ax.set_xlabel("% gait cycle")
+    axes[0, 0].legend(fontsize=7)
+    return fig
+
+
+# --------------------------------------------------------------------------------------
+# Activation parameters, saturation, metabolics
+# --------------------------------------------------------------------------------------
+
+
+def activation_table(sol: tr.GaitSolution) -> pd.DataFrame:
+    """τ_act (s), c3, s1, s2: Table 5.10's initial values, ours (identified when the spec
+    frees them), the thesis's identified values (labelled), the bounds (Sec 5.3.4) and
+    whether ours sit at a bound (within 1 % of the range)."""
+    ours = sol.stats["activation_parameters"]
+    rows = []
+    for k in tr.ACTIVATION_PARAMS:
+        lo, hi = activation.ACTIVATION_BOUNDS[k]
+        v = ours[k]
+        at = "lower" if v - lo < 0.01 * (hi - lo) else ("upper" if hi - v < 0.01 * (hi - lo) else "")
+        rows.append({"parameter": k, "initial (Table 5.10)": THESIS_TABLE_5_10["initial"][k], "ours": v,
+                     "thesis, Table 5.10": THESIS_TABLE_5_10["identified"][k], "bounds": (lo, hi),
+                     "ours at bound": at})
+    return pd.DataFrame(rows).set_index("parameter")
+
+
+def synergy_cost_table(sol: tr.GaitSolution | None = None) -> pd.DataFrame:
+    """Why the synergy weights s1, s2 (Eq 5.54) run to a corner: for a given ankle-extensor
+    activation A = s1 a_SOL + s2 a_PL + (1 − s1 − s2) a_GAM, the least Act cost
+    a_SOL² + a_PL² + a_GAM² (Eq 5.55's fifth term) is A² / |w|² with w = (s1, s2, 1 − s1 − s2)
+    (Cauchy–Schwarz; attained at a ∝ w). The factor 1/|w|² is largest (3) at the thesis's
+    initial guess (1/3, 1/3) — a stationary point — and falls towards every corner of the
+    bounds [0, 0.5]². Nothing else in Eq 5.55 involves s1, s2 (no EMG term), so they are
+    not identified by data. Rows: Table 5.10's initial and identified values, ours (if
+    ``sol``), the corners."""
+    rows = {"initial (Table 5.10)": (1 / 3, 1 / 3), "thesis, Table 5.10": (0.25, 0.25)}
+    if sol is not None:
+        ap = sol.stats["activation_parameters"]
+        rows["ours"] = (ap["s1"], ap["s2"])
+    rows.update({"corner (0.5, 0.5)": (0.5, 0.5), "corner (0.5, 0)": (0.5, 0.0), "corner (0, 0): GAM only": (0.0, 0.0)})
+    out = []
+    for lab, (s1, s2) in rows.items():
+        w = np.array([s1, s2, 1 - s1 - s2])
+        out.append({"weights": lab, "s1": s1, "s2": s2, "GAM weight": 1 - s1 - s2, "Act cost / A²": 1 / float(w @ w)})
+    return pd.DataFrame(out).set_index("weights")
+
+
+def saturation(sol: tr.GaitSolution, level: float = 0.99) -> pd.Series:
+    """Share of nodes at which each of the 12 generator activations is ≥ ``level``."""
+    return (sol.activations >= level).mean()
+
+
+def _recompute_edot(sol: tr.GaitSolution, **kw) -> dict:
+    """Ė (W) of an NMSK solution's trajectory with :func:`gaitlib.metabolics.nmsk_metabolic_rate`
+    options ``kw`` (e.g. ``isometric_torque="bhargava"``), at the control nodes."""
+    U = sol.solution.phase("cycle").controls
+    q = {j: sol.q[j].to_numpy() for j in cv.JOINTS}
+    qd = {j: sol.qd[j].to_numpy() for j in cv.JOINTS}
+    ed = {m: U[f"ed_{m}"].to_numpy() for m in tr.NMSK_MUSCLES}
+    am = {m: sol.muscle_activations[m].to_numpy() for m in tr.NMSK_MUSCLES}
+    ap = sol.stats["activation_parameters"]
+    ts = dict(zip(tr.NMSK_MUSCLES, sol.stats["t_stim_s"]))
+    mtp = {f"mtp_{s}": U[f"tau_mtp_{s}"].to_numpy() for s in cv.SIDES}
+    r = metabolics.nmsk_metabolic_rate(q, qd, ed, am, tr.mtg_params_of(sol.spec), s1=ap["s1"], s2=ap["s2"],
+                                       mtp_torques=mtp, t_stim=ts, **kw)
+    return {k: np.asarray(r[k], float) * np.ones(len(sol.q)) for k in
+            ("total", "activation", "maintenance", "shortening", "basal", "work")}
+
+
+def _cot_of(sol, edot) -> float:
+    t = sol.q.index.to_numpy()
+    tf = float(sol.stats["tf_s"])
+    per = t < tf - 1e-12
+    tt = np.append(t[per], tf)
+    ee = np.append(np.asarray(edot)[per], np.asarray(edot)[per][0])
+    g = data_mod.load_gait_data(sol.spec.speed_class, sol.spec.source)
+    return metabolics.cost_of_transport(tt, ee, distance=g.speed * g.cycle_time)
+
+
+def cot_breakdown(sol: tr.GaitSolution) -> pd.DataFrame:
+    """Cost of transport (Eq 5.57, J kg⁻¹ m⁻¹) of an NMSK solution by term of Eq 5.38
+    (each term integrated alone; 'total' includes the clipping of negative non-basal
+    power, so the terms need not add up to it), for two readings of the shortening heat:
+    the thesis's Eq 5.47 as printed (isometric term 0.16 s^τ τ0 ω_f even for a relaxed
+    generator — what the NLP minimised) and Bhargava's (0.16 a s^τ τ0 t^A(θ) ω_f). Same
+    trajectory, recomputed; not re-optimised."""
+    out = {}
+    for lab, kw in (("Eq 5.47 as printed (NLP)", {}), ("Bhargava F_iso = a τ0 t^A", {"isometric_torque": "bhargava"})):
+        e = _recompute_edot(sol, **kw)
+        out[lab] = {k: _cot_of(sol, v) for k, v in e.items()}
+    df = pd.DataFrame(out)
+    df.index.name = "term of Eq 5.38"
+    return df
+
+
+def mtb_scale_table(sol: tr.GaitSolution) -> pd.DataFrame:
+    """How big the Mtb term (Eq 5.55's 8th term, Eq 5.56 normalisation) is: mean Ė, the
+    normalising range Ė_max − Ė_min, the factor t_f⁶/(BM² D⁴) with D the stride (our
+    reading of the thesis's "d") and with d = 50 ms (the delay, the other symbol named d),
+    and the resulting weighted term beside the objective."""
+    g = data_mod.load_gait_data(sol.spec.speed_class, sol.spec.source)
+    D = g.speed * g.cycle_time
+    tf = float(sol.stats["tf_s"])
+    ebar = float(sol.stats["mean_metabolic_rate_W"])
+    de = tr.MTB_COT_N * (tr.MTB_BM_MAX - tr.MTB_BM_MIN) * D / tf
+    w = sol.spec.term_weights.get("Mtb", 0.0)
+    rows = []
+    for lab, d in (("d = stride D (ours)", D), ("d = delay 0.05 s", activation.DELAY)):
+        f = tf**6 / (cv.BODY_MASS**2 * d**4)
+        rms = float(np.sqrt(np.mean(sol.metabolic["total"].to_numpy() ** 2)))
+        term = f * (rms / de) ** 2  # (1/t_f)∫ … dt ≈ mean of the integrand
+        rows.append({"reading": lab, "mean Ė (W)": ebar, "Ė_max − Ė_min (W)": de, "t_f⁶/(BM² d⁴)": f,
+                     "w·Mtb (approx.)": w * term, "objective": float(sol.stats["objective"])})
+    return pd.DataFrame(rows).set_index("reading")
