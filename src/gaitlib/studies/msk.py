@@ -22,7 +22,9 @@ EMG: our data are not the thesis's (Bovi 2011, eight muscles with SD). Schwartz 
 2008 give rectus femoris, medial and lateral hamstrings, tibialis anterior and medial
 gastrocnemius with SD; the gaitutils normal envelopes give all eight of the thesis's
 muscles (gluteus maximus, rectus femoris, vasti, hamstrings, soleus, peronei,
-gastrocnemius, tibialis anterior) without SD, normalised to their peak. The mapping is
+gastrocnemius, tibialis anterior) without SD, normalised to their peak — of which
+gluteus maximus and soleus are on/off activity windows (values 0 and 0.95), not envelopes
+(:func:`emg_reference` reports the kind). The mapping is
 :data:`EMG_MAP`; the NMSK guess uses the Schwartz EMG where it has the muscle (the
 transcription's ``excitation_guess="emg"``) and the inverse-MTG excitations elsewhere.
 """
@@ -79,11 +81,12 @@ def parameter_sets() -> dict[str, str]:
 def ch5_spec(model: str = "MSK", **kw) -> tr.GaitSpec:
     """The Ch 5 data-tracking spec of ``model``: MSK → Eq 5.33 (Table 5.3); NMSK → Eq 5.55
     (Table 5.9) with the activation parameters identified (``free_activation``, Eq 5.53,
-    Table 5.10 initial values) and the EMG guess (Sec 5.3.4). Parameter sets from
+    Table 5.10 initial values), the EMG guess (Sec 5.3.4) and at most 3,000 iterations. Parameter sets from
     :func:`parameter_sets`; ``kw`` override any field."""
     base = dict(parameter_sets())
     if model == "NMSK":
-        base.update(free_activation=True, excitation_guess="emg")
+        # max_iter 3000: from the thesis's data-based guess IPOPT needs ≈ 2,100 iterations
+        base.update(free_activation=True, excitation_guess="emg", max_iter=3000)
     base.update(kw)
     return sg.natural_gait_spec(model, **base)
 
@@ -134,8 +137,10 @@ def emg_reference(speed_class: str = "Free") -> dict:
     """EMG of both sources on the excitations' names (``GM_r`` … ``TA_l``), on the Schwartz
     data's time grid (s).
 
-    Returns ``{'schwartz': (mean, sd), 'gaitutils': (mean, None), 'gaitutils_scale': k}``;
-    absent muscles are missing columns. The left leg is the right leg's envelope shifted by
+    Returns ``{'schwartz': (mean, sd), 'gaitutils': (mean, None), 'gaitutils_scale': k,
+    'gaitutils_kind': {muscle: 'envelope' | 'on/off'}}``; absent muscles are missing
+    columns. gaitutils's gluteus maximus and soleus entries take only a few values (0 and
+    0.95 with interpolated steps): they are on/off activity windows, not envelopes. The left leg is the right leg's envelope shifted by
     the data's left-leg phase (for gaitutils, whose envelopes are each on their own leg's
     cycle; Schwartz's left is already shifted by the loader). gaitutils envelopes (peak ≈ 1)
     are multiplied by one factor k — the mean ratio of the Schwartz to the gaitutils peak over
@@ -155,18 +160,22 @@ def emg_reference(speed_class: str = "Free") -> dict:
         yr = np.interp(frac, fg, gu.mean[f"{cg}_r"].to_numpy())
         mean_g[f"{m}_r"] = yr
         mean_g[f"{m}_l"] = np.interp(np.mod(frac - sch.left_shift, 1.0), frac, yr, period=1.0)
+    kind = {m: ("on/off" if np.unique(np.round(gu.mean[f"{cg}_r"].to_numpy(), 6)).size <= 5 else "envelope")
+            for m, (_, cg, _) in EMG_MAP.items()}
     ratios = [np.max(mean_s[f"{m}_r"]) / np.max(mean_g[f"{m}_r"]) for m, (cs, _, _) in EMG_MAP.items() if cs]
     k = float(np.mean(ratios))
     idx = pd.Index(t, name="time")
     return {"schwartz": (pd.DataFrame(mean_s, index=idx), pd.DataFrame(sd_s, index=idx)),
             "gaitutils": (pd.DataFrame({c: k * v for c, v in mean_g.items()}, index=idx), None),
-            "gaitutils_scale": k}
+            "gaitutils_scale": k, "gaitutils_kind": kind}
 
 
 def excitation_scores(sol: tr.GaitSolution) -> pd.DataFrame:
     """Predicted excitations e(t) (NMSK) against the EMG, per muscle (both legs pooled):
-    Pearson correlation of the time courses (shape) and mean levels, for each source; and
-    the share of the cycle inside the Schwartz ±1 SD band."""
+    Pearson correlation of the time courses (shape; for gaitutils's on/off windows, of the
+    timing) and mean levels, for each source; the share of the cycle inside the Schwartz
+    ±1 SD band; and the mean node-to-node change |Δe| beside the EMG's on the same nodes
+    (roughness)."""
     if sol.excitations is None:
         raise ValueError("excitation_scores needs an NMSK solution")
     ref = emg_reference(sol.spec.speed_class)
@@ -202,6 +211,10 @@ def excitation_scores(sol: tr.GaitSolution) -> pd.DataFrame:
                 row[f"mean EMG ({lab})"] = np.nan
         band = row.pop("_band", None)
         row["% in Schwartz ±1 SD"] = 100 * float(np.mean(np.concatenate(band))) if band else np.nan
+        row["gaitutils kind"] = ref["gaitutils_kind"][m]
+        row["mean |Δe| per node (ours)"] = float(np.mean([np.mean(np.abs(np.diff(sims[s]))) for s in cv.SIDES]))
+        src = "schwartz" if "schwartz" in refs else "gaitutils"
+        row["mean |Δ| per node (EMG)"] = float(np.mean([np.mean(np.abs(np.diff(refs[src][s]))) for s in cv.SIDES]))
         rows.append(row)
     return pd.DataFrame(rows).set_index("muscle")
 
@@ -222,15 +235,25 @@ def excitation_figure(sol: tr.GaitSolution, side: str = "r"):
             ax.fill_between(pct, mean[c] - sd[c], mean[c] + sd[c], color="0.85", label="Schwartz EMG ±1 SD")
             ax.plot(pct, mean[c], ":", color="0.3", label="Schwartz EMG mean")
         g = ref["gaitutils"][0]
-        ax.plot(100 * g.index / g.index[-1], g[c], "--", color="tab:green", lw=1,
-                label=f"gaitutils × {ref['gaitutils_scale']:.2f}")
+        pg = 100 * g.index / g.index[-1]
+        if ref["gaitutils_kind"][m] == "on/off":
+            on = g[c].to_numpy() > 0.5 * g[c].max()
+            ax.fill_between(pg, 0, 1, where=on, transform=ax.get_xaxis_transform(), color="tab:green", alpha=0.12,
+                            label="gaitutils on window")
+        else:
+            ax.plot(pg, g[c], "--", color="tab:green", lw=1, label=f"gaitutils × {ref['gaitutils_scale']:.2f}")
         ax.plot(100 * sol.excitations.index / tf, sol.excitations[c], color="tab:red", lw=1.6,
                 label="NMSK e(t)")
         ax.set_title(f"{m} ({activation.MUSCLE_GENERATOR[m].replace('_', ' ')})")
         ax.set_ylim(0, max(0.85, ax.get_ylim()[1]))
     for ax in axes[1]:
         ax.set_xlabel("% gait cycle")
-    axes[0, 0].legend(fontsize=7)
+    handles = {}
+    for ax in axes.flat:
+        for h, lab in zip(*ax.get_legend_handles_labels()):
+            handles.setdefault(lab, h)
+    fig.legend(handles.values(), handles.keys(), loc="lower center", ncols=len(handles), fontsize=8,
+               bbox_to_anchor=(0.5, -0.06))
     return fig
 
 

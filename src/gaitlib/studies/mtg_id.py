@@ -447,9 +447,10 @@ def envelope_figure(res: MTGIdentification, sets: dict | None = None):
             ax = axes[row, col]
             for (lab, p), ls in zip(sets.items(), ("--", "-", ":")):
                 env = mtg.isometric_envelope(g, qq, _as_params(p))
-                l1, = ax.plot(qq / cv.DEG, env["active"], ls, color="0.35", lw=1.2, label=f"t^A envelope, {lab}")
-                ax.plot(qq / cv.DEG, env["passive"], ls, color="0.6", lw=1.2, label=f"t^P, {lab}")
-            ax.plot(q / cv.DEG, sh[g], "k", lw=1.6, label="demanded τ^M_exp")
+                ax.plot(qq / cv.DEG, env["active"], ls, color="0.35", lw=1.2,
+                        label=rf"$s^\tau\tau_0 t^A$ (Eq 5.24), {lab}")
+                ax.plot(qq / cv.DEG, env["passive"], ls, color="0.6", lw=1.2, label=rf"passive (Eq 5.25), {lab}")
+            ax.plot(q / cv.DEG, sh[g], "k", lw=1.6, label=r"demanded $\tau^M_{exp}$")
             ax.set_title(g.replace("_", " "))
             ax.set_xlabel(f"{j} angle (deg)")
             ax.set_ylabel("N·m")
@@ -477,7 +478,7 @@ def velocity_figure(res: MTGIdentification, sets: dict | None = None):
             ax = axes[row, col]
             for (lab, p), ls in zip(sets.items(), ("--", "-", ":")):
                 ax.plot(vv / cv.DEG, mtg.torque_velocity(g, vv, _as_params(p)), ls, color="0.35", lw=1.2,
-                        label=f"t^V limit, {lab}")
+                        label=rf"$s^\tau\tau_0 t^V$ (Eq 5.27), {lab}")
             act = mtg.demanded_active_torque(g, sh[g], q, qd, _as_params(res.params))
             ax.plot(qd / cv.DEG, act, "k.", ms=2.5, label="demanded active torque (identified)")
             ax.set_title(g.replace("_", " "))
