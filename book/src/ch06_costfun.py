@@ -42,7 +42,7 @@ from IPython.display import HTML
 
 from gaitlib import data, plots
 from gaitlib.model import ChildModel
-from gaitlib.studies import gait, predictive as pr
+from gaitlib.studies import gait, msk, predictive as pr
 
 pd.set_option("display.precision", 3)
 free = data.load_gait_data("Free")
@@ -133,9 +133,10 @@ emg_frames = {}
 if fp is not None:
     ex = fp.excitations
     cols = {}
-    for m, ch in pr.EMG_MAP["schwartz2008"].items():
+    for m, (stem, _, _) in msk.EMG_MAP.items():
         for s in "rl":
-            cols[f"emg_{ch}_{s}"] = ex[f"{m}_{s}"]
+            if stem is not None:
+                cols[f"{stem}_{s}"] = ex[f"{m}_{s}"]
     emg_frames["NMSK FP excitation"] = pd.DataFrame(cols, index=ex.index)
     chans = [c for c in cols if c in free.mean.columns]
     fig = plots.tracking_figure(free, emg_frames, channels=chans, ncols=4, data_label="EMG ±1 SD",

@@ -70,12 +70,13 @@ def _mesh(n_intervals, degree):
 
 def baseline(model: str, *, n_intervals: int = 20, degree: int = 5, root=None, progress: bool = False,
              **kw) -> tr.GaitSolution:
-    """The model's Ch 5 natural-gait data-tracking solution (MSK Eq 5.33, NMSK Eq 5.55 with
-    the activation parameters identified; :func:`gaitlib.studies.msk.ch5_spec`), solved or
-    reloaded from the cache; ``kw`` override spec fields."""
+    """The model's Ch 5 natural-gait data-tracking solution (MSK Eq 5.33; NMSK Eq 5.55 with
+    the activation parameters identified, warm-started from the MSK one):
+    :func:`gaitlib.studies.msk.solve`, solved or reloaded from the cache; ``kw`` override
+    spec fields."""
     from . import msk
 
-    return sg.solve_cached(msk.ch5_spec(model, **_mesh(n_intervals, degree), **kw), root=root, progress=progress)
+    return msk.solve(model, root=root, progress=progress, **_mesh(n_intervals, degree), **kw)
 
 
 def default_params() -> dict:
@@ -180,30 +181,28 @@ def score(sol: tr.GaitSolution, gait: data_mod.GaitData) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-#: NMSK muscle → data EMG channel (Schwartz 2008 has RF, MH, LH, TA, MG; gaitutils all 8).
-EMG_MAP = {"schwartz2008": {"RF": "RF", "BF": "LH", "GAM": "MG", "TA": "TA"},
-           "gaitutils": {m: m for m in ("GM", "RF", "VM", "BF", "SOL", "PL", "GAM", "TA")}}
-
-
 def excitation_score(sol: tr.GaitSolution, gait: data_mod.GaitData) -> pd.DataFrame:
-    """RMSE and NRMSE of the NMSK excitations e(t) against the data's EMG envelopes (both
-    dimensionless, on normalised time) for the muscles the data set has
-    (:data:`EMG_MAP`: biceps femoris ↔ lateral hamstrings, medial gastrocnemius ↔ GAM)."""
+    """RMSE and NRMSE of the NMSK excitations e(t) against ``gait``'s EMG envelopes (both
+    dimensionless, on normalised time) for the muscles that data set has (mapping
+    :data:`gaitlib.studies.msk.EMG_MAP`: e.g. BF ↔ Schwartz's lateral hamstrings)."""
+    from . import msk
+
     if sol.excitations is None:
         raise ValueError("excitation_score needs an NMSK solution")
+    col = 0 if gait.source == "schwartz2008" else 1
     tau = sol.excitations.index.to_numpy() / float(sol.stats["tf_s"])
     tg = gait.time / gait.cycle_time
     rows = []
-    for m, ch in EMG_MAP[gait.source].items():
+    for m, stems in msk.EMG_MAP.items():
+        stem = stems[col]
         for s in cv.SIDES:
-            col = f"emg_{ch}_{s}"
-            if col not in gait.mean.columns:
+            if stem is None or f"{stem}_{s}" not in gait.mean.columns:
                 continue
-            d = np.interp(tau, tg, gait.mean[col].to_numpy())
+            d = np.interp(tau, tg, gait.mean[f"{stem}_{s}"].to_numpy())
             e = sol.excitations[f"{m}_{s}"].to_numpy() - d
             rmse = float(np.sqrt(np.mean(e**2)))
-            rows.append({"kind": "excitation", "channel": m, "side": s, "emg": ch, "unit": "1", "rmse": rmse,
-                         "nrmse": rmse / max(float(np.ptp(gait.mean[col])), 1e-9)})
+            rows.append({"kind": "excitation", "channel": m, "side": s, "emg": stem, "unit": "1", "rmse": rmse,
+                         "nrmse": rmse / max(float(np.ptp(gait.mean[f"{stem}_{s}"])), 1e-9)})
     return pd.DataFrame(rows)
 
 
