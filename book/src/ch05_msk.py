@@ -131,8 +131,11 @@ tab
 stored = tr.load_mtg_params(mtg_id.PARAMS_FILE)
 prov = json.loads(mtg_id.PARAMS_FILE.read_text())["provenance"]
 dev = max(abs(getattr(stored[g], k) - getattr(ident.params[g], k)) for g in mtg.GENERATORS for k in mtg_id.GAMMA)
+same_spec = prov["spec"] == json.loads(json.dumps(ident.spec.__dict__))
 print(f"{mtg_id.PARAMS_FILE.name}: status {prov['status']}, {prov['iterations']} iterations, "
       f"spec {prov['spec']}; largest difference from this run: {dev:.2e}")
+print("the stored set IS this page's identification" if same_spec and dev < 1e-8 else
+      "STALE: the stored set is not this page's identification — rerun `python -m gaitlib.studies.mtg_id`")
 
 # %% [markdown]
 # ### Which constraints bind
@@ -441,7 +444,7 @@ print(f"• This page's solves and identifications took {time.perf_counter() - T
 # * *MSK and NMSK tracking.* Our RMSEs are several times Tables 5.4 and 5.11's, as in Ch 2:
 #   different data, contact parameters identified on other data (unless Ch 4's are used),
 #   and the right leg landing with a flexed knee. The NMSK fit is close to the MSK fit,
-#   as in the thesis, but only because it starts from it; from the thesis's data-based
+#   as in the thesis, largely because it starts from it; from the thesis's data-based
 #   guess the same NLP ends in a worse local optimum (`msk.solve` docstring).
 # * *Activation parameters.* Eq 5.55 has no EMG term, so τ_act, c3, s1, s2 are not
 #   identified by data: the effort terms decide, and push s1, s2 to a corner of their
