@@ -134,3 +134,41 @@ def test_committed_ch5_file():
     assert p == tr.load_mtg_params(mtg_id.PARAMS_FILE)
     assert tr.mtg_params_of("default") is None
     assert tr.mtg_params_of("thesis")["ankle_ext"] == mtg.THESIS_PARAMS["ankle_ext"]
+
+
+def test_gait_spec_mtg_params_reach_the_msk_dynamics():
+    """GaitSpec.mtg_params is what the MSK problem's implicit dynamics use: the dynamics
+    residual at a node equals τ_inv − MTG torques computed with that set (and differs from
+    the adult curves' where they differ)."""
+    import casadi as ca
+
+    from gaitlib import conventions as cv
+    from gaitlib.ocp import Named
+
+    spec = tr.GaitSpec(model="MSK", cost="Eq5.33", mtg_params="thesis", n_intervals=4, degree=3)
+    gp = tr.build(spec)
+    ph = gp.problem.phases[0]
+    g = gp.guess.phases["cycle"]
+    i = 40
+    x = np.array([np.asarray(g.states[k], float)[i] for k in ph.states])
+    u = np.array([np.asarray(g.controls[k], float)[i] for k in ph.controls])
+    dyn = next(c for c in ph.path_constraints if c.name == "dynamics")
+    r = np.asarray(ca.DM(dyn.fun(Named(ca.DM(x), ph.states), Named(ca.DM(u), ph.controls),
+                                 Named(ca.DM.zeros(0, 1), ()), 0.0))).ravel()
+    X = dict(zip(ph.states, x))
+    U = dict(zip(ph.controls, u))
+    q = np.array([X[c] for c in cv.COORDS])
+    qd = np.array([X[f"qd_{c}"] for c in cv.COORDS])
+    qdd = np.array([X[f"qdd_{c}"] for c in cv.COORDS])
+    tau_id = np.asarray(gp.model.function("inverse_dynamics")(q, qd, qdd, gp.p_body, gp.p_contact)[0]).ravel()
+    for params, equal in ((mtg.THESIS_PARAMS, True), (None, False)):
+        tau_in = []
+        for j in cv.JOINTS:
+            if j.startswith("mtp"):
+                tau_in.append(U[f"tau_{j}"])
+            else:
+                jn, s = j.rsplit("_", 1)
+                tau_in.append(float(mtg.joint_torque(jn, X[j], X[f"qd_{j}"], U[f"a_{jn}_ext_{s}"],
+                                                     U[f"a_{jn}_flex_{s}"], params)))
+        diff = np.abs(r[3:] - (tau_id - np.array(tau_in))).max()
+        assert (diff < 1e-9) == equal, (params is None, diff)
