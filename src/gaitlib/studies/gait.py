@@ -65,7 +65,8 @@ def solve_cached(spec: tr.GaitSpec, *, use_cache: bool = True, root=None, guess=
     desc = {"kind": "gait", **spec.to_dict()}
     if guess is not None:
         desc["warm_start"] = _guess_signature(guess)
-    where = cache.lookup("gait", desc, root, modules=())  # gait solutions depend on the CORE sources only
+    # gait solutions depend on the CORE sources, and on the effect library when effects are on
+    where = cache.lookup("gait", desc, root, modules=("gap/effects.py",) if getattr(spec, "effects", ()) else ())
     found = cache.find(where, "spec.json") if use_cache else None
     if found is not None:
         with warnings.catch_warnings():
