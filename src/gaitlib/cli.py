@@ -12,6 +12,10 @@ Commands
                      class on dask.distributed (gaitlib.sweep; a LocalCluster, or an existing
                      cluster with ``--scheduler tcp://host:port``; ``--serial`` without dask)
                      and write ``sweep.csv`` plus each run's outputs in ``DIR/<model>_<cost>_<speed>``.
+``gap --data CSV --out DIR``   sim-to-real gap diagnosis of a tidy data CSV: located gap,
+                     ranking of candidate effects, shrink; ``diagnosis.json`` + figures (gaitlib.gap)
+``gap-twin --effect NAME --magnitude X --seed N --out CSV``   a twin data set with a known
+                     injected effect, in the tidy format
 """
 
 from __future__ import annotations
@@ -145,6 +149,9 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--quiet", action="store_true", help="no IPOPT progress log")
     r.set_defaults(func=_cmd_run)
     _add_sweep_parser(sub)
+    from .gap.cli import add_parsers as _add_gap_parsers  # gaitlib gap, gaitlib gap-twin (issue 7)
+
+    _add_gap_parsers(sub)
     return p
 
 

@@ -1,2 +1,33 @@
-"""Sim-to-real gap diagnosis (work in progress)."""
-from .effects import EFFECTS  # noqa: F401
+"""Where the model misses reality: the sim-to-real gap diagnosis (issue 7).
+
+``gaitlib.gap.EFFECTS``            the registry of candidate unmodelled effects (:mod:`.effects`)
+``gaitlib.gap.locate(sol, data)``  SD-standardised residual by channel and gait phase (:mod:`.locate`)
+``gaitlib.gap.diagnose(data, …)``  re-solve with each effect, rank, shrink (:mod:`.diagnose`)
+``gaitlib.gap.make_twin(…)``       synthetic data with a known effect (:mod:`.twin`)
+``gaitlib.gap.validate_twins(…)``  the diagnosis scored on twins
+``gaitlib.gap.read_data(csv)``     any tidy CSV as a data set (:mod:`.io`)
+
+Shell: ``gaitlib gap --data CSV --out DIR`` and ``gaitlib gap-twin --effect NAME
+--magnitude X --seed N --out CSV``. Attributes load lazily (importing the package is cheap).
+"""
+
+from __future__ import annotations
+
+import importlib
+
+_LAZY = {
+    "EFFECTS": ("effects", "EFFECTS"), "TWIN_EFFECTS": ("effects", "TWIN_EFFECTS"), "Effect": ("effects", "Effect"),
+    "locate": ("locate", "locate"), "Located": ("locate", "Located"),
+    "diagnose": ("diagnose", "diagnose"), "Diagnosis": ("diagnose", "Diagnosis"),
+    "make_twin": ("twin", "make_twin"), "write_twin": ("twin", "write_twin"),
+    "validate_twins": ("twin", "validate_twins"), "read_data": ("io", "read_data"), "load_real": ("io", "load_real"),
+}
+
+__all__ = list(_LAZY)
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        mod, attr = _LAZY[name]
+        return getattr(importlib.import_module(f".{mod}", __name__), attr)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

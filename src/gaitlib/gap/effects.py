@@ -246,6 +246,36 @@ SEGMENT_INERTIA = Effect(
 )
 
 
+def _body_mass_body(pb, th, ctx):
+    k = th["k"]
+    pb = list(pb)
+    for s in ("hat",) + _LEG_SEGMENTS:
+        for pre in ("mass", "moi"):
+            i = _idx(f"{pre}_{s}")
+            pb[i] = pb[i] * (1 + k)
+    return pb
+
+
+BODY_MASS = Effect(
+    name="body_mass",
+    title="body mass differing from the data's normalising mass",
+    doc="""The data are group means of mass-normalised curves (N/kg, body weights) scaled by
+    one child's mass (41.4 kg, thesis Sec 4.1.1); the model's segment masses (Table 4.1
+    fractions, 1.001 BM in total) are its dynamic mass. If the two differ — a heavier or
+    lighter dynamic body, or a force-plate/normalisation error — the vertical GRF no longer
+    averages to the model's weight. Every segment's mass and moment of inertia is
+    multiplied by (1 + k); the data stay as they are.
+
+    Parameters
+    ----------
+    k : relative change of the whole body's mass and MOIs, 1; bounds [−0.3, 0.3]; null 0.
+    """,
+    params=(EffectParam("k", "1", -0.3, 0.3, 0.0, "relative body mass change"),),
+    twin_magnitudes=(0.02, 0.04, 0.08),
+    body=_body_mass_body,
+)
+
+
 def _hat_com_load(x, th, ctx):
     """Root wrench of the COM offset, written linear in d so that d = 0 is exactly zero:
     Δr = d R(θ) x̂; ΔF = m d e with e = θ̈ J R x̂ − θ̇² R x̂; ΔM = Δr × m (a_c + g ŷ) +
@@ -482,6 +512,18 @@ def regenerate_left(gait, shift: float, emg: bool | None = None):
                                notes=tuple(gait.notes) + (f"left leg regenerated at shift {shift:.4f}",))
 
 
+def left_generated(gait) -> bool:
+    """Whether ``gait``'s left-leg angles are the right leg's shifted by ``left_shift``
+    (order-5 Fourier, as :func:`gaitlib.data.load_gait_data` generates them)."""
+    from .. import data as data_mod
+
+    for stem in ("hip", "knee", "ankle"):
+        test = data_mod.fourier_shift(gait.mean[f"{stem}_r"].to_numpy(), gait.left_shift, _FOURIER_ORDER)
+        if not np.allclose(test, gait.mean[f"{stem}_l"].to_numpy(), atol=1e-9):
+            return False
+    return True
+
+
 def _left_shift_adjust(gait, th):
     return regenerate_left(gait, float(gait.left_shift) + float(th["delta"]))
 
@@ -500,6 +542,9 @@ LEFT_SHIFT = Effect(
     symbolic) — and the gap of a solution with this effect is computed against the data
     with the left leg regenerated at shift + δ (:func:`regenerate_left`). The metatarsal
     and HAT references are not re-shifted.
+
+    Applies only to data whose left leg *is* generated from the right one
+    (:func:`left_generated`); for data with both legs measured it is not a candidate.
 
     Parameters
     ----------
@@ -637,12 +682,13 @@ ACTIVATION_TIMING = Effect(
 
 #: The registry of candidate effects by name.
 EFFECTS: dict[str, Effect] = {e.name: e for e in (
-    SEGMENT_INERTIA, HAT_COM, ARM_SWING, FRICTION, FOOT_CONTACT, LEFT_SHIFT,
+    SEGMENT_INERTIA, BODY_MASS, HAT_COM, ARM_SWING, FRICTION, FOOT_CONTACT, LEFT_SHIFT,
     CO_CONTRACTION, JOINT_STIFFNESS, ACTIVATION_TIMING)}
 
-#: Effects that can be injected into (and diagnosed by) a twin of the SK model: those whose
-#: signature lies in the angles, torques and GRFs.
-TWIN_EFFECTS = tuple(n for n, e in EFFECTS.items() if "SK" in e.models)
+#: Effects validated on twins of the SK model: those of physics whose signature lies in the
+#: angles, torques and GRFs. (``left_shift`` concerns data whose left leg is generated from
+#: the right one; twins carry both legs, see :mod:`gaitlib.gap.twin`.)
+TWIN_EFFECTS = tuple(n for n, e in EFFECTS.items() if "SK" in e.models and e.data_adjust is None)
 
 
 # ======================================================================================

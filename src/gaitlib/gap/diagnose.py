@@ -1,0 +1,473 @@
+"""Attribute and shrink the gap: re-solve with each candidate effect, rank, report.
+
+:func:`diagnose` takes a data set (a tidy CSV, a :class:`~gaitlib.gap.io.DataSet` or
+GaitData) and a baseline model, and
+
+1. fits the baseline (objective ``"fit"``, :mod:`gaitlib.gap.solve`: the SD-standardised
+   tracking error of the located channels plus the spec's regularisation; from the data's
+   own data-based guess and, if given, warm-started from another solution — the better
+   objective is kept) and locates its gap (:func:`gaitlib.gap.locate.locate`);
+2. re-solves with every applicable candidate effect (:data:`gaitlib.gap.effects.EFFECTS`),
+   warm-started from the baseline fit, through :func:`gaitlib.sweep.sweep`:
+   ``identify="nlp"`` effects with their parameters free in the NLP; ``"profile"`` effects
+   (signature in EMG only) on a grid of fixed magnitudes, keeping the one with the smallest
+   gap; comparison-only effects (``resolve=False``) by a bounded scalar search of the gap
+   on the baseline's solution;
+3. ranks the effects by a criterion that pays for parameters and says "unexplained" when
+   none is good enough;
+4. for the top effects: the gap before/after per channel and phase, % closed, and an
+   interval from resampling the data within SD/√n.
+
+Criterion
+---------
+With z the SD-standardised residual (:mod:`gaitlib.gap.locate`) and RSS = Σ z² over the
+located channels and points, each model is scored as a Gaussian likelihood with unknown
+variance on n_eff effectively independent samples (the resel count of the baseline's
+residual, :func:`gaitlib.gap.locate.resels`): ΔAIC = n_eff ln(RSS_k / RSS_0) + 2 k and
+ΔBIC = n_eff ln(RSS_k / RSS_0) + k ln n_eff (k = parameters added; for profiled effects the
+magnitude counts as one). Raw figures (% of the RSS closed) are reported beside them.
+Effects are ranked by ΔBIC; the top effect must have ΔBIC ≤ :data:`BIC_THRESHOLD`
+("very strong" evidence on Kass & Raftery's scale) and a converged solve, else the
+diagnosis is ``"unexplained"``. Verdict ``"explained"`` if it also closes ≥ 50 % of the
+RSS, ``"partial"`` otherwise.
+
+Interval: the data's means are redrawn B times as mean + SD*/√n · g(τ) (g: smooth unit
+noise, :func:`gaitlib.gap.twin.smooth_noise`; a generated left leg gets the right leg's
+noise at its shifted time), the solutions held fixed, and % closed recomputed; the 2.5 and
+97.5 percentiles are reported. The solutions are not re-solved per draw (cost), so the
+interval covers the data's uncertainty, not the re-identification's.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .. import transcription as tr
+from . import effects as fx
+from . import io as gio
+from . import locate as L
+from .solve import solve_many
+
+__all__ = ["BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "Fit", "Diagnosis", "diagnose", "assemble",
+           "candidates", "base_spec", "as_dataset", "baseline_fits", "pick_best"]
+
+#: ΔBIC a top effect must reach (≤) to be named.
+BIC_THRESHOLD = -10.0
+#: Fixed magnitudes tried for ``identify="profile"`` effects that need a re-solve.
+PROFILE_GRID = {"co_contraction": (0.1, 0.2, 0.35, 0.5), "joint_stiffness": (-0.5, 1.0, 2.0, 3.0)}
+#: Default baseline: SK, data-tracking cost (Eq 4.11), 10 × 3 LGR.
+DEFAULT_BASE = dict(model="SK", cost="DT", n_intervals=10, degree=3)
+#: % of the RSS a named effect must close for the verdict "explained" (else "partial").
+EXPLAINED_PCT = 50.0
+
+
+def base_spec(base=None) -> tr.GaitSpec:
+    if isinstance(base, tr.GaitSpec):
+        if base.effects:
+            raise ValueError("the baseline spec must have no effects")
+        return base
+    return tr.GaitSpec(**dict(DEFAULT_BASE if base is None else base))
+
+
+def as_dataset(data, like=None, fill_from=None) -> gio.DataSet:
+    if isinstance(data, gio.DataSet):
+        return data
+    if isinstance(data, (str, Path)):
+        return gio.read_data(data, like=like, fill_from=fill_from)
+    if hasattr(data, "mean") and hasattr(data, "sd"):
+        return gio.DataSet(gait=data, label=f"{data.source} {data.speed_class}", base=data.source,
+                           n=gio.n_subjects(data.source, data.speed_class))
+    raise TypeError(f"data must be a CSV path, DataSet or GaitData, got {type(data).__name__}")
+
+
+def candidates(spec0: tr.GaitSpec, gait, effects=None) -> tuple[list, dict]:
+    """(applicable effect names, {name: reason} of those left out)."""
+    names = list(fx.EFFECTS) if effects is None else list(effects)
+    ok, skipped = [], {}
+    for n in names:
+        e = fx.EFFECTS[n]
+        if spec0.model not in e.models:
+            skipped[n] = f"not applicable to the {spec0.model} model (signature: {e.signature})"
+        elif n == "left_shift" and not fx.left_generated(gait):
+            skipped[n] = "the data's left leg is measured, not generated from the right one"
+        elif e.identify == "profile" and e.resolve and n not in PROFILE_GRID:
+            skipped[n] = "no profile grid"
+        else:
+            ok.append(n)
+    return ok, skipped
+
+
+@dataclass
+class Fit:
+    """One candidate's re-solve: its solution, identified parameters, located gap."""
+
+    effect: str
+    solution: object | None
+    thetas: dict
+    located: L.Located | None
+    n_params: int
+    identify: str
+    status: str
+    ok: bool
+    profile: list = field(default_factory=list)  # [(magnitude, rss, status)]
+
+
+def _status(sol) -> tuple[str, bool]:
+    if sol is None:
+        return "error", False
+    st = sol.stats["status"]
+    return st, st in ("Solve_Succeeded", "Solved_To_Acceptable_Level")
+
+
+def pick_best(sols: list):
+    """The converged solution with the lowest objective (else the lowest objective)."""
+    sols = [s for s in sols if s is not None]
+    if not sols:
+        return None
+    conv = [s for s in sols if _status(s)[1]]
+    pool = conv or sols
+    return min(pool, key=lambda s: s.stats["objective"])
+
+
+# ======================================================================================
+# Ranking
+# ======================================================================================
+
+def _noise_fns(located_list, rng, B: int) -> dict:
+    """Smooth unit noise draws per channel id: id → callable(τ) → (B, len τ)."""
+    from .twin import smooth_noise
+
+    ids = sorted({c for loc in located_list for c in loc.channels["channel"]})
+    return {c: smooth_noise(rng, B) for c in ids}
+
+
+def _root(ch: str) -> str:
+    return ch[:-2] + "_r" if ch.endswith("_l") else ch
+
+
+def _resampled_rss(loc: L.Located, ds, fns: dict, left_shift: float, generated: bool) -> np.ndarray:
+    """RSS of ``loc`` for each noise draw (B,): data mean + SD*/√n · g; a generated left
+    leg takes its right leg's draw at τ + ``left_shift``."""
+    n = max(ds.n, 1)
+    tot = None
+    for ch, g in loc.points.groupby("channel", sort=False):
+        tau = g["tau"].to_numpy()
+        se = g["sd_eff"].to_numpy() / np.sqrt(n)
+        if ch.endswith("_l") and generated and _root(ch) in fns:
+            eps = fns[_root(ch)](tau + left_shift)
+        else:
+            eps = fns[ch](tau)
+        z = (g["sim"].to_numpy() - (g["mean"].to_numpy() + se * eps)) / g["sd_eff"].to_numpy()
+        r = np.sum(z**2, axis=1)
+        tot = r if tot is None else tot + r
+    return tot
+
+
+def _criteria(rss0, rssk, k, n_eff):
+    lr = n_eff * math.log(max(rssk, 1e-300) / max(rss0, 1e-300))
+    return lr + 2 * k, lr + k * math.log(max(n_eff, 1.0))
+
+
+@dataclass
+class Diagnosis:
+    """The result of :func:`diagnose` (see the module docstring)."""
+
+    data: gio.DataSet
+    spec: tr.GaitSpec
+    objective: str
+    baseline: object
+    located: L.Located
+    fits: dict
+    ranking: pd.DataFrame
+    top_effect: str
+    verdict: str
+    shrink: dict
+    intervals: dict
+    skipped: dict
+    settings: dict
+    solution_located: L.Located | None = None  # the gap of a given (e.g. thesis) solution
+
+    def to_dict(self) -> dict:
+        def rec(df):
+            return json.loads(df.to_json(orient="records")) if df is not None else None
+
+        out = {
+            "data": {"label": self.data.label, "base_source": self.data.base, "speed_class": self.data.gait.speed_class,
+                     "n_subjects": self.data.n, "signature": self.data.signature, "filled": list(self.data.filled),
+                     "path": self.data.path, "notes": list(self.data.notes) + list(self.data.gait.notes)},
+            "baseline": {"spec": self.spec.to_dict(), "objective": self.objective,
+                         "stats": _stats(self.baseline)},
+            "criterion": {"rss": "sum of squared SD-standardised residuals over located channels and points",
+                          "n_eff": self.located.n_eff, "n_points": self.located.n_points,
+                          "dAIC": "n_eff ln(RSS_k/RSS_0) + 2k", "dBIC": "n_eff ln(RSS_k/RSS_0) + k ln n_eff",
+                          "threshold_dBIC": BIC_THRESHOLD, "explained_pct": EXPLAINED_PCT},
+            "located": {"summary": self.located.summary(), "table": rec(self.located.table),
+                        "channels": rec(self.located.channels)},
+            "ranking": rec(self.ranking),
+            "top_effect": self.top_effect,
+            "verdict": self.verdict,
+            "shrink": {k: {"table": rec(v), "pct_closed": float(self.ranking.set_index("effect").loc[k, "pct_closed"]),
+                           "interval_95": self.intervals.get(k)} for k, v in self.shrink.items()},
+            "skipped": self.skipped,
+            "effects": {n: {"title": e.title, "n_params": e.n_params, "identify": e.identify,
+                            "params": [p.__dict__ for p in e.params]} for n, e in fx.EFFECTS.items()},
+            "settings": self.settings,
+        }
+        if self.solution_located is not None:
+            out["solution_located"] = {"summary": self.solution_located.summary(),
+                                       "table": rec(self.solution_located.table)}
+        return out
+
+    def save(self, out, figures: bool = True) -> Path:
+        """Write ``diagnosis.json``, ``located.csv``, ``ranking.csv``, ``shrink_<effect>.csv``
+        and (``figures``) ``gap_heatmap.png``, ``ranking.png``, ``shrink.png``."""
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "diagnosis.json").write_text(json.dumps(self.to_dict(), indent=1, default=_json_default))
+        self.located.table.to_csv(out / "located.csv", index=False, float_format="%.6g")
+        self.ranking.drop(columns=["parameters"]).to_csv(out / "ranking.csv", index=False, float_format="%.6g")
+        for k, v in self.shrink.items():
+            v.to_csv(out / f"shrink_{k}.csv", index=False, float_format="%.6g")
+        if figures:
+            import matplotlib
+
+            matplotlib.use("Agg")
+            from . import figures as F
+
+            F.gap_heatmap(self.located, title=f"gap of the baseline fit — {self.data.label}").savefig(
+                out / "gap_heatmap.png", dpi=110)
+            F.ranking_bars(self.ranking, top=self.top_effect).savefig(out / "ranking.png", dpi=110)
+            if self.shrink:
+                first = next(iter(self.shrink))
+                F.shrink_heatmaps(self.located, self.fits[first].located, first).savefig(out / "shrink.png", dpi=110)
+        return out
+
+
+def _json_default(o):
+    if isinstance(o, (np.floating, np.integer)):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    return str(o)
+
+
+def _stats(sol) -> dict:
+    if sol is None:
+        return {}
+    keys = ("status", "iterations", "solve_time_s", "build_time_s", "time_per_iteration_s", "objective",
+            "max_violation", "from_cache", "objective_kind", "effects")
+    return {k: sol.stats.get(k) for k in keys if k in sol.stats}
+
+
+def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", resamples: int = 200, seed: int = 0,
+             top: int = 3, skipped=None, settings=None, solution=None) -> Diagnosis:
+    """Rank fitted candidates against the baseline fit and build the :class:`Diagnosis`."""
+    loc0 = L.locate(base_sol, ds)
+    n_eff = loc0.n_eff
+    rows = []
+    for name, f in fits.items():
+        e = fx.EFFECTS[name]
+        if f.located is None:
+            rows.append({"effect": name, "title": e.title, "n_params": f.n_params, "identify": f.identify,
+                         "parameters": f.thetas.get(name, {}), "status": f.status, "ok": False,
+                         "rss_before": loc0.rss, "rss_after": np.nan, "pct_closed": np.nan, "dAIC": np.nan,
+                         "dBIC": np.nan})
+            continue
+        rk = f.located.rss
+        daic, dbic = _criteria(loc0.rss, rk, f.n_params, n_eff)
+        rows.append({"effect": name, "title": e.title, "n_params": f.n_params, "identify": f.identify,
+                     "parameters": f.thetas.get(name, {}), "status": f.status, "ok": f.ok,
+                     "rss_before": loc0.rss, "rss_after": rk, "pct_closed": 100.0 * (1.0 - rk / loc0.rss),
+                     "dAIC": daic, "dBIC": dbic})
+    ranking = pd.DataFrame(rows)
+    if not ranking.empty:
+        ranking = ranking.sort_values("dBIC", na_position="last").reset_index(drop=True)
+        ranking.insert(0, "rank", np.arange(1, len(ranking) + 1))
+    elig = ranking[(ranking["ok"]) & (ranking["dBIC"] <= BIC_THRESHOLD)] if not ranking.empty else ranking
+    if len(elig):
+        top_effect = str(elig.iloc[0]["effect"])
+        verdict = "explained" if float(elig.iloc[0]["pct_closed"]) >= EXPLAINED_PCT else "partial"
+    else:
+        top_effect, verdict = "unexplained", "unexplained"
+    # shrink tables and intervals for the top effects
+    shrink, intervals = {}, {}
+    tops = [r["effect"] for _, r in ranking.iterrows() if r["ok"] and np.isfinite(r["dBIC"])][:top]
+    rng = np.random.default_rng(seed)
+    generated = fx.left_generated(ds.gait)
+    shift0 = float(ds.gait.left_shift)
+    fns = _noise_fns([loc0] + [fits[k].located for k in tops], rng, resamples) if resamples and tops else None
+    r0 = _resampled_rss(loc0, ds, fns, shift0, generated) if fns else None
+    for k in tops:
+        lk = fits[k].located
+        shrink[k] = _shrink_table(loc0, lk)
+        if fns:
+            delta = float(fits[k].thetas.get("left_shift", {}).get("delta", 0.0))
+            rk_b = _resampled_rss(lk, ds, fns, shift0 + delta, generated)
+            pc = 100.0 * (1.0 - rk_b / r0)
+            intervals[k] = [float(np.percentile(pc, 2.5)), float(np.percentile(pc, 97.5))]
+    if intervals:
+        ranking["pct_closed_lo"] = ranking["effect"].map(lambda k: intervals.get(k, [np.nan, np.nan])[0])
+        ranking["pct_closed_hi"] = ranking["effect"].map(lambda k: intervals.get(k, [np.nan, np.nan])[1])
+    sol_loc = L.locate(solution, ds) if solution is not None else None
+    st = dict(settings or {})
+    st.update({"resamples": resamples, "seed": seed, "bic_threshold": BIC_THRESHOLD})
+    return Diagnosis(ds, spec0, objective, base_sol, loc0, fits, ranking, top_effect, verdict, shrink, intervals,
+                     dict(skipped or {}), st, sol_loc)
+
+
+def _shrink_table(loc0: L.Located, lk: L.Located) -> pd.DataFrame:
+    a = loc0.table[["channel", "kind", "side", "phase", "n", "rms_z", "mean_z", "significant"]].rename(
+        columns={"rms_z": "rms_before", "mean_z": "mean_before", "significant": "significant_before"})
+    b = lk.table[["channel", "phase", "rms_z", "mean_z", "significant"]].rename(
+        columns={"rms_z": "rms_after", "mean_z": "mean_after", "significant": "significant_after"})
+    t = a.merge(b, on=["channel", "phase"], how="left")
+    ss0, ss1 = t["n"] * t["rms_before"] ** 2, t["n"] * t["rms_after"] ** 2
+    t["pct_closed"] = 100.0 * (1.0 - ss1 / ss0.where(ss0 > 0))
+    return t
+
+
+# ======================================================================================
+# Solving: baseline fits and candidates
+# ======================================================================================
+
+def baseline_fits(spec0, datasets: dict, warm=None, *, objective="fit", root=None, use_cache=True, chunks: int = 2,
+                  **sweep_kw) -> dict:
+    """Baseline fits of several data sets (key → DataSet): from each data set's own guess and,
+    with ``warm`` (a solution), warm-started from it; the better objective is kept.
+    Returns key → GaitSolution."""
+    keys = list(datasets)
+    groups = {}
+    for i in range(chunks):
+        part = keys[i::chunks]
+        if part:
+            groups[f"baseline-cold-{i}"] = (spec0, [(f"{k}|cold", datasets[k].gait, None) for k in part])
+            if warm is not None:
+                groups[f"baseline-warm-{i}"] = (spec0, [(f"{k}|warm", datasets[k].gait, warm) for k in part])
+    res = solve_many(groups, root=root, use_cache=use_cache, objective=objective, **sweep_kw)
+    return {k: pick_best([res.get(f"{k}|cold"), res.get(f"{k}|warm")]) for k in keys}
+
+
+def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit", root=None, use_cache=True,
+                   **sweep_kw) -> dict:
+    """Fits of every candidate on every data set: key → {effect: Fit}."""
+    groups = {}
+    for n in names:
+        e = fx.EFFECTS[n]
+        if not e.resolve:
+            continue
+        if e.identify == "nlp":
+            spec = _with_effects(spec0, ((n, None),))
+            groups[n] = (spec, [(f"{k}|{n}", ds.gait, bases[k]) for k, ds in datasets.items() if bases[k] is not None])
+        else:
+            for m in PROFILE_GRID[n]:
+                spec = _with_effects(spec0, ((n, m),))
+                groups[f"{n}@{m}"] = (spec, [(f"{k}|{n}@{m}", ds.gait, bases[k]) for k, ds in datasets.items()
+                                             if bases[k] is not None])
+    res = solve_many(groups, root=root, use_cache=use_cache, objective=objective, **sweep_kw) if groups else {}
+    recs = res.get("__records__", {})
+    out = {}
+    for k, ds in datasets.items():
+        fits = {}
+        for n in names:
+            e = fx.EFFECTS[n]
+            if not e.resolve:
+                fits[n] = _comparison_fit(n, bases[k], ds)
+            elif e.identify == "nlp":
+                sol = res.get(f"{k}|{n}")
+                st, ok = _status(sol)
+                if sol is None and n in recs and recs[n].error:
+                    st = "error"
+                th = sol.stats.get("effects", {}) if sol is not None else {}
+                loc = L.locate(sol, ds, thetas=th) if sol is not None else None
+                fits[n] = Fit(n, sol, th, loc, e.n_params, e.identify, st, ok)
+            else:
+                prof, best = [], None
+                for m in PROFILE_GRID[n]:
+                    sol = res.get(f"{k}|{n}@{m}")
+                    st, ok = _status(sol)
+                    if sol is None:
+                        prof.append((m, np.nan, st))
+                        continue
+                    th = sol.stats.get("effects", {})
+                    loc = L.locate(sol, ds, thetas=th)
+                    prof.append((m, loc.rss, st))
+                    if ok and (best is None or loc.rss < best[2].rss):
+                        best = (sol, th, loc, st)
+                if best is None:
+                    fits[n] = Fit(n, None, {}, None, e.n_params, e.identify, "no converged profile point", False, prof)
+                else:
+                    fits[n] = Fit(n, best[0], best[1], best[2], e.n_params, e.identify, best[3], True, prof)
+        out[k] = fits
+    return out
+
+
+def _with_effects(spec0, effects) -> tr.GaitSpec:
+    import dataclasses
+
+    return dataclasses.replace(spec0, effects=tuple(effects))
+
+
+def _comparison_fit(name: str, base_sol, ds) -> Fit:
+    """Comparison-only effect: bounded scalar search of the gap on the baseline solution."""
+    from scipy.optimize import minimize_scalar
+
+    e = fx.EFFECTS[name]
+    p = e.magnitude
+    sim = L.sim_channels(base_sol, ds.gait.source)
+
+    def rss(v):
+        th = e.null_theta()
+        th[p.name] = float(v)
+        return L.locate(sim, ds, thetas={name: th}).rss
+
+    r = minimize_scalar(rss, bounds=(p.lower, p.upper), method="bounded", options={"xatol": 1e-4})
+    th = e.null_theta()
+    th[p.name] = float(r.x)
+    loc = L.locate(sim, ds, thetas={name: th})
+    return Fit(name, base_sol, {name: th}, loc, e.n_params, e.identify, "Solve_Succeeded (comparison only)", True)
+
+
+# ======================================================================================
+# The entry point
+# ======================================================================================
+
+def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None, solution=None, like=None,
+             fill_from=None, resamples: int = 200, seed: int = 0, root=None, use_cache: bool = True,
+             **sweep_kw) -> Diagnosis:
+    """Diagnose the sim-to-real gap of a baseline model on a data set.
+
+    Parameters
+    ----------
+    data : a tidy CSV (``gaitlib.data`` format; read by :func:`gaitlib.gap.io.read_data`),
+        a :class:`~gaitlib.gap.io.DataSet` or a :class:`~gaitlib.data.GaitData`.
+    base : baseline :class:`~gaitlib.transcription.GaitSpec` or its fields (default
+        :data:`DEFAULT_BASE`: SK, DT, 10 × 3 LGR); its speed class must match the data's
+        speed and cycle time.
+    effects : candidate names (default: every applicable effect of :data:`EFFECTS`).
+    objective : ``"fit"`` (default) or ``"cost"`` (the spec's cost function), see
+        :mod:`gaitlib.gap.solve`.
+    warm : a solution to warm-start the baseline fit from (in addition to the cold start).
+    solution : a solution (e.g. a thesis chapter's) whose own gap is also located and reported.
+    like, fill_from : passed to :func:`gaitlib.gap.io.read_data`.
+    resamples, seed : data resampling for the % closed intervals.
+    root, use_cache : the solutions cache.
+    **sweep_kw : ``scheduler``, ``n_workers``, ``serial``, ``progress`` of :func:`gaitlib.sweep.sweep`.
+    """
+    ds = as_dataset(data, like, fill_from)
+    spec0 = base_spec(base)
+    names, skipped = candidates(spec0, ds.gait, effects)
+    b = baseline_fits(spec0, {"data": ds}, warm, objective=objective, root=root, use_cache=use_cache, **sweep_kw)
+    base_sol = b["data"]
+    if base_sol is None:
+        raise RuntimeError("the baseline fit failed (no solution returned); see the sweep's error report")
+    fits = candidate_fits(spec0, {"data": ds}, {"data": base_sol}, names, objective=objective, root=root,
+                          use_cache=use_cache, **sweep_kw)["data"]
+    settings = {"objective": objective, "candidates": names, "warm": warm is not None}
+    return assemble(ds, spec0, base_sol, fits, objective=objective, resamples=resamples, seed=seed, skipped=skipped,
+                    settings=settings, solution=solution)

@@ -1,0 +1,133 @@
+"""Figures of the gap diagnosis: channel × phase heat maps, rankings, confusion matrices."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from .locate import PHASES
+
+__all__ = ["gap_heatmap", "ranking_bars", "shrink_heatmaps", "confusion_plot", "channel_curves"]
+
+
+def _label(ch: str) -> str:
+    kind, name = ch.split(":", 1)
+    return f"{name} ({kind})"
+
+
+def _heat(ax, loc, value="rms_z", vmax=None, cmap="magma_r", title="", colorbar=True):
+    H = loc.heat(value)
+    S = loc.heat("significant").fillna(False).astype(bool)
+    data = H.to_numpy(float)
+    vmax = vmax or max(float(np.nanmax(data)) if data.size else 1.0, 1.0)
+    im = ax.imshow(data, aspect="auto", cmap=cmap, vmin=0, vmax=vmax)
+    ax.set_xticks(range(len(PHASES)), PHASES, fontsize=8)
+    ax.set_yticks(range(len(H.index)), [_label(c) for c in H.index], fontsize=7)
+    for i in range(data.shape[0]):
+        for j in range(data.shape[1]):
+            v = data[i, j]
+            if np.isfinite(v):
+                ax.text(j, i, f"{v:.1f}{'*' if S.iloc[i, j] else ''}", ha="center", va="center", fontsize=6,
+                        color="white" if v > 0.6 * vmax else "black")
+    ax.set_title(title, fontsize=9)
+    if colorbar:
+        ax.figure.colorbar(im, ax=ax, shrink=0.8, label="RMS of z (SD units)")
+    return im
+
+
+def gap_heatmap(loc, title: str = "", ax=None):
+    """Channel × phase heat map of the RMS SD-standardised residual; * = leaves the ±1 SD
+    band significantly somewhere in the cell (:mod:`gaitlib.gap.locate`)."""
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(6.5, 0.28 * len(loc.channels) + 1.6))
+    _heat(ax, loc, title=title)
+    ax.figure.tight_layout()
+    return ax.figure
+
+
+def shrink_heatmaps(loc0, loc1, effect: str, title: str = ""):
+    """Before/after heat maps (same colour scale) for one effect."""
+    import matplotlib.pyplot as plt
+
+    vmax = max(float(np.nanmax(loc0.heat().to_numpy(float))), 1.0)
+    fig, axs = plt.subplots(1, 2, figsize=(11, 0.28 * len(loc0.channels) + 1.8), sharey=True)
+    _heat(axs[0], loc0, vmax=vmax, title="baseline", colorbar=False)
+    im = _heat(axs[1], loc1, vmax=vmax, title=f"with {effect}", colorbar=False)
+    fig.colorbar(im, ax=axs, shrink=0.8, label="RMS of z (SD units)")
+    if title:
+        fig.suptitle(title, fontsize=10)
+    return fig
+
+
+def ranking_bars(ranking: pd.DataFrame, top: str | None = None, threshold: float | None = None):
+    """% of the RSS closed (raw, with interval where computed) and ΔBIC per effect."""
+    import matplotlib.pyplot as plt
+
+    from .diagnose import BIC_THRESHOLD
+
+    threshold = BIC_THRESHOLD if threshold is None else threshold
+    r = ranking.dropna(subset=["dBIC"]).iloc[::-1]
+    fig, axs = plt.subplots(1, 2, figsize=(10, 0.35 * len(r) + 1.5), sharey=True)
+    y = np.arange(len(r))
+    colors = ["tab:green" if e == top else ("tab:gray" if not ok else "tab:blue") for e, ok in zip(r["effect"], r["ok"])]
+    axs[0].barh(y, r["pct_closed"], color=colors)
+    if "pct_closed_lo" in r.columns:
+        lo, hi = r["pct_closed_lo"].to_numpy(), r["pct_closed_hi"].to_numpy()
+        m = np.isfinite(lo)
+        axs[0].errorbar(r["pct_closed"].to_numpy()[m], y[m], xerr=[r["pct_closed"].to_numpy()[m] - lo[m],
+                                                                    hi[m] - r["pct_closed"].to_numpy()[m]],
+                        fmt="none", ecolor="k", capsize=3)
+    axs[0].axvline(0, color="k", lw=0.8)
+    axs[0].set_xlabel("RSS closed (%) — raw")
+    axs[0].set_yticks(y, [f"{e} (k={int(k)})" for e, k in zip(r["effect"], r["n_params"])], fontsize=8)
+    axs[1].barh(y, r["dBIC"], color=colors)
+    axs[1].axvline(threshold, color="tab:red", ls="--", lw=1, label=f"threshold {threshold:g}")
+    axs[1].axvline(0, color="k", lw=0.8)
+    axs[1].set_xlabel("ΔBIC — penalised (lower is better)")
+    axs[1].legend(fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+def confusion_plot(conf: pd.DataFrame, title: str = ""):
+    """Injected (rows) × named (columns) counts."""
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(0.7 * conf.shape[1] + 2.5, 0.5 * conf.shape[0] + 1.8))
+    ax.imshow(conf.to_numpy(), cmap="Blues")
+    ax.set_xticks(range(conf.shape[1]), conf.columns, rotation=40, ha="right", fontsize=8)
+    ax.set_yticks(range(conf.shape[0]), conf.index, fontsize=8)
+    for i in range(conf.shape[0]):
+        for j in range(conf.shape[1]):
+            v = conf.iat[i, j]
+            if v:
+                ax.text(j, i, str(v), ha="center", va="center", fontsize=8,
+                        color="white" if v > 0.6 * conf.to_numpy().max() else "black")
+    ax.set_xlabel("named by the diagnosis")
+    ax.set_ylabel("injected")
+    ax.set_title(title, fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
+def channel_curves(loc0, loc1, channels, labels=("baseline", "with effect")):
+    """Data ±1 SD band with the baseline's and an effect's curves for a few channels."""
+    import matplotlib.pyplot as plt
+
+    n = len(channels)
+    fig, axs = plt.subplots(1, n, figsize=(3.3 * n, 2.8), squeeze=False)
+    for ax, ch in zip(axs[0], channels):
+        p0 = loc0.points[loc0.points["channel"] == ch]
+        ax.fill_between(100 * p0["tau"], p0["mean"] - p0["sd"], p0["mean"] + p0["sd"], color="0.85", label="data ±1 SD")
+        ax.plot(100 * p0["tau"], p0["mean"], color="k", lw=1)
+        ax.plot(100 * p0["tau"], p0["sim"], color="tab:red", lw=1.3, label=labels[0])
+        if loc1 is not None:
+            p1 = loc1.points[loc1.points["channel"] == ch]
+            ax.plot(100 * p1["tau"], p1["sim"], color="tab:blue", lw=1.3, ls="--", label=labels[1])
+        ax.set_title(_label(ch), fontsize=9)
+        ax.set_xlabel("% cycle")
+    axs[0][0].legend(fontsize=7)
+    fig.tight_layout()
+    return fig

@@ -1,0 +1,274 @@
+"""Solving gait problems on any data set, cached, and as sweeps.
+
+Objective. ``objective="fit"`` (the diagnosis's default) replaces the spec's tracking terms
+(Trq, Ang, GRF and the joint part of Q) by one SD-standardised tracking term over the
+located channels, ``Fit = (1/16) Σ_c ((sim_c − mean_c) / SD*_c)²`` (angles, net torques,
+GRFs, both legs; SD* as :mod:`gaitlib.gap.locate`, weight 1/4 as the thesis's tracking
+terms), and keeps the rest of the spec's cost (Jrk, Rsd, Imp, Act, Mtb, HAT; Q's HAT and
+metatarsal part as ``Qrest``). The re-solves then minimise the same measure the gap is
+ranked by — an effect's free parameters are identified by the data's likelihood rather
+than by range-normalised costs, which otherwise pull parameters to their bounds while the
+gap grows. ``objective="cost"`` keeps the spec's own cost function.
+
+A :class:`Runner` builds a spec's NLP once and re-solves it on other data sets: the
+references are NLP parameters (:func:`gaitlib.transcription.tracking_frame`), so a twin or
+a resampled data set needs no rebuild. The normalising ranges of the cost terms, the state
+bounds and the data-based part of the initial guess stay those of the spec's own data set
+(``speed_class``/``source``), which must have the same speed and cycle time; so does the
+HAT reference (pelvis height from the vertical GRF, an estimate rather than data — it
+cannot be computed for every synthetic GRF).
+
+Solutions are cached under ``<root>/gap/<key>``, the key hashing the spec, the data set's
+numbers (:func:`gaitlib.gap.io.signature`), the warm start, and the code (the
+:data:`gaitlib.cache.CORE` sources plus this module and :mod:`gaitlib.gap.effects`).
+Failed solves are cached and returned as failed (their IPOPT status is the result).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from .. import cache
+from .. import ocp
+from .. import transcription as tr
+
+__all__ = ["Runner", "solve_on", "solve_many", "guess_signature", "CACHE_MODULES", "OBJECTIVES", "FIT_WEIGHT",
+           "fit_problem"]
+
+OBJECTIVES = ("fit", "cost")
+#: IPOPT's initial barrier parameter for warm-started solves (default 0.1 would push the
+#: warm start far into the interior and often end in another local optimum).
+MU_WARM = 1e-4
+#: Weight of the SD-standardised tracking term (the thesis's tracking terms have 1/4).
+FIT_WEIGHT = 1.0
+#: Factor on the spec's non-tracking terms (Jrk, Rsd, Imp, Act, Mtb) under the Fit objective.
+REG_FACTOR = 0.1
+_KEEP = ("Jrk", "Rsd", "Imp", "Act", "Mtb")
+
+#: Sources (besides the cache's CORE) that gap solutions depend on.
+CACHE_MODULES = ("gap/effects.py", "gap/solve.py")
+
+
+def guess_signature(guess) -> str | None:
+    if guess is None:
+        return None
+    if isinstance(guess, tr.GaitSolution):
+        guess = guess.solution
+    if isinstance(guess, ocp.Solution):
+        return f"solution:{guess.status}:{guess.objective:.12g}:{guess.iterations}"
+    raise TypeError(f"warm start must be a GaitSolution or ocp.Solution, got {type(guess).__name__}")
+
+
+def _where(spec: tr.GaitSpec, gait, guess, root, objective="fit") -> Path:
+    from .io import signature
+
+    desc = {"kind": "gap-solve", "spec": spec.to_dict(), "data": signature(gait), "guess": guess_signature(guess),
+            "objective": objective}
+    return cache.lookup("gap", desc, root, modules=CACHE_MODULES)
+
+
+def _check_same_cycle(gp, gait):
+    g0 = gp.ref.gait
+    if abs(float(g0.cycle_time) - float(gait.cycle_time)) > 1e-9 or abs(float(g0.speed) - float(gait.speed)) > 1e-9:
+        raise ValueError(f"data set has cycle time {gait.cycle_time:.4f} s / speed {gait.speed:.4f} m/s, the spec's "
+                         f"data {g0.cycle_time:.4f} s / {g0.speed:.4f} m/s: build a spec of that speed class")
+
+
+def _fit_channels():
+    ch = [(j, "x", j) for j in tr.LEG_JOINTS]
+    ch += [(f"tau_{j}", "tau_net", tr.cv.JOINTS.index(j)) for j in tr.LEG_JOINTS]
+    ch += [(g, "grf", i) for i, g in enumerate(tr.GRF_CHANNELS)]
+    return ch
+
+
+def sd_columns(gait, tau_grid) -> dict:
+    """``sd_<channel>`` columns (SD* of :mod:`gaitlib.gap.locate`) on ``tau_grid``."""
+    from .locate import SD_FLOOR, tracking_view
+
+    view = tracking_view(gait)
+    t = np.asarray(view.time, float) / float(view.cycle_time)
+    out = {}
+    for name, _, _ in _fit_channels():
+        sd = view.sd[name].to_numpy()
+        floor = SD_FLOOR * float(np.sqrt(np.mean(sd**2)))
+        if floor <= 0:
+            raise ValueError(f"data channel {name!r} has no SD: cannot standardise its residual")
+        out[f"sd_{name}"] = np.maximum(np.interp(tau_grid, t, sd), floor)
+    return out
+
+
+def fit_problem(gp) -> ocp.Problem:
+    """``gp``'s problem with the Fit objective (module docstring)."""
+    ph = gp.problem.phases[0]
+    w = gp.spec.term_weights
+    node, fx = gp.functions["node"], gp.functions["effects"]
+    rg = gp.ref.ranges
+    chans = _fit_channels()
+
+    def fit(x, u, p, t, d):
+        dd = fx.wrap_data(d, p, t) if fx is not None else d
+        n = node(x, u, p)
+        tot = 0
+        for name, src, i in chans:
+            sim = x[i] if src == "x" else n[src][i]
+            tot = tot + ((sim - dd[f"ref_{name}"]) / d[f"sd_{name}"]) ** 2
+        return tot / len(chans)
+
+    goals = [dataclasses.replace(g, weight=g.weight * REG_FACTOR) for g in ph.goals if g.name in _KEEP]
+    goals.append(ocp.Goal("Fit", weight=FIT_WEIGHT, integrand=fit, divide_by_duration=True))
+    frame = ph.data.copy()
+    for k, v in sd_columns(gp.ref.gait, frame.index.to_numpy(float)).items():
+        frame[k] = v
+    new = dataclasses.replace(ph, goals=tuple(goals), data=frame)
+    return dataclasses.replace(gp.problem, phases=(new,), name=gp.problem.name + "_fit")
+
+
+class Runner:
+    """A spec built (and transcribed, on first use) once; :meth:`solve` on any data set."""
+
+    def __init__(self, spec: tr.GaitSpec, objective: str = "fit"):
+        if objective not in OBJECTIVES:
+            raise ValueError(f"objective must be one of {OBJECTIVES}, got {objective!r}")
+        self.spec, self.objective = spec, objective
+        self.gp = tr.build(spec)
+        self.problem = fit_problem(self.gp) if objective == "fit" else self.gp.problem
+        self._T = {}
+
+    def transcription(self, warm: bool = False) -> ocp.Transcription:
+        """The NLP (built once); ``warm``: with IPOPT's ``mu_init`` = :data:`MU_WARM`."""
+        if warm not in self._T:
+            opts = self.gp.options
+            if warm:
+                opts = dataclasses.replace(opts, ipopt={**dict(opts.ipopt), "mu_init": MU_WARM})
+            self._T[warm] = ocp.transcribe(self.problem, self.gp.mesh, opts)
+        return self._T[warm]
+
+    def reference(self, gait):
+        """The spec's reference with ``gait``'s joint angles (hip: thigh in the laboratory),
+        net torques and GRFs; the HAT reference (an estimate from the spec's own data, not
+        data) is kept."""
+        from .. import kinematics
+
+        base = self.gp.ref
+        t = np.asarray(base.q.index, float)
+        if len(t) != len(gait.time) or not np.allclose(t, gait.time):
+            raise ValueError("data set's time grid differs from the spec's data (load it with gaitlib.gap.io)")
+        Q = kinematics.pose_from_data(self.gp.model, gait, t, self.gp.p_contact, penetration=0.002, thigh="lab")
+        q = base.q.copy()
+        for c in tr.cv.JOINTS:
+            q[c] = Q[:, tr.cv.COORDS.index(c)]
+        tau = gait.mean[[f"tau_{j}" for j in tr.LEG_JOINTS]].copy()
+        tau.columns = list(tr.LEG_JOINTS)
+        grf = gait.mean[list(tr.GRF_CHANNELS)].copy()
+        deriv = dict(base.deriv)
+        T = float(gait.cycle_time)
+        for c in tr.cv.JOINTS:
+            deriv[c] = tr._fourier_derivatives(q[c].to_numpy(), T, 12)
+        return dataclasses.replace(base, gait=gait, q=q, tau=tau, grf=grf, deriv=deriv)
+
+    def data_guess(self, gait) -> ocp.Guess:
+        """The data-based initial guess (thesis Sec 4.3.2) built from ``gait``'s own curves
+        (HAT: the spec's reference)."""
+        gp = self.gp
+        g = tr.initial_guess(self.spec, gp.model, self.reference(gait), gp.p_body, gp.p_contact)
+        ph0 = gp.problem.phases[0]
+        if "edot_rest" in ph0.controls:
+            g = tr._with_edot_rest_guess(g, ph0.states, ph0.controls, gp.problem.parameters, gp.functions["edot"],
+                                         gp.t_stim)
+        return g
+
+    def frame(self, gait):
+        frame = tr.tracking_frame(self.spec, self.reference(gait))
+        if self.objective == "fit":
+            for k, v in sd_columns(gait, frame.index.to_numpy(float)).items():
+                frame[k] = v
+        return frame
+
+    def solve(self, gait, guess=None) -> tr.GaitSolution:
+        """Solve on ``gait``: from its data-based guess (``guess=None``) or warm-started
+        (IPOPT ``mu_init`` :data:`MU_WARM`) from a solution."""
+        _check_same_cycle(self.gp, gait)
+        g = self.data_guess(gait) if guess is None else tr.warm_start(self.gp, guess)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ocp.SolveFailedWarning)
+            sol = self.transcription(guess is not None).solve(g, data={"cycle": self.frame(gait)})
+        out = tr.postprocess(self.gp, sol)
+        out.stats["from_cache"] = False
+        out.stats["objective_kind"] = self.objective
+        return out
+
+
+def _load(found: Path, objective: str) -> tr.GaitSolution:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ocp.SolveFailedWarning)
+        sol = tr.GaitSolution.load(found)
+    sol.stats["from_cache"] = True
+    sol.stats["objective_kind"] = objective
+    return sol
+
+
+def solve_on(spec: tr.GaitSpec, gait, guess=None, *, root=None, use_cache: bool = True,
+             runner: Runner | None = None, objective: str = "fit") -> tr.GaitSolution:
+    """Solve ``spec`` tracking ``gait`` (a GaitData) with ``objective``, warm-started from
+    ``guess``, or reload it from the cache."""
+    where = _where(spec, gait, guess, root, objective)
+    found = cache.find(where, "spec.json") if use_cache else None
+    if found is not None:
+        return _load(found, objective)
+    runner = runner or Runner(spec, objective)
+    sol = runner.solve(gait, guess)
+    if use_cache:
+        sol.save(where)
+    return sol
+
+
+def _work(arg):
+    """Sweep worker: one spec, several data sets → {key: GaitSolution}. Builds lazily (a
+    fully cached item builds nothing)."""
+    spec, jobs, root, use_cache, objective = arg
+    runner = None
+    out = {}
+    for key, gait, guess in jobs:
+        where = _where(spec, gait, guess, root, objective)
+        found = cache.find(where, "spec.json") if use_cache else None
+        if found is not None:
+            out[key] = _load(found, objective)
+            continue
+        runner = runner or Runner(spec, objective)
+        sol = runner.solve(gait, guess)
+        if use_cache:
+            sol.save(where)
+        out[key] = sol
+    return out
+
+
+def solve_many(groups: dict, *, root=None, use_cache: bool = True, objective: str = "fit", **sweep_kw) -> dict:
+    """Solve groups of jobs through :func:`gaitlib.sweep.sweep` (one item per group: its
+    spec is built once and solved on each of its data sets).
+
+    Parameters
+    ----------
+    groups : name → (spec, [(key, gait, guess), ...]); keys unique over all groups.
+    root : solutions cache (default :func:`gaitlib.cache.default_dir` of this process,
+        passed to the workers explicitly).
+    **sweep_kw : ``scheduler``, ``n_workers``, ``serial``, ``progress``.
+
+    Returns
+    -------
+    dict key → GaitSolution, plus ``"__records__"`` → {group: RunRecord} (failed groups:
+    ``ok=False`` with the traceback; a non-converged solve is a solution with its status).
+    """
+    from .. import sweep
+
+    root = str(Path(root if root is not None else cache.default_dir()).resolve())
+    items = {name: (spec, jobs, root, use_cache, objective) for name, (spec, jobs) in groups.items()}
+    recs = sweep.sweep(_work, items, **sweep_kw)
+    out: dict = {"__records__": {r.name: r for r in recs}}
+    for r in recs:
+        if r.value is not None:
+            out.update(r.value)
+    return out

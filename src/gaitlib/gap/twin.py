@@ -1,0 +1,323 @@
+"""Twins: synthetic data sets with a known, injected effect, in the tidy format.
+
+A twin of a real data set (default Schwartz 2008 *Free*) is the baseline model with one
+effect (or two) switched on at a chosen magnitude, solved tracking the real data: its
+channels become the synthetic group mean, the real data's SD its SD, and smooth noise of
+standard deviation SD/√n (n: the real data's subjects) is added — the uncertainty of a
+group mean of n children. Like the real data it has one leg (``ipsilateral``: the right
+leg of the solution); the reader generates the left leg from it with the data's time shift
+(thesis Sec 4.2.3), exactly as for the real data.
+
+Quantities written: pelvic tilt (the real data's: the model's upright HAT has no anatomical
+pelvis angle), hip/knee/ankle angles (the hip as the data's hip angle = thigh angle in the
+laboratory − pelvic tilt), the three net joint moments, the two GRF components and, for
+MSK/NMSK baselines, the EMG channels of the real data set's muscles (NMSK excitations, MSK
+generator activations). ``source`` is ``twin(<real source>)``; the truth (effect,
+magnitude, seed) goes to a separate JSON file that the diagnosis never reads.
+
+Noise: a periodic Gaussian process per quantity with a squared-exponential correlation of
+length :data:`NOISE_LENGTH` (fraction of the cycle; group-mean curves are smooth) and
+marginal SD = SD(τ)/√n — :func:`smooth_noise`.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .. import conventions as cv
+from .. import data as data_mod
+from .. import transcription as tr
+from . import io as gio
+from .effects import EFFECTS
+
+__all__ = ["NOISE_LENGTH", "smooth_noise", "twin_spec", "twin_frame", "make_twin", "write_twin", "DEFAULT_BASE"]
+
+#: Correlation length of the twin and resampling noise, fraction of the cycle.
+NOISE_LENGTH = 0.05
+#: Default baseline of twins: SK data tracking on a coarse mesh (10 × 3 LGR).
+DEFAULT_BASE = dict(model="SK", cost="DT", n_intervals=10, degree=3)
+_N_HARM = 20
+
+
+def smooth_noise(rng: np.random.Generator, n_curves: int, length: float = NOISE_LENGTH):
+    """Random periodic curves with unit marginal variance and squared-exponential
+    correlation exp(−Δ²/(2ℓ²)) (Δ: cycle fraction, wrapped), as a callable τ → (n_curves,
+    len(τ)). A random Fourier series whose harmonic variances are the kernel's spectrum
+    (∝ exp(−(2πkℓ)²/2)), normalised to unit variance."""
+    k = np.arange(0, _N_HARM + 1)
+    w = np.exp(-0.5 * (2 * np.pi * k * length) ** 2)
+    w[0] *= 0.5
+    w = w / w.sum()
+    a = rng.standard_normal((n_curves, k.size)) * np.sqrt(w)
+    b = rng.standard_normal((n_curves, k.size)) * np.sqrt(w)
+    b[:, 0] = 0.0  # Var = Σ_k w_k = 1 (w_0 = s(0)/2, w_k = s(k): the one-sided spectrum)
+
+    def f(tau):
+        ph = 2 * np.pi * np.outer(k, np.asarray(tau, float))
+        return a @ np.cos(ph) + b @ np.sin(ph)
+
+    return f
+
+
+def twin_spec(effects: tuple, base: dict | None = None) -> tr.GaitSpec:
+    """The spec that generates a twin: the baseline with ``effects`` ((name, magnitude), …)."""
+    base = dict(DEFAULT_BASE if base is None else base)
+    return tr.GaitSpec(**base, effects=tuple(effects))
+
+
+_ANGLE_Q = {"hip": "hip_flexion", "knee": "knee_flexion", "ankle": "ankle_dorsiflexion"}
+_MOMENT_Q = {"hip": "hip_extensor_moment", "knee": "knee_extensor_moment", "ankle": "ankle_plantarflexor_moment"}
+
+
+def twin_frame(sol: tr.GaitSolution, real: gio.DataSet, seed: int | None, *, noise: bool = True,
+               length: float = NOISE_LENGTH) -> pd.DataFrame:
+    """The tidy rows of a twin from a solved model (both legs, sides ``R``/``L``; 51 points;
+    data units and signs).
+
+    SD = the real data's SD of the same channel (left leg: the real data's, as generated);
+    noise as :func:`smooth_noise` × SD/√n (``seed``; ``noise=False``: the clean curves)."""
+    from .locate import sim_channels
+
+    gait = real.gait
+    sim = sim_channels(sol, gait.source)
+    tau = np.linspace(0.0, 1.0, 51)
+    ts = sim.index.to_numpy(float)
+    t_data = np.asarray(gait.time, float) / float(gait.cycle_time)
+
+    def at(col):
+        ext = np.concatenate([ts - 1.0, ts, ts + 1.0])
+        return np.interp(np.mod(tau, 1.0), ext, np.tile(sim[col].to_numpy(), 3))
+
+    def real_sd(col):
+        return np.interp(tau, t_data, gait.sd[col].to_numpy())
+
+    pelvis_model = np.interp(tau, t_data, gait.mean["pelvis_tilt"].to_numpy())
+    values, sd = {}, {}
+    stems = [(j, q) for j, q in _ANGLE_Q.items()] + [(f"tau_{j}", q) for j, q in _MOMENT_Q.items()] \
+        + [("grf_x", "grf_anterior"), ("grf_y", "grf_vertical")]
+    for s_, side in (("r", "R"), ("l", "L")):
+        for stem, q in stems:
+            v = at(f"{stem}_{s_}")
+            if stem == "hip":  # q_hip is the thigh in the laboratory; the data's hip is relative to the pelvis
+                v = v - pelvis_model
+            values[(q, side)] = gio.model_to_data_units(stem, v, gait.body_mass)
+            sd[(q, side)] = np.abs(gio.model_to_data_units(stem, real_sd(f"{stem}_{s_}"), gait.body_mass))
+        for c in sim.columns:
+            if c.startswith("emg_") and c.endswith(f"_{s_}") and c in gait.sd.columns:
+                values[(c[:-2], side)] = at(c)
+                sd[(c[:-2], side)] = real_sd(c)
+    if noise:
+        rng = np.random.default_rng(seed)
+        keys = list(values)
+        g = smooth_noise(rng, len(keys), length)(tau)
+        g[:, -1] = g[:, 0]  # 100 % = 0 %
+        for i, k in enumerate(keys):
+            values[k] = values[k] + g[i] * sd[k] / np.sqrt(max(real.n, 1))
+    values[("pelvis_anterior_tilt", "ipsilateral")] = gio.model_to_data_units("pelvis_tilt", pelvis_model,
+                                                                               gait.body_mass)
+    sd[("pelvis_anterior_tilt", "ipsilateral")] = np.abs(gio.model_to_data_units(
+        "pelvis_tilt", real_sd("pelvis_tilt"), gait.body_mass))
+    return gio.to_tidy(values, sd, f"twin({real.base})", gait.speed_class, tau * 100)
+
+
+def make_twin(effects, seed: int = 0, *, base: dict | None = None, real: gio.DataSet | None = None,
+              root=None, use_cache: bool = True, noise: bool = True,
+              objective: str = "fit") -> tuple[pd.DataFrame, dict]:
+    """A twin data set: (tidy DataFrame, truth dict).
+
+    Parameters
+    ----------
+    effects : ((name, magnitude), …) — one effect, two, or none (the baseline's own twin).
+    seed : noise seed.
+    base : baseline spec fields (default :data:`DEFAULT_BASE`: SK, DT, 10 × 3 LGR).
+    real : the real data set (default Schwartz 2008 of the baseline's speed class).
+    objective : ``"fit"`` (the model with the effect fitted to the real data) or ``"cost"``
+        (the spec's cost function), :mod:`gaitlib.gap.solve`.
+    """
+    from .solve import solve_on
+
+    spec = twin_spec(effects, base)
+    real = real or gio.load_real(spec.speed_class, spec.source)
+    sol = solve_on(spec, real.gait, root=root, use_cache=use_cache, objective=objective)
+    frame = twin_frame(sol, real, seed, noise=noise)
+    truth = {"effects": [[n, m] for n, m in effects], "seed": seed, "base": spec.to_dict(),
+             "real": real.label, "n_subjects": real.n, "noise_length": NOISE_LENGTH,
+             "status": sol.stats["status"], "iterations": sol.stats["iterations"],
+             "objective": sol.stats["objective"], "objective_kind": objective}
+    return frame, truth
+
+
+def write_twin(path, effects, seed: int = 0, **kw) -> Path:
+    """Write a twin's tidy CSV to ``path`` and its truth to ``<path stem>.truth.json``."""
+    frame, truth = make_twin(effects, seed, **kw)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    frame.to_csv(path, index=False, float_format="%.8g")
+    path.with_suffix(".truth.json").write_text(json.dumps(truth, indent=1, default=str))
+    return path
+
+
+# ======================================================================================
+# Validation: the diagnosis on twins whose effect is withheld
+# ======================================================================================
+
+#: Objective that generates twins: the spec's own cost function (a smooth, thesis-like gait
+#: of the model with the effect on the real data).
+GEN_OBJECTIVE = "cost"
+
+
+def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), base: dict | None = None,
+                   real: gio.DataSet | None = None, objective: str = "fit", gen_objective: str = GEN_OBJECTIVE,
+                   out_dir=None, root=None, use_cache: bool = True, resamples: int = 0, **sweep_kw):
+    """Generate twins (each effect × magnitude × seed, plus the effect-free twin of each
+    seed), diagnose each with the baseline model only, and score the diagnosis.
+
+    Returns a :class:`TwinValidation`. Cost: (#twins + #seeds) twin solves, 2 baseline fits
+    per twin (cold + warm start) and one re-solve per candidate per twin, all through
+    :func:`gaitlib.sweep.sweep` (one item per spec, built once and re-solved on every twin
+    by swapping the NLP's data).
+    """
+    from . import diagnose as D
+    from .solve import solve_many, solve_on
+
+    effects = tuple(effects or TWIN_EFFECTS_DEFAULT())
+    base = dict(DEFAULT_BASE if base is None else base)
+    spec0 = tr.GaitSpec(**base)
+    real = real or gio.load_real(spec0.speed_class, spec0.source)
+    mags = {e: tuple(magnitudes[e]) if magnitudes and e in magnitudes else EFFECTS[e].twin_magnitudes for e in effects}
+    # 1. generate: one solve per (effect, magnitude) and the effect-free one
+    gen = {"none": ()}
+    for e in effects:
+        for i, m in enumerate(mags[e]):
+            gen[f"{e}@{i}"] = ((e, m),)
+    groups = {k: (twin_spec(v, base), [(f"gen|{k}", real.gait, None)]) for k, v in gen.items()}
+    res = solve_many(groups, root=root, use_cache=use_cache, objective=gen_objective, **sweep_kw)
+    out_dir = Path(out_dir) if out_dir is not None else None
+    datasets, truth = {}, {}
+    gen_stats = {}
+    for k, v in gen.items():
+        sol = res.get(f"gen|{k}")
+        gen_stats[k] = {"status": sol.stats["status"] if sol is not None else "error",
+                        "iterations": sol.stats.get("iterations") if sol is not None else None,
+                        "solve_time_s": sol.stats.get("solve_time_s") if sol is not None else None}
+        if sol is None:
+            continue
+        for seed in seeds:
+            key = f"{k}#{seed}"
+            frame = twin_frame(sol, real, seed)
+            if out_dir is not None:
+                out_dir.mkdir(parents=True, exist_ok=True)
+                p = out_dir / f"twin_{k.replace('@', '_m')}_s{seed}.csv"
+                frame.to_csv(p, index=False, float_format="%.8g")
+                datasets[key] = gio.read_data(p)
+            else:
+                import tempfile
+
+                with tempfile.TemporaryDirectory() as td:
+                    p = Path(td) / "twin.csv"
+                    frame.to_csv(p, index=False, float_format="%.8g")
+                    datasets[key] = gio.read_data(p)
+            truth[key] = {"effects": v, "seed": seed, "level": (int(k.split("@")[1]) if "@" in k else None)}
+    # 2. the baseline fits (cold and warm from the baseline's fit of the real data)
+    warm = solve_on(spec0, real.gait, root=root, use_cache=use_cache, objective=objective)
+    bases = D.baseline_fits(spec0, datasets, warm, objective=objective, root=root, use_cache=use_cache, **sweep_kw)
+    # 3. candidates: every twin effect, re-solved on every twin
+    names, _ = D.candidates(spec0, next(iter(datasets.values())).gait, effects)
+    fits = D.candidate_fits(spec0, datasets, bases, names, objective=objective, root=root, use_cache=use_cache,
+                            **sweep_kw)
+    # 4. diagnose each twin
+    diags = {}
+    for key, ds in datasets.items():
+        if bases[key] is None:
+            continue
+        diags[key] = D.assemble(ds, spec0, bases[key], fits[key], objective=objective, resamples=resamples,
+                                settings={"twin": key})
+    return TwinValidation.build(diags, truth, mags, gen_stats, settings={
+        "base": spec0.to_dict(), "objective": objective, "gen_objective": gen_objective, "seeds": list(seeds),
+        "effects": list(effects), "magnitudes": {e: list(v) for e, v in mags.items()}, "real": real.label,
+        "n_subjects": real.n, "noise_length": NOISE_LENGTH})
+
+
+def TWIN_EFFECTS_DEFAULT():
+    from .effects import TWIN_EFFECTS
+
+    return TWIN_EFFECTS
+
+
+class TwinValidation:
+    """Scores of the diagnosis on twins.
+
+    ``rows``: one per twin — injected effect and magnitude (level 0/1/2 = small/middle/
+    large), seed, the diagnosis's top effect and verdict, correct (top = injected; for the
+    effect-free twin: "unexplained"), RSS of the baseline fit, of the effect-free twin with
+    the same seed (RSS_0), of the top effect and of the true effect, % of the RSS closed,
+    and the shrink of the *injected* gap, (RSS_base − RSS_top) / (RSS_base − RSS_0); the
+    true effect's identified magnitude. ``confusion``: injected × named counts.
+    """
+
+    def __init__(self, rows: pd.DataFrame, diags: dict, gen_stats: dict, settings: dict):
+        self.rows, self.diags, self.gen_stats, self.settings = rows, diags, gen_stats, settings
+
+    @classmethod
+    def build(cls, diags, truth, mags, gen_stats, settings):
+        rows = []
+        for key, d in diags.items():
+            t = truth[key]
+            inj = t["effects"][0][0] if t["effects"] else "none"
+            mag = t["effects"][0][1] if t["effects"] else 0.0
+            seed = t["seed"]
+            d0 = diags.get(f"none#{seed}")
+            rss0 = d0.located.rss if d0 is not None else np.nan
+            rk = d.ranking.set_index("effect")
+            rss_b = d.located.rss
+            rss_top = float(rk.loc[d.top_effect, "rss_after"]) if d.top_effect in rk.index else rss_b
+            rss_true = float(rk.loc[inj, "rss_after"]) if inj in rk.index else np.nan
+            inj_gap = rss_b - rss0
+            true_mag = np.nan
+            if inj in d.fits and d.fits[inj].thetas.get(inj):
+                true_mag = float(next(iter(d.fits[inj].thetas[inj].values())))
+            rows.append({
+                "twin": key, "injected": inj, "magnitude": mag, "level": t["level"], "seed": seed,
+                "top": d.top_effect, "verdict": d.verdict,
+                "correct": (d.top_effect == inj) if inj != "none" else (d.top_effect == "unexplained"),
+                "rss_base": rss_b, "rss_0": rss0, "rss_top": rss_top, "rss_true": rss_true,
+                "pct_closed_top": 100.0 * (1 - rss_top / rss_b),
+                "shrink_injected_top": 100.0 * (rss_b - rss_top) / inj_gap if inj != "none" and inj_gap > 0 else np.nan,
+                "shrink_injected_true": 100.0 * (rss_b - rss_true) / inj_gap if inj != "none" and inj_gap > 0 else np.nan,
+                "identified_magnitude": true_mag,
+                "dBIC_top": float(rk.loc[d.top_effect, "dBIC"]) if d.top_effect in rk.index else np.nan,
+                "dBIC_true": float(rk.loc[inj, "dBIC"]) if inj in rk.index else np.nan,
+                "n_eff": d.located.n_eff,
+            })
+        return cls(pd.DataFrame(rows), diags, gen_stats, settings)
+
+    @property
+    def confusion(self) -> pd.DataFrame:
+        r = self.rows
+        labels = list(dict.fromkeys(list(self.settings["effects"]) + ["none"]))
+        cols = list(dict.fromkeys(list(self.settings["effects"]) + ["unexplained"]))
+        c = pd.crosstab(r["injected"], r["top"]).reindex(index=labels, columns=cols, fill_value=0)
+        extra = [x for x in r["top"].unique() if x not in cols]
+        for x in extra:
+            c[x] = pd.crosstab(r["injected"], r["top"]).reindex(index=labels, fill_value=0)[x]
+        return c.fillna(0).astype(int)
+
+    def accuracy(self) -> pd.DataFrame:
+        """Top-1 accuracy and mean shrink of the injected gap per magnitude level."""
+        r = self.rows[self.rows["injected"] != "none"]
+        g = r.groupby("level")
+        out = pd.DataFrame({"twins": g.size(), "top-1 accuracy (%)": 100 * g["correct"].mean(),
+                            "mean shrink of injected gap, top (%)": g["shrink_injected_top"].mean(),
+                            "mean shrink of injected gap, true effect (%)": g["shrink_injected_true"].mean()})
+        out.index = out.index.map({0: "small", 1: "middle", 2: "large"})
+        return out
+
+    def to_dict(self) -> dict:
+        return {"rows": json.loads(self.rows.to_json(orient="records")),
+                "confusion": json.loads(self.confusion.to_json()),
+                "accuracy": json.loads(self.accuracy().to_json()),
+                "generation": self.gen_stats, "settings": self.settings}
