@@ -25,8 +25,12 @@ Starting points (our choice; the thesis started (a) and (b) from Brown & McPhee'
 parameters, which we could not obtain — ``shared/design/model-facts.md``): the *neutral*
 start :func:`neutral_start` — the centre of each Table 4.7 box (k_v at its geometric
 centre, 3.2·10⁶ N/m³) with the thesis's friction guess μ_s = 0.40, μ_d = 0.35 (Sec 4.3.1) —
-is (a)'s first start and (b)'s guess. (c) is warm-started from (b)'s solution (states,
-controls and contact parameters; the body parameters start at their Sec 4.1.1 values).
+is (a)'s first start and (b)'s guess (with the data-based guess of Sec 4.3.2 for the states
+and controls). (b) is reached through a continuation on the residual bounds
+(:data:`CONTINUATION`), because from the neutral start the exact problem stopped at IPOPT's
+iteration limit, infeasible. (c) is warm-started from
+(b)'s solution (states, controls and contact parameters; the body parameters start at their
+Sec 4.1.1 values).
 The thesis's identified values (Tables 4.17–4.18) are **not** used as a start; they enter
 only through the HAT-height reference of the tracked kinematics (the height at which that
 contact, at rest, carries the data's vertical GRF — the public data have no pelvis marker),
@@ -73,13 +77,14 @@ __all__ = [
     "neutral_start", "thesis_params", "trajectory_optimization", "spec_b", "spec_c", "optimal_control",
     "optimal_control_body", "run_all",
     "rmse_table", "rmse_beside_thesis", "solver_table", "geometry_table", "contact_table",
-    "body_table", "at_bounds", "friction_ratios", "residual_rms", "grf_fit",
+    "body_table", "at_bounds", "friction_ratios", "residual_rms", "grf_fit", "dynamic_consistency", "grf_error_by_phase",
     "save_identified", "identified_vs_result",
 ]
 
 #: The three approaches: key → label used in tables and figures.
 APPROACHES = {"a": "(a) trajectory optimisation", "b": "(b) optimal control",
-              "c": "(c) optimal control + body parameters"}
+              "c": "(c) optimal control + body parameters",
+              "c_wide": "(c′) = (c) with Table 4.7 widened to the thesis's (c) values"}
 
 #: Friction-ratio bounds of Eq 4.4 (μ_d / μ_s), thesis Sec 4.3.1.
 MU_RATIO = (0.55, 0.99)
@@ -132,6 +137,11 @@ THESIS_CONTACT_SOURCE = {"a": "thesis Table 4.12", "b": "thesis Table 4.13", "c"
 #: Thesis compute times (Intel i7-6700, MATLAB): Sec 4.3.3 and Sec 4.4.2.
 THESIS_TIME = {"a": "6 min (Sec 4.3.3, GlobalSearch)", "b": "11 min (Sec 4.3.3, GPOPS-II)",
                "c": "5 h (Sec 4.4.2, GPOPS-II)"}
+
+# (c′) is approach (c) with other bounds: the thesis's (c) is its reference
+for _d in (THESIS_RMSE, THESIS_RMSE_SOURCE, THESIS_GEOMETRY, THESIS_GEOMETRY_SOURCE, THESIS_CONTACT,
+           THESIS_CONTACT_SOURCE, THESIS_TIME):
+    _d["c_wide"] = _d["c"]
 
 _GEOM = ("a", "b", "c", "r_x", "r_y", "r_z", "gamma", "beta", "alpha")
 _GEOM_UNIT = ("mm",) * 6 + ("deg",) * 3
@@ -489,8 +499,9 @@ def trajectory_optimization(spec: TrajOptSpec = TrajOptSpec(), *, use_cache: boo
     where = _cache_dir("contact_id", desc, root, modules=None)
     prob = problem
     f = where / "result.json"
-    if use_cache and f.exists():
-        rec = json.loads(f.read_text())
+    found = cache.find(where, "result.json") if use_cache else None
+    if found is not None:
+        rec = json.loads((found / "result.json").read_text())
         prob = prob or InverseDynamicsID(spec)
         return _result_a(prob, rec, from_cache=True)
     prob = prob or InverseDynamicsID(spec)
@@ -540,37 +551,45 @@ def _result_a(prob: InverseDynamicsID, rec: dict, from_cache: bool) -> ApproachR
                           fr["ellipsoids"], rmse, stats, starts=starts)
 
 
-def spec_b(n_intervals: int = 20, degree: int = 5, **kw) -> tr.GaitSpec:
+def spec_b(n_intervals: int = 20, degree: int = 5, contact_bounds: str = "table4.7", **kw) -> tr.GaitSpec:
     """Approach (b): SK, Eq 4.11 (Table 4.8 weights), 39 contact parameters free within
     Table 4.7 verbatim and Eq 4.4; Eq 4.8 residual bounds; thesis mesh 20 × 5 LGR."""
-    return tr.GaitSpec(model="SK", cost="Eq4.11", free_contact=True, contact_bounds="table4.7",
+    return tr.GaitSpec(model="SK", cost="Eq4.11", free_contact=True, contact_bounds=contact_bounds,
                        n_intervals=n_intervals, degree=degree, **kw)
 
 
-def spec_c(n_intervals: int = 20, degree: int = 5, **kw) -> tr.GaitSpec:
+def spec_c(n_intervals: int = 20, degree: int = 5, contact_bounds: str = "table4.7", **kw) -> tr.GaitSpec:
     """Approach (c): (b) + the 25 body/joint parameters free (Table 4.14), per-ellipsoid
     normal force ≥ 0 (Sec 4.4.1), cost Eq 4.13 (Eq 4.11 + Imp Eq 4.12 + Rsd Eq 4.13,
-    w5 = w6 = 1/4)."""
+    w5 = w6 = 1/4). ``contact_bounds="widened"``: Table 4.7 widened to contain the thesis's
+    own (c) values (Table 4.17, five of which lie outside Table 4.7 — the bounds the thesis
+    must have used in Sec 4.4, unreported)."""
     return tr.GaitSpec(model="SK", cost="Eq4.13", free_contact=True, free_body=True,
-                       normal_force_constraint=True, contact_bounds="table4.7",
+                       normal_force_constraint=True, contact_bounds=contact_bounds,
                        n_intervals=n_intervals, degree=degree, **kw)
+
+
+#: How a cold-started (b)/(c) guess is built; part of the cache key of those solves (which
+#: otherwise depend on the CORE sources only): change it with the method.
+GUESS_METHOD = "data-based guess of the spec (states, jerks, data torques, zero residuals) + start parameters (v1)"
 
 
 def _solve_gait_cached(spec: tr.GaitSpec, start: dict, warm: tr.GaitSolution | None, use_cache: bool, root,
                        progress: bool = False) -> tr.GaitSolution:
     """Solve ``spec`` from the data-based guess with the parameters ``start`` (name → value)
     or warm-started from ``warm``; cached on spec + start + warm start's identity + code."""
-    desc = {"kind": "contact_id_gait", **spec.to_dict(),
+    desc = {"kind": "contact_id_gait", **spec.to_dict(), "guess": GUESS_METHOD,
             "start": {k: float(np.format_float_positional(v, 12)) for k, v in sorted(start.items())}}
     if warm is not None:
         ws = warm.solution
         desc["warm_start"] = {"spec": warm.spec.to_dict(), "status": ws.status,
                               "objective": float(f"{ws.objective:.12g}"), "iterations": ws.iterations}
     where = _cache_dir("contact_id", desc, root, modules=())
-    if use_cache and (where / "spec.json").exists():
+    found = cache.find(where, "spec.json") if use_cache else None
+    if found is not None:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ocp.SolveFailedWarning)
-            sol = tr.GaitSolution.load(where)
+            sol = tr.GaitSolution.load(found)
         sol.stats["from_cache"] = True
         return sol
     gp = tr.build(spec)
@@ -657,7 +676,8 @@ def optimal_control_body(spec: tr.GaitSpec | None = None, warm: ApproachResult |
     """Approach (c) (Sec 4.4): :func:`spec_c`, warm-started from (b)'s solution ``warm``
     (states, controls, contact parameters; body parameters from their Sec 4.1.1 values), or
     — without ``warm`` — from the data-based guess with contact parameters ``start``
-    (default :func:`neutral_start`)."""
+    (default :func:`neutral_start`). The result's key is ``"c"``, or ``"c_wide"`` for a spec
+    with ``contact_bounds="widened"`` (:func:`spec_c`)."""
     spec = spec or spec_c()
     if warm is not None:
         if warm.solution is None:
@@ -667,7 +687,8 @@ def optimal_control_body(spec: tr.GaitSpec | None = None, warm: ApproachResult |
         p0 = neutral_start() if start is None else np.asarray(start, float)
         st = {f"c.{n}": float(v) for n, v in zip(contact_mod.param_names(), p0)}
         sol = _solve_gait_cached(spec, st, None, use_cache, root, progress)
-    return _with_stages(_result_from_gait("c", sol), [])
+    key = "c" if spec.contact_bounds == "table4.7" else "c_wide"
+    return _with_stages(_result_from_gait(key, sol), [])
 
 
 def run_all(n_intervals: int = 20, degree: int = 5, traj: TrajOptSpec = TrajOptSpec(), *, use_cache: bool = True,
@@ -683,6 +704,81 @@ def run_all(n_intervals: int = 20, degree: int = 5, traj: TrajOptSpec = TrajOptS
 # --------------------------------------------------------------------------------------
 # Tables
 # --------------------------------------------------------------------------------------
+
+
+def _kinematics(res: ApproachResult):
+    """(t, Q, QD, QDD) of a result at its frame times (arrays 11 × n)."""
+    t = res.q.index.to_numpy(dtype=float)
+    if res.solution is None:  # (a): the fixed reference kinematics of the problem
+        gait = data_mod.load_gait_data("Free")
+        ref = tr.reference(gait, ChildModel(), contact_mod.default_params())
+        d = {c: ref.deriv[c](t) for c in cv.COORDS}
+        return t, *(np.array([d[c][k] for c in cv.COORDS]) for k in range(3))
+    X = res.solution.solution.phase("cycle").interpolate(t)
+    return (t, X[list(cv.COORDS)].to_numpy().T, X[[f"qd_{c}" for c in cv.COORDS]].to_numpy().T,
+            X[[f"qdd_{c}" for c in cv.COORDS]].to_numpy().T)
+
+
+def dynamic_consistency(results: dict[str, ApproachResult]) -> pd.DataFrame:
+    """How far the data's GRFs are from what each approach's *kinematics* require.
+
+    For the floating base, inverse dynamics with no ground load gives the total external
+    force the motion needs: F_x = m ẍ_com, F_y = m (ÿ_com + g). With the pelvis residuals
+    (near) zero, as in (b) and (c), the two feet's simulated forces must add up to it, so the
+    mismatch E(t) = F(t) − (GRF_r + GRF_l)_data(t) is an error no contact parameters can
+    remove: the two feet's errors add up to E, hence the quadratic mean of their RMSEs is at
+    least RMS(E) / 2 (a floor). For (a) (kinematics = the data reference, residuals free)
+    E is what its residuals would be if its contact reproduced the data's GRFs exactly.
+
+    Returns one row per approach: RMS(E_x), RMS(E_y) (N), the floors RMS(E)/2 and the
+    achieved quadratic-mean RMSE of the two feet (N), per direction.
+    """
+    m = ChildModel()
+    gait = data_mod.load_gait_data("Free")
+    f = m.function("inverse_dynamics_grf")
+    rows = []
+    for k, res in results.items():
+        t, Q, QD, QDD = _kinematics(res)
+        n = t.size
+        _, F = f.map(n)(Q, QD, QDD, np.tile(res.p_body[:, None], n), np.zeros((6, n)))
+        F = np.asarray(F)
+        row = {"approach": APPROACHES[k]}
+        rm = res.rmse.set_index("channel")["rmse"]
+        for i, d in ((0, "x"), (1, "y")):
+            data_sum = sum(np.interp(t, gait.time, gait.mean[f"grf_{d}_{s}"]) for s in cv.SIDES)
+            E = F[i] - data_sum
+            rms = float(np.sqrt(np.mean(E**2)))
+            row[f"RMS E_{d} (N)"] = rms
+            row[f"floor per foot, {d} (N)"] = rms / 2
+            row[f"achieved per foot, {d} (N)"] = float(np.sqrt((rm[f"grf_{d}_r"] ** 2 + rm[f"grf_{d}_l"] ** 2) / 2))
+        rows.append(row)
+    return pd.DataFrame(rows).set_index("approach")
+
+
+def grf_error_by_phase(results: dict[str, ApproachResult], threshold: float = 20.0) -> pd.DataFrame:
+    """Where the vertical GRF error is: each foot's squared error split between the data's
+    swing (data vertical force < ``threshold`` N) and stance, and the mean simulated vertical
+    force during the data's swing (a foot touching the ground when it should be in the air).
+
+    Returns one row per approach and foot: RMSE (N), share of the squared error in swing
+    (%), RMSE over the swing and over the stance samples (N), mean simulated force in swing (N).
+    """
+    gait = data_mod.load_gait_data("Free")
+    rows = []
+    for k, res in results.items():
+        t = res.grf.index.to_numpy(dtype=float)
+        for s in cv.SIDES:
+            d = np.interp(t, gait.time, gait.mean[f"grf_y_{s}"])
+            e = res.grf[f"grf_y_{s}"].to_numpy() - d
+            sw = d < threshold
+            rows.append({"approach": APPROACHES[k], "foot": {"r": "right", "l": "left"}[s],
+                         "RMSE (N)": float(np.sqrt(np.mean(e**2))),
+                         "share of squared error in swing (%)": float(100 * np.sum(e[sw] ** 2) / np.sum(e**2)),
+                         "RMSE in swing (N)": float(np.sqrt(np.mean(e[sw] ** 2))) if sw.any() else np.nan,
+                         "RMSE in stance (N)": float(np.sqrt(np.mean(e[~sw] ** 2))),
+                         "mean simulated force in swing (N)": float(np.mean(res.grf[f"grf_y_{s}"].to_numpy()[sw]))
+                         if sw.any() else np.nan})
+    return pd.DataFrame(rows).set_index(["approach", "foot"])
 
 
 def residual_rms(res: ApproachResult) -> dict:
@@ -818,7 +914,7 @@ def at_bounds(res: ApproachResult, rtol: float = 1e-3) -> pd.DataFrame:
         for side, b in (("lower", lo[i]), ("upper", hi[i])):
             if abs(v - b) <= rtol * w:
                 rows.append({"parameter": n, "bound": side, "value (SI)": v})
-    if res.key == "c":
+    if res.key in ("c", "c_wide"):
         m = ChildModel()
         blo, bhi = m.p_body_bounds()
         for i, n in enumerate(P_BODY_NAMES):
@@ -872,6 +968,10 @@ def save_identified(res: ApproachResult, path=None) -> Path:
                    "p_body": {n: [float(a), float(b)] for n, a, b in zip(P_BODY_NAMES, blo, bhi)}},
         "provenance": {
             "study": "gaitlib.studies.contact_id.optimal_control_body (warm start: approach (b))",
+            "method": ("approach (b) from the neutral start (Table 4.7 box centres, k_v geometric centre, "
+                       "mu_s 0.40, mu_d 0.35) through the residual-bound continuation CONTINUATION; approach (c) "
+                       "warm-started from (b)'s solution; IPOPT (MUMPS), exact Hessian, tol 1e-5, 20 x 5 LGR"),
+            "data": "Schwartz et al. 2008, Free speed class (data/schwartz2008_curves.csv), both legs",
             "spec": res.solution.spec.to_dict(),
             "gaitlib_version": __version__,
             "cache_fingerprint": cache.fingerprint(),
