@@ -200,3 +200,26 @@ def test_thesis_reference_tables_are_consistent():
             assert ci.MU_RATIO[0] <= r <= ci.MU_RATIO[1] + 1e-3, (k, e, r)
         outside[k] = {n for n, v, l, h in zip(contact.param_names(), p, lo, hi) if not l - 1e-9 <= v <= h + 1e-9}
     assert outside == {"a": {"heel.r_y"}, "b": set(), "c": set(contact.TABLE_4_17_OUTSIDE_TABLE_4_7)}
+
+
+def test_committed_ch4_parameters_are_a_converged_feasible_identification():
+    """data/identified/ch4_child.json (approach (c) on the Free data): converged, within the
+    Table 4.7 / Table 4.14 bounds it records (which are the library's), Eq 4.4 holds, the
+    total mass stays within ±20 % of the subjects' 41.4 kg."""
+    got = params.load_identified("ch4_child")
+    prov = got["provenance"]
+    assert prov["ipopt_status"] == "Solve_Succeeded"
+    assert prov["spec"]["cost"] == "Eq4.13" and prov["spec"]["free_body"] and prov["spec"]["normal_force_constraint"]
+    assert prov["spec"]["n_intervals"] == 20 and prov["spec"]["degree"] == 5
+    lo, hi = contact.bounds()
+    pc, pb = got["p_contact"], got["p_body"]
+    tol = 1e-7 * (hi - lo)
+    assert np.all(pc >= lo - tol) and np.all(pc <= hi + tol)
+    np.testing.assert_allclose([got["bounds"]["p_contact"][n] for n in contact.param_names()],
+                               np.column_stack([lo, hi]))
+    blo, bhi = ChildModel().p_body_bounds()
+    assert np.all(pb >= blo - 1e-7 * (bhi - blo)) and np.all(pb <= bhi + 1e-7 * (bhi - blo))
+    for e in cv.ELLIPSOIDS:
+        r = pc[contact.param_index(e, "mu_d")] / pc[contact.param_index(e, "mu_s")]
+        assert ci.MU_RATIO[0] - 1e-6 <= r <= ci.MU_RATIO[1] + 1e-6
+    assert 0.8 * 41.4 <= ChildModel().total_mass(pb) <= 1.2 * 41.4
