@@ -752,10 +752,12 @@ def build(spec: GaitSpec) -> GaitProblem:
     if spec.normal_force_constraint:
         path.append(PathConstraint("normal_force", lambda x, u, p, t: node(x, u, p)["fn_raw"], 0.0, np.inf))
     if fx is not None:  # effects' path constraints, each expr ≥ 0 (co-contraction)
+        def fx_path(e_, m_):
+            return lambda x, u, p, t: e_.path(node(x, u, p), fx.theta(e_, m_, p), fx.ctx)
+
         for e_, m_ in fx.items:
             if e_.path is not None:
-                path.append(PathConstraint(f"fx_{e_.name}", lambda x, u, p, t, e_=e_, m_=m_: e_.path(
-                    node(x, u, p), fx.theta(e_, m_, p), fx.ctx), 0.0, np.inf))
+                path.append(PathConstraint(f"fx_{e_.name}", fx_path(e_, m_), 0.0, np.inf))
     endpoint = []
     if spec.free_contact:
         def ratio(x0, xf, p, t0, tf):
