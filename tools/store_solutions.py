@@ -59,10 +59,11 @@ def main(argv) -> int:
         return 1
     used = {Path(p) for p in log.read_text().split()} if log.exists() else set()
     new = tmp / "store"
-    for entry in used:
+    for entry in used:  # looked up (solved here or reloaded) or served from the store
+        src = entry if entry.is_dir() else STORE / entry.parent.name / entry.name
         dest = new / entry.parent.name / entry.name
-        if not dest.exists():
-            shutil.copytree(entry, dest)
+        if src.is_dir() and not dest.exists():
+            shutil.copytree(src, dest)
     new.mkdir(parents=True, exist_ok=True)
     subset = any(a != "--fresh" for a in argv)
     if subset and STORE.exists():  # some notebooks only: keep the other chapters' entries

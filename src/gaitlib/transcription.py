@@ -345,10 +345,21 @@ class GaitSpec:
         w.update(dict(self.weights))
         return {k: v for k, v in w.items() if v}
 
+    def identified_sets(self) -> tuple[str, ...]:
+        """Names of the identified parameter sets (``data/identified/<name>.json``) this spec
+        reads: ``"ch4_child"`` for ``contact_params``/``body_params`` ``"ch4"``, ``"ch5_mtg"``
+        for ``mtg_params="ch5"``. Cache keys hash exactly these (:func:`gaitlib.cache.fingerprint`)."""
+        sets = []
+        if "ch4" in (self.contact_params, self.body_params):
+            sets.append("ch4_child")
+        if self.mtg_params == "ch5":
+            sets.append("ch5_mtg")
+        return tuple(sets)
+
     def key(self) -> str:
         """Cache key: hash of the full spec, the library version and the code and data
         (:func:`gaitlib.cache.key`) — any change to either gives a new key."""
-        return cache.key({"kind": "gait", **self.to_dict()})
+        return cache.key({"kind": "gait", **self.to_dict()}, identified=self.identified_sets())
 
     def to_dict(self) -> dict:
         return json.loads(json.dumps(asdict(self)))

@@ -68,7 +68,7 @@ def _where(spec: tr.GaitSpec, gait, guess, root, objective="fit") -> Path:
 
     desc = {"kind": "gap-solve", "spec": spec.to_dict(), "data": signature(gait), "guess": guess_signature(guess),
             "objective": objective}
-    return cache.lookup("gap", desc, root, modules=CACHE_MODULES)
+    return cache.lookup("gap", desc, root, modules=CACHE_MODULES, identified=spec.identified_sets())
 
 
 def _check_same_cycle(gp, gait):

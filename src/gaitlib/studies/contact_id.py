@@ -70,6 +70,7 @@ from .. import ocp
 from .. import params as params_mod
 from .. import transcription as tr
 from ..model import P_BODY_NAMES, P_BODY_UNITS, ChildModel
+from . import gait
 
 __all__ = [
     "APPROACHES", "THESIS_RMSE", "THESIS_GEOMETRY", "THESIS_CONTACT", "THESIS_TIME",
@@ -482,10 +483,6 @@ def _result_from_gait(key: str, sol: tr.GaitSolution) -> ApproachResult:
                           stats, solution=sol)
 
 
-def _cache_dir(kind: str, desc: dict, root, modules) -> Path:
-    return cache.lookup(kind, desc, root, modules=modules)
-
-
 def trajectory_optimization(spec: TrajOptSpec = TrajOptSpec(), *, use_cache: bool = True, root=None,
                             problem: InverseDynamicsID | None = None) -> ApproachResult:
     """Approach (a): multistart identification on fixed kinematics (Sec 4.3.1; class docs).
@@ -496,7 +493,8 @@ def trajectory_optimization(spec: TrajOptSpec = TrajOptSpec(), *, use_cache: boo
     is the lowest-cost converged local solution. Cached on the spec and this module's code.
     """
     desc = {"kind": "contact_id_a", **spec.to_dict()}
-    where = _cache_dir("contact_id", desc, root, modules=None)
+    # fixed kinematics, the model's default body parameters: no identified set is read
+    where = cache.lookup("contact_id", desc, root, identified=())
     prob = problem
     f = where / "result.json"
     found = cache.find(where, "result.json") if use_cache else None
@@ -584,13 +582,9 @@ def _solve_gait_cached(spec: tr.GaitSpec, start: dict, warm: tr.GaitSolution | N
         ws = warm.solution
         desc["warm_start"] = {"spec": warm.spec.to_dict(), "status": ws.status,
                               "objective": float(f"{ws.objective:.12g}"), "iterations": ws.iterations}
-    where = _cache_dir("contact_id", desc, root, modules=())
-    found = cache.find(where, "spec.json") if use_cache else None
-    if found is not None:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", ocp.SolveFailedWarning)
-            sol = tr.GaitSolution.load(found)
-        sol.stats["from_cache"] = True
+    where = cache.lookup("contact_id", desc, root, modules=(), identified=spec.identified_sets())
+    sol = gait.load_cached(where) if use_cache else None
+    if sol is not None:
         return sol
     gp = tr.build(spec)
     if warm is not None:
@@ -974,7 +968,7 @@ def save_identified(res: ApproachResult, path=None) -> Path:
             "data": "Schwartz et al. 2008, Free speed class (data/schwartz2008_curves.csv), both legs",
             "spec": res.solution.spec.to_dict(),
             "gaitlib_version": __version__,
-            "cache_fingerprint": cache.fingerprint(),
+            "cache_fingerprint": cache.fingerprint(identified=res.solution.spec.identified_sets()),
             "spec_key": res.solution.stats.get("spec_key"),
             "ipopt_status": st["status"],
             "iterations": st["iterations"],

@@ -55,6 +55,20 @@ THESIS_TABLE = {"SK": "thesis, Table 4.9 (optimal control)", "MSK": "thesis, Tab
                 "NMSK": "thesis, Table 5.11"}
 
 
+def load_cached(where) -> tr.GaitSolution | None:
+    """The gait solution stored at a :func:`gaitlib.cache.lookup` directory (or the same
+    entry in the repository's store), with ``stats["from_cache"] = True``; None if absent.
+    A failed solve reloads as failed (its warning silenced: the status is the result)."""
+    found = cache.find(where, "spec.json")
+    if found is None:
+        return None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ocp.SolveFailedWarning)
+        sol = tr.GaitSolution.load(found)
+    sol.stats["from_cache"] = True
+    return sol
+
+
 def solve_cached(spec: tr.GaitSpec, *, use_cache: bool = True, root=None, guess=None,
                  progress: bool = False) -> tr.GaitSolution:
     """Solve ``spec`` or reload it from the cache (never a stale entry: the key hashes the
@@ -66,13 +80,10 @@ def solve_cached(spec: tr.GaitSpec, *, use_cache: bool = True, root=None, guess=
     if guess is not None:
         desc["warm_start"] = _guess_signature(guess)
     # gait solutions depend on the CORE sources, and on the effect library when effects are on
-    where = cache.lookup("gait", desc, root, modules=("gap/effects.py",) if getattr(spec, "effects", ()) else ())
-    found = cache.find(where, "spec.json") if use_cache else None
-    if found is not None:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", ocp.SolveFailedWarning)
-            sol = tr.GaitSolution.load(found)
-        sol.stats["from_cache"] = True
+    where = cache.lookup("gait", desc, root, modules=("gap/effects.py",) if getattr(spec, "effects", ()) else (),
+                         identified=spec.identified_sets())
+    sol = load_cached(where) if use_cache else None
+    if sol is not None:
         return sol
     sol = tr.solve(spec, guess=guess, progress=progress)
     if use_cache:

@@ -894,7 +894,8 @@ def _result(sp: JumpSpec, model: JumpModel, p_contact, sol: ocp.Solution) -> Jum
 def cache_location(sp: "JumpSpec", root=None):
     """Where the solution of ``sp`` is (or would be) cached: keyed by the spec, the core
     sources, the jump model and this study (:mod:`gaitlib.cache`)."""
-    return cache.lookup("jump", {"kind": "jump", **sp.to_dict()}, root, modules=("jump.py", "studies/jump.py"))
+    return cache.lookup("jump", {"kind": "jump", **sp.to_dict()}, root, modules=("jump.py", "studies/jump.py"),
+                        identified=())
 
 
 def solve(sp: JumpSpec | str, guess: ocp.Guess | ocp.Solution | None = None, *,

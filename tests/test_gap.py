@@ -1,0 +1,298 @@
+"""Tests of the sim-to-real gap diagnosis (gaitlib.gap, issue 7)."""
+
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+import pandas as pd
+import pytest
+
+from gaitlib import data as data_mod
+from gaitlib import ocp
+from gaitlib import transcription as tr
+from gaitlib.gap import effects as fx
+from gaitlib.gap import io as gio
+from gaitlib.gap import locate as L
+
+TINY = dict(n_intervals=3, degree=2)
+
+
+@pytest.fixture(scope="module")
+def real():
+    return gio.load_real()
+
+
+# -------------------------------------------------------------------------- locate
+
+def _data_as_sim(ds) -> pd.DataFrame:
+    """The data (as tracked) on the locate grid: a 'solution' with zero residual."""
+    view = L.tracking_view(ds.gait)
+    tau = view.time / view.cycle_time
+    df = view.mean.copy()
+    df.index = pd.Index(tau, name="tau")
+    return df[df.index < 1.0]
+
+
+def test_locate_finds_a_known_phase_offset(real):
+    """A +2 SD offset on the right knee in mid swing only: exactly that cell is off (RMS z =
+    2, significant); every other cell is zero and not significant."""
+    sim = _data_as_sim(real)
+    e = L.phase_edges(real.gait.events)
+    tau = sim.index.to_numpy()
+    msw = (tau >= e[4]) & (tau < e[5])
+    sd = np.interp(tau, real.gait.time / real.gait.cycle_time, real.gait.sd["knee_r"].to_numpy())
+    floor = L.SD_FLOOR * np.sqrt(np.mean(real.gait.sd["knee_r"].to_numpy()[:-1] ** 2))
+    sim.loc[msw, "knee_r"] += 2.0 * np.maximum(sd[msw], floor)
+    loc = L.locate(sim, real)
+    t = loc.table.set_index(["channel", "phase"])
+    assert t.loc[("angle:knee_r", "MSw"), "rms_z"] == pytest.approx(2.0, rel=1e-9)
+    assert bool(t.loc[("angle:knee_r", "MSw"), "significant"])
+    others = t.drop(index=("angle:knee_r", "MSw"))
+    assert others["rms_z"].max() < 1e-9
+    assert not others["significant"].any()
+    # phases from the events: right leg MSw is the middle third of swing
+    assert e[3] == pytest.approx(real.gait.events["foot_off"])
+    # pointwise test: 2 SD out with n = 82 subjects is far beyond the band (z = (2−1)·√82)
+    assert loc.points.query("channel == 'angle:knee_r'")["p_bonf"].min() < 1e-10
+
+
+def test_locate_band_edge_is_not_significant(real):
+    """Exactly on the band edge (|z| = 1) the one-sided test gives p = 1/2 per point."""
+    sim = _data_as_sim(real)
+    sd = np.maximum(real.gait.sd["hip_r"].to_numpy()[:-1],
+                    L.SD_FLOOR * np.sqrt(np.mean(real.gait.sd["hip_r"].to_numpy()[:-1] ** 2)))
+    sim["hip_r"] = sim["hip_r"] + sd
+    loc = L.locate(sim, real)
+    p = loc.points.query("channel == 'angle:hip_r'")
+    assert np.allclose(p["z"], 1.0)
+    assert np.allclose(p["p_bonf"], 1.0)  # min(1, 0.5 × 50)
+
+
+def test_resels_of_smooth_and_rough_curves():
+    tau = np.arange(50) / 50
+    assert L.resels(np.sin(2 * np.pi * tau)) == pytest.approx(3.77 * 1, rel=0.02)  # 3.77 k for harmonic k
+    assert L.resels(np.sin(2 * np.pi * 3 * tau)) == pytest.approx(3.77 * 3, rel=0.05)
+    assert L.resels(np.ones(50)) == 1.0
+
+
+# -------------------------------------------------------------------------- effects
+
+def _nlp_at_guess(spec):
+    gp = tr.build(spec)
+    # an unexpanded MX graph: the NLP's functions without the (slow) expanded solver build
+    T = ocp.transcribe(gp.problem, gp.mesh, ocp.SolverOptions(graph="mx", expand=False))
+    w0 = T.initial_point(gp.guess)
+    p = np.concatenate([T.data_vector(), T.goal_weights()])
+    f = ca.Function("fg", [T.nlp["x"], T.nlp["p"]], [T.nlp["f"], T.nlp["g"]])
+    fv, gv = f(w0, p)
+    return gp, T, float(fv), np.asarray(gv).ravel()
+
+
+def test_effects_at_null_leave_the_problem_unchanged():
+    """Every effect, with its parameters free but at their null values, gives the baseline
+    NLP's objective and constraints at the same point (the baseline's optimum stays an
+    optimum); a magnitude fixed at 0 drops the effect. SK for the effects that apply to it,
+    MSK for the muscle-level ones."""
+    ref = {}
+    for name, e in fx.EFFECTS.items():
+        if not e.resolve:
+            continue
+        model = "SK" if "SK" in e.models else "MSK"
+        base = dict(model=model, cost="DT", **TINY)
+        if model not in ref:
+            ref[model] = _nlp_at_guess(tr.GaitSpec(**base))
+        _, T0, f0, g0 = ref[model]
+        gp, T, f1, g1 = _nlp_at_guess(tr.GaitSpec(**base, effects=((name, None),)))
+        assert [p.name for p in gp.problem.parameters] == [f"fx.{name}.{q.name}" for q in e.params]
+        assert f1 == pytest.approx(f0, rel=1e-12, abs=1e-12), name
+        if e.path is None:
+            assert np.allclose(g1, g0, atol=1e-9), name
+        else:  # co-contraction at c = 0: a_flex ≥ 0 and a_ext ≥ 0 — inactive for the guess
+            assert len(g1) > len(g0) and T.n_constraints > T0.n_constraints
+        fixed0 = fx.bind(tr.GaitSpec(**base, effects=((name, 0.0),)), None)
+        assert fixed0.items == [] and fixed0.parameters == []
+
+
+def test_effects_registry_documented():
+    assert len(fx.EFFECTS) >= 6
+    for name, e in fx.EFFECTS.items():
+        assert e.name == name and e.n_params >= 1 and len(e.doc) > 200
+        assert "Parameters" in e.doc and all(p.unit for p in e.params)
+        for p in e.params:
+            assert p.lower <= p.null <= p.upper
+        for m in e.twin_magnitudes:
+            assert e.magnitude.lower <= m <= e.magnitude.upper
+    with pytest.raises(ValueError, match="unknown effect"):
+        tr.GaitSpec(effects=(("gravity_off", 1.0),))
+    with pytest.raises(ValueError, match="applies to models"):
+        tr.GaitSpec(model="SK", effects=(("co_contraction", 0.2),))
+    with pytest.raises(ValueError, match="outside"):
+        tr.GaitSpec(effects=(("hat_com", 5.0),))
+    s = tr.GaitSpec(effects=[("hat_com", 0.02), ["friction", None]])
+    assert tr.GaitSpec.from_dict(s.to_dict()) == s
+
+
+def _named_x(values: dict):
+    names = tr._states(tr.GaitSpec())
+    v = np.zeros(len(names))
+    for k, val in values.items():
+        v[names.index(k)] = val
+    return ocp.Named(ca.DM(v), names, "state")
+
+
+def test_hat_com_offset_static_moment():
+    """Upright HAT at rest: the offset's extra moment about the hip is m_HAT g d, no force."""
+    spec = tr.GaitSpec(**TINY, effects=(("hat_com", 0.03),))
+    gp = tr.build(spec)
+    ctx = fx.Context(spec, gp.model, gp.ref, gp.ref.gait.cycle_time, gp.p_body, gp.p_contact)
+    w = np.asarray(fx.EFFECTS["hat_com"].root_load(_named_x({}), {"d": 0.03}, ctx), float).ravel()
+    m = gp.p_body[gp.model.p_body_names.index("mass_hat")]
+    assert w == pytest.approx([0.0, 0.0, m * 9.81 * 0.03], abs=1e-12)
+
+
+def test_arm_swing_antiphase_cancels_horizontal_force_and_moment():
+    """Antiphase arms (contralateral hips moving symmetrically about their means): the two
+    arms' horizontal forces and pitch moments cancel exactly, their vertical forces add."""
+    spec = tr.GaitSpec(**TINY, effects=(("arm_swing", 1.0),))
+    gp = tr.build(spec)
+    ctx = fx.Context(spec, gp.model, gp.ref, gp.ref.gait.cycle_time, gp.p_body, gp.p_contact)
+    cr, cl = float(np.mean(gp.ref.q["hip_r"])), float(np.mean(gp.ref.q["hip_l"]))
+    a, ad, add = 0.3, 1.1, -4.0
+    x = _named_x({"hip_r": cr + a, "qd_hip_r": ad, "qdd_hip_r": add,
+                  "hip_l": cl - a, "qd_hip_l": -ad, "qdd_hip_l": -add})
+    w = np.asarray(fx.EFFECTS["arm_swing"].root_load(x, {"G": 1.0}, ctx), float).ravel()
+    assert abs(w[0]) < 1e-12 and abs(w[2]) < 1e-12
+    m, lc = fx.ARM["mass"], fx.ARM["com"]
+    # each arm's COM rises by lc (1 − cos φ); vertical force = 2 m d²/dt² of it, here with φ = a
+    phi, phid, phidd = a, ad, add
+    ydd = lc * (phidd * np.sin(phi) + phid**2 * np.cos(phi))
+    assert w[1] == pytest.approx(2 * m * ydd, rel=1e-12)
+
+
+def test_left_shift_reference_is_the_fourier_shift(real):
+    """The symbolic left-leg reference at δ equals data.fourier_shift of the right leg at
+    shift + δ (order 5) on the data grid; δ = 0 gives the data's own left leg."""
+    spec = tr.GaitSpec(**TINY, effects=(("left_shift", None),))
+    gp = tr.build(spec)
+    frame = tr.tracking_frame(spec, gp.ref)
+    delta = ca.SX.sym("delta")
+    names = list(frame.columns)
+    dsym = ca.SX.sym("d", len(names))
+    over = fx.EFFECTS["left_shift"].reference(ocp.Named(dsym, names, "data"), {"delta": delta}, None, None)
+    f = ca.Function("f", [dsym, delta], [over["ref_knee_l"], over["ref_grf_y_l"]])
+    g = real.gait
+    for dv in (0.0, 0.02, -0.035):
+        kn, gy = [], []
+        for _, row in frame.iterrows():
+            a, b = f(row.to_numpy(float), dv)
+            kn.append(float(a)), gy.append(float(b))
+        ref_kn = data_mod.fourier_shift(g.mean["knee_r"].to_numpy(), g.left_shift + dv, 5)
+        ref_gy = data_mod.fourier_shift(g.mean["grf_y_r"].to_numpy(), g.left_shift + dv, 5)
+        assert np.allclose(kn, ref_kn, atol=1e-9) and np.allclose(gy, ref_gy, atol=1e-7)
+    assert fx.left_generated(g)
+
+
+# -------------------------------------------------------------------------- IO and twins
+
+def test_tidy_reader_errors_name_the_quantity(tmp_path, real):
+    df = data_mod.load_tidy(data_mod.DATA_DIR / "schwartz2008_curves.csv")
+    df = df[(df.speed_class == "Free") & (df.quantity != "grf_vertical")]
+    p = tmp_path / "hand.csv"
+    df.to_csv(p, index=False)
+    with pytest.raises(data_mod.DataError, match="grf_vertical"):
+        gio.read_data(p)
+    ds = gio.read_data(p, fill_from="schwartz2008")
+    assert ds.filled == ("grf_vertical",)
+    assert np.allclose(ds.gait.mean["grf_y_r"], real.gait.mean["grf_y_r"])
+    df2 = df.assign(source="mylab")
+    df2.to_csv(p, index=False)
+    with pytest.raises(data_mod.DataError, match="like"):
+        gio.read_data(p, fill_from="schwartz2008")
+
+
+def test_hand_written_csv_reads_like_the_real_data(tmp_path, real):
+    """A CSV with only the needed quantities, every 10 % of the cycle, written by hand,
+    reads as the same data set interpolated (the real reader does the work)."""
+    df = data_mod.load_tidy(data_mod.DATA_DIR / "schwartz2008_curves.csv")
+    df = df[(df.speed_class == "Free") & df.quantity.isin(gio.REQUIRED_QUANTITIES) & (df.percent_cycle % 10 == 0)]
+    p = tmp_path / "hand.csv"
+    with open(p, "w") as f:
+        f.write(",".join(data_mod.TIDY_COLUMNS) + "\n")
+        for r in df.itertuples(index=False):
+            f.write(f"{r.source},{r.speed_class},{r.quantity},{r.side},{r.percent_cycle:g},{r.mean},{r.sd},{r.unit}\n")
+    ds = gio.read_data(p)
+    assert ds.n == 82 and ds.base == "schwartz2008"
+    assert ds.gait.cycle_time == pytest.approx(real.gait.cycle_time)
+    k = np.arange(0, 51, 5)  # the written points
+    assert np.allclose(ds.gait.mean["knee_r"].to_numpy()[k], real.gait.mean["knee_r"].to_numpy()[k])
+
+
+def test_twin_round_trip_through_the_tidy_reader(tmp_path, real):
+    """A noise-free twin written in the tidy format and read back equals the solution it was
+    made of (both legs; RSS ≈ 0); with noise, RSS ≈ N_points / n (SD/√n noise)."""
+    from gaitlib.gap import twin
+
+    spec = tr.GaitSpec(model="SK", cost="DT", n_intervals=4, degree=2, max_iter=40)
+    gp = tr.build(spec)
+    # any state/control trajectory will do for the round trip: the data-based guess
+    sol = tr.postprocess(gp, ocp.transcribe(gp.problem, gp.mesh, ocp.SolverOptions(max_iter=0)).solve(gp.guess))
+    clean = twin.twin_frame(sol, real, seed=None, noise=False)
+    assert set(clean["side"]) == {"R", "L", "ipsilateral"} and set(clean["source"]) == {"twin(schwartz2008)"}
+    p = tmp_path / "twin.csv"
+    clean.to_csv(p, index=False, float_format="%.12g")
+    ds = gio.read_data(p)
+    assert not fx.left_generated(ds.gait)
+    loc = L.locate(sol, ds)
+    assert loc.rss < 1e-12
+    rss = []
+    for seed in range(4):
+        twin.twin_frame(sol, real, seed=seed).to_csv(p, index=False, float_format="%.12g")
+        rss.append(L.locate(sol, gio.read_data(p)).rss)
+    expected = loc.n_points / real.n
+    assert 0.4 * expected < np.mean(rss) < 1.8 * expected
+    a = twin.twin_frame(sol, real, seed=3)
+    b = twin.twin_frame(sol, real, seed=3)
+    assert a.equals(b)
+
+
+def test_smooth_noise_unit_variance_and_correlation():
+    from gaitlib.gap.twin import NOISE_LENGTH, smooth_noise
+
+    g = smooth_noise(np.random.default_rng(0), 20000)(np.array([0.0, 0.02, 0.5, 1.0]))
+    assert g.var(axis=0) == pytest.approx([1, 1, 1, 1], rel=0.05)
+    assert np.corrcoef(g[:, 0], g[:, 1])[0, 1] == pytest.approx(np.exp(-0.5 * (0.02 / NOISE_LENGTH) ** 2), abs=0.02)
+    assert np.allclose(g[:, 0], g[:, 3])  # periodic
+
+
+# -------------------------------------------------------------------------- diagnosis
+
+def test_criteria_pay_for_parameters():
+    from gaitlib.gap.diagnose import _criteria
+
+    daic, dbic = _criteria(100.0, 100.0, 1, 200.0)
+    assert daic == pytest.approx(2.0) and dbic == pytest.approx(np.log(200.0))
+    daic, dbic = _criteria(100.0, 90.0, 2, 200.0)
+    assert dbic == pytest.approx(200 * np.log(0.9) + 2 * np.log(200))
+
+
+def test_diagnose_names_the_injected_effect_on_a_twin(tmp_path):
+    """A coarse SK twin with lower friction (k = −0.3): the diagnosis, given the baseline
+    model and three candidates, names friction and recovers its magnitude."""
+    from gaitlib.gap import diagnose as D
+    from gaitlib.gap import twin
+
+    base = dict(model="SK", cost="DT", n_intervals=10, degree=3)
+    p = twin.write_twin(tmp_path / "twin.csv", (("friction", -0.3),), seed=1, base=base, root=tmp_path / "sol")
+    d = D.diagnose(p, base=base, effects=("friction", "segment_inertia", "hat_com"), root=tmp_path / "sol",
+                   resamples=50, serial=True, progress=False)
+    assert d.top_effect == "friction", d.ranking
+    r = d.ranking.set_index("effect")
+    assert r.loc["friction", "parameters"]["k"] == pytest.approx(-0.3, abs=0.06)
+    assert r.loc["friction", "dBIC"] <= D.BIC_THRESHOLD
+    lo, hi = d.intervals["friction"]
+    assert lo <= r.loc["friction", "pct_closed"] <= hi
+    out = d.save(tmp_path / "out", figures=False)
+    import json
+
+    j = json.loads((out / "diagnosis.json").read_text())
+    assert j["top_effect"] == "friction" and j["ranking"][0]["effect"] == "friction"
