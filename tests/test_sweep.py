@@ -80,6 +80,13 @@ def test_localcluster_gives_bitwise_the_serial_results(serial, tmp_path, capfd):
     lines = [ln for ln in err.splitlines() if ln.startswith("[")]
     assert "LocalCluster(2 workers" in err and len(lines) == len(SPECS)
     assert [ln.split()[1] for ln in lines if ln.endswith("FAILED")] == ["SK_DT_Free_3it"]
+    # a second sweep of the same runs reloads them in this process: no cluster, same results
+    again = sw.solve_specs(SPECS, cache_root=root, n_workers=2)
+    assert "LocalCluster" not in capfd.readouterr().err
+    assert all(r.worker.startswith("cache:") for r in again.values())
+    assert [(r.name, r.ok, r.status) for r in again.values()] == [(r.name, r.ok, r.status) for r in recs.values()]
+    for name in SPECS:
+        _bitwise_equal(recs[name].value, again[name].value)
 
 
 def test_localcluster_workers_are_single_threaded():

@@ -294,6 +294,20 @@ def solve_specs(specs: Mapping[str, Any], *, guesses: Mapping[str, Any] | None =
     for name, spec in specs.items():
         if not isinstance(spec, GaitSpec):
             raise TypeError(f"specs[{name!r}] must be a GaitSpec, got {type(spec).__name__}")
+    from .studies import gait
+
     root = str(Path(cache_root if cache_root is not None else cache.default_dir()).resolve())
     items = {name: (spec, guesses.get(name), bool(use_cache), root) for name, spec in specs.items()}
-    return {r.name: r for r in sweep(_solve_spec, items, **sweep_kw)}
+    # runs already in the cache are reloaded here (no cluster is started for them)
+    done = {}
+    if use_cache:
+        host = f"cache:{socket.gethostname()}:{os.getpid()}"
+        for name, (spec, guess, _, _) in items.items():
+            t0 = time.perf_counter()
+            sol = gait.load_cached(gait.cache_dir(spec, guess=guess, root=root))
+            if sol is not None:
+                ok, status = _status_of(sol)
+                done[name] = RunRecord(name, ok, status, sol, None, time.perf_counter() - t0, host)
+    todo = {k: v for k, v in items.items() if k not in done}
+    ran = {r.name: r for r in sweep(_solve_spec, todo, **sweep_kw)} if todo else {}
+    return {name: done[name] if name in done else ran[name] for name in items}

@@ -55,6 +55,17 @@ THESIS_TABLE = {"SK": "thesis, Table 4.9 (optimal control)", "MSK": "thesis, Tab
                 "NMSK": "thesis, Table 5.11"}
 
 
+def cache_dir(spec: tr.GaitSpec, *, guess=None, root=None) -> Path:
+    """Where :func:`solve_cached` stores (or finds) the solution of ``spec`` from ``guess``:
+    keyed by the spec, the warm start's identity, the CORE sources (+ the effect library
+    when effects are on) and the data and identified sets the spec reads."""
+    desc = {"kind": "gait", **spec.to_dict()}
+    if guess is not None:
+        desc["warm_start"] = _guess_signature(guess)
+    return cache.lookup("gait", desc, root, modules=("gap/effects.py",) if getattr(spec, "effects", ()) else (),
+                        identified=spec.identified_sets())
+
+
 def load_cached(where) -> tr.GaitSolution | None:
     """The gait solution stored at a :func:`gaitlib.cache.lookup` directory (or the same
     entry in the repository's store), with ``stats["from_cache"] = True``; None if absent.
@@ -76,12 +87,7 @@ def solve_cached(spec: tr.GaitSpec, *, use_cache: bool = True, root=None, guess=
     failed — their status is the result. ``guess``: a :class:`~gaitlib.ocp.Guess` or
     another :class:`~gaitlib.ocp.Solution` (warm start; part of the cache key via its
     objective and status only if given, so warm-started runs are cached separately)."""
-    desc = {"kind": "gait", **spec.to_dict()}
-    if guess is not None:
-        desc["warm_start"] = _guess_signature(guess)
-    # gait solutions depend on the CORE sources, and on the effect library when effects are on
-    where = cache.lookup("gait", desc, root, modules=("gap/effects.py",) if getattr(spec, "effects", ()) else (),
-                         identified=spec.identified_sets())
+    where = cache_dir(spec, guess=guess, root=root)
     sol = load_cached(where) if use_cache else None
     if sol is not None:
         return sol
