@@ -65,6 +65,27 @@ def test_time_scaled_guess_is_a_consistent_trajectory(base):
     np.testing.assert_allclose(x - x.iloc[0], (src["pelvis_tx"] - src["pelvis_tx"].iloc[0]) * stride / s0)
 
 
+def test_full_guess_scales_every_state_and_control_consistently(base):
+    """run_guess(…, "ch5"): all of the Ch 5 solution; in scaled time t' = k t the jerks are
+    ÷ k³ (the horizontal pelvis jerk also × stride ratio), torques and activations unchanged."""
+    slow = data.load_gait_data("VerySlow")
+    stride = slow.speed * slow.cycle_time
+    src = base.solution.phase("cycle")
+    ph = pr.run_guess(base, "ch5", cycle_time=slow.cycle_time, stride=stride).phase("cycle")
+    k = slow.cycle_time / src.tf
+    s0 = data.load_gait_data("Free").speed * data.load_gait_data("Free").cycle_time
+    assert list(ph.states.columns) == list(src.states.columns)
+    assert list(ph.controls.columns) == list(src.controls.columns)
+    np.testing.assert_allclose(ph.controls["jerk_knee_r"], src.controls["jerk_knee_r"] / k**3)
+    np.testing.assert_allclose(ph.controls["jerk_pelvis_tx"], src.controls["jerk_pelvis_tx"] / k**3 * stride / s0)
+    np.testing.assert_allclose(ph.states["qd_knee_r"], src.states["qd_knee_r"] / k)
+    for c in ("tau_mtp_r", "R_y", tr.MTG_CONTROLS[0]):
+        np.testing.assert_array_equal(ph.controls[c], src.controls[c])
+    assert pr.GUESS_POLICY == {"MSK": "thesis", "NMSK": "ch5"}
+    with pytest.raises(ValueError, match="guess must be"):
+        pr.run_guess(base, "data")
+
+
 def test_score_is_zero_against_its_own_channels_and_grows_with_an_offset(base):
     """score() of a solution against data built from that solution's own channels is 0;
     a constant offset of 5° on one angle gives RMSE 5° and NRMSE 5°/range on it only."""

@@ -45,6 +45,17 @@ stats[["status", "converged", "iterations", "solve (s)", "ms/iteration", "object
        "COT (J/kg/m)"]]
 
 # %% [markdown]
+# **Initial guesses.** MSK: the thesis's (Sec 7.1) — the time-scaled *Free* data with the
+# Ch 5 HAT and metatarsal motion and MTG activations. NMSK: the *whole* Ch 5 NMSK solution
+# scaled in time (a departure, as in Ch 6); from the thesis's partial guess the NMSK runs
+# gave these statuses (not used anywhere else on this page):
+
+# %%
+res_thesis_guess = pr.speed_study(("NMSK",), classes, progress=False, guess={"NMSK": "thesis"})
+tg = res_thesis_guess.stats()[["status", "iterations", "solve (s)", "objective", "max violation"]]
+tg
+
+# %% [markdown]
 # ## Compute times (thesis Table 7.2)
 #
 # Ours on this 2-core machine beside the thesis's hours for the class of the same rank

@@ -6,10 +6,12 @@ problems. As in the thesis:
 
 - the HAT term (Eq 6.4) tracks the HAT motion of the model's Ch 5 data-tracking solution
   (MSK Eq 5.33, NMSK Eq 5.55), not the data's pelvis estimate (``GaitSpec.hat_reference``);
-- the initial guess is the data-based guess with the HAT coordinates, the metatarsal angles
-  and torques — and, for MSK, the 12 MTG activations — taken from that Ch 5 solution
-  (:func:`thesis_guess`); NMSK excitations start from the EMG where the data have the
-  muscle (``excitation_guess="emg"``, Sec 5.3.4);
+- the initial guess of the MSK runs is the data-based guess with the HAT coordinates, the
+  metatarsal angles and torques and the 12 MTG activations taken from that Ch 5 solution
+  (:func:`thesis_guess`); NMSK excitations would start from the EMG where the data have
+  the muscle (``excitation_guess="emg"``, Sec 5.3.4). **Departure:** the NMSK runs start
+  from the whole Ch 5 NMSK solution (:data:`GUESS_POLICY`, :func:`run_guess`), because
+  from the thesis's partial guess most of them stopped at the iteration limit;
 - no parameter is identified (contact, MTG and activation parameters fixed).
 
 Ch 7 (thesis Sec 7.1) — semi-predictive slow and fast gaits: the DT cost function (Table
@@ -41,7 +43,7 @@ from .. import transcription as tr
 from . import gait as sg
 
 __all__ = ["CH6_COSTS", "CH7_CLASSES", "THESIS_CLASS", "THESIS_HOURS_TABLE_6_3", "THESIS_HOURS_TABLE_7_2",
-           "THESIS_COT_FIG_7_5", "BASELINE_COST", "baseline", "default_params", "thesis_guess", "ch6_specs", "ch7_specs",
+           "THESIS_COT_FIG_7_5", "BASELINE_COST", "GUESS_POLICY", "baseline", "default_params", "thesis_guess", "run_guess", "ch6_specs", "ch7_specs",
            "score", "excitation_score", "StudyResult", "cost_function_study", "speed_study", "cot_table",
            "times_table"]
 
@@ -88,7 +90,28 @@ def default_params() -> dict:
     return msk.parameter_sets()
 
 
-def thesis_guess(base: tr.GaitSolution, *, cycle_time: float | None = None, stride: float | None = None) -> ocp.Solution:
+#: How the runs of each model are started (see :func:`run_guess`): ``"thesis"`` — the
+#: thesis's partial guess of Sec 6.1 (:func:`thesis_guess`); ``"ch5"`` — the whole Ch 5
+#: solution (every state and control, time-scaled for Ch 7). MSK runs use the thesis's guess.
+#: NMSK runs use ``"ch5"``: from the thesis's partial guess, 5 of the first 8 NMSK runs at
+#: the full mesh stopped at IPOPT's 1000-iteration limit (DT, SDT3, SP2, VerySlow, Slow;
+#: measured 2026-11-22) — the chapters show those statuses beside the runs they report.
+GUESS_POLICY = {"MSK": "thesis", "NMSK": "ch5"}
+GUESSES = ("thesis", "ch5")
+
+
+def run_guess(base: tr.GaitSolution, how: str, *, cycle_time: float | None = None,
+              stride: float | None = None) -> ocp.Solution:
+    """The initial guess of a Ch 6/7 run from its model's Ch 5 solution ``base``:
+    ``how="thesis"`` → :func:`thesis_guess`; ``"ch5"`` → all of ``base``'s states and
+    controls (same time scaling), static parameters left to the target problem."""
+    if how not in GUESSES:
+        raise ValueError(f"guess must be one of {GUESSES}, got {how!r}")
+    return thesis_guess(base, cycle_time=cycle_time, stride=stride, full=(how == "ch5"))
+
+
+def thesis_guess(base: tr.GaitSolution, *, cycle_time: float | None = None, stride: float | None = None,
+                 full: bool = False) -> ocp.Solution:
     """The part of a Ch 5 solution the thesis carries into Chs 6–7 as initial guess.
 
     States: HAT coordinates and metatarsal angles with their velocities and accelerations;
@@ -101,12 +124,18 @@ def thesis_guess(base: tr.GaitSolution, *, cycle_time: float | None = None, stri
     velocities ÷ k and accelerations ÷ k² so the guess stays a consistent trajectory; the
     horizontal pelvis position is rescaled to ``stride`` (m) so it meets the periodic
     offset of the target problem.
+
+    ``full=True``: every state and control of ``base`` (not the thesis's partial guess;
+    see :data:`GUESS_POLICY`).
     """
     sol = base.solution
     ph = sol.phase("cycle")
     coords = list(_HAT) + ["mtp_r", "mtp_l"]
-    xs = [c for c in ph.states.columns if any(c in (k, f"qd_{k}", f"qdd_{k}") for k in coords)]
-    us = [c for c in ph.controls.columns if c.startswith("tau_mtp_") or c in tr.MTG_CONTROLS]
+    if full:
+        xs, us = list(ph.states.columns), list(ph.controls.columns)
+    else:
+        xs = [c for c in ph.states.columns if any(c in (k, f"qd_{k}", f"qdd_{k}") for k in coords)]
+        us = [c for c in ph.controls.columns if c.startswith("tau_mtp_") or c in tr.MTG_CONTROLS]
     X, U = ph.states[xs].copy(), ph.controls[us].copy()
     tf = float(ph.tf)
     if cycle_time is not None:
@@ -118,6 +147,9 @@ def thesis_guess(base: tr.GaitSolution, *, cycle_time: float | None = None, stri
                 X[c] = X[c] / k**2
             elif c.startswith("qd_"):
                 X[c] = X[c] / k
+        for c in us:  # jerks (d³q/dt³); torques, activations and excitations keep their values
+            if c.startswith("jerk_") or c.startswith("qddd_"):
+                U[c] = U[c] / k**3
         tf = tf * k
     if stride is not None:
         g = data_mod.load_gait_data(base.spec.speed_class, base.spec.source)
@@ -126,6 +158,9 @@ def thesis_guess(base: tr.GaitSolution, *, cycle_time: float | None = None, stri
         X["pelvis_tx"] = x0 + (X["pelvis_tx"] - x0) * (stride / s0)
         for c in ("qd_pelvis_tx", "qdd_pelvis_tx"):
             X[c] = X[c] * (stride / s0)
+        for c in us:
+            if c in ("jerk_pelvis_tx", "qddd_pelvis_tx"):
+                U[c] = U[c] * (stride / s0)
     phase = ocp.PhaseSolution("cycle", X, U, float(ph.t0), tf)
     return replace(sol, phases={"cycle": phase}, parameters={})
 
@@ -224,13 +259,14 @@ class StudyResult:
     solutions: dict
     baselines: dict
     scores: pd.DataFrame = field(default_factory=pd.DataFrame)
+    guess: dict = field(default_factory=dict)  # model → "thesis" | "ch5" (run_guess)
 
     def stats(self) -> pd.DataFrame:
         rows = []
         for name, rec in self.records.items():
             sol = self.solutions.get(name)
             st = sol.stats if sol is not None else {}
-            rows.append({"run": name, "status": rec.status, "converged": bool(st.get("success", False)),
+            rows.append({"run": name, "guess": self.guess.get(name.split(" ", 1)[0]), "status": rec.status, "converged": bool(st.get("success", False)),
                          "iterations": st.get("iterations"), "solve (s)": st.get("solve_time_s"),
                          "ms/iteration": 1e3 * st["time_per_iteration_s"] if st else np.nan,
                          "build (s)": st.get("build_time_s"), "objective": st.get("objective"),
@@ -265,33 +301,41 @@ def _scores(sols: dict, gaits: dict, key_of) -> pd.DataFrame:
 
 def cost_function_study(models=("MSK", "NMSK"), costs=CH6_COSTS, *, n_intervals: int = 20, degree: int = 5,
                         root=None, scheduler: str | None = None, n_workers: int | None = None, serial: bool = False,
-                        progress: bool = True, source: str = "schwartz2008", params: dict | None = None) -> StudyResult:
+                        progress: bool = True, source: str = "schwartz2008", params: dict | None = None,
+                        guess: dict | None = None) -> StudyResult:
     """Thesis Ch 6: the ``models`` × ``costs`` runs, scored against the Free data.
+
+    ``guess``: model → ``"thesis"`` | ``"ch5"`` overriding :data:`GUESS_POLICY` (how each
+    model's runs are started, :func:`run_guess`).
 
     ``params``: GaitSpec fields naming the parameter sets of every run and of the Ch 5
     baselines (e.g. ``{"mtg_params": "ch5", "body_params": "ch4", "contact_params": "ch4"}``
     — the thesis carries the identified values of Chs 4–5 into Ch 6); default
     :func:`default_params`."""
     params = default_params() if params is None else dict(params)
+    how = {**GUESS_POLICY, **(guess or {})}
     bases = {m: baseline(m, n_intervals=n_intervals, degree=degree, root=root, source=source, **params)
              for m in models}
     specs, guesses = {}, {}
     for m in models:
         sp = ch6_specs(m, bases[m], costs, n_intervals=n_intervals, degree=degree, source=source, **params)
         specs.update(sp)
-        guesses.update({k: thesis_guess(bases[m]) for k in sp})
+        guesses.update({k: run_guess(bases[m], how[m]) for k in sp})
     recs, sols = _run(specs, guesses, root=root, scheduler=scheduler, n_workers=n_workers, serial=serial,
                       progress=progress)
     gaits = {"Free": data_mod.load_gait_data("Free", source)}
-    return StudyResult(specs, recs, sols, bases, _scores(sols, gaits, lambda s: "Free"))
+    return StudyResult(specs, recs, sols, bases, _scores(sols, gaits, lambda s: "Free"), guess=how)
 
 
 def speed_study(models=("MSK", "NMSK"), classes=CH7_CLASSES, *, n_intervals: int = 20, degree: int = 5,
                 root=None, scheduler: str | None = None, n_workers: int | None = None, serial: bool = False,
-                progress: bool = True, source: str = "schwartz2008", params: dict | None = None) -> StudyResult:
+                progress: bool = True, source: str = "schwartz2008", params: dict | None = None,
+                guess: dict | None = None) -> StudyResult:
     """Thesis Ch 7: DT per model and speed class on time-scaled Free data, scored against
-    each class's own data (never tracked). ``params`` as :func:`cost_function_study`."""
+    each class's own data (never tracked). ``params`` and ``guess`` as
+    :func:`cost_function_study`."""
     params = default_params() if params is None else dict(params)
+    how = {**GUESS_POLICY, **(guess or {})}
     bases = {m: baseline(m, n_intervals=n_intervals, degree=degree, root=root, source=source, **params)
              for m in models}
     gaits = {c: data_mod.load_gait_data(c, source) for c in classes}
@@ -301,10 +345,10 @@ def speed_study(models=("MSK", "NMSK"), classes=CH7_CLASSES, *, n_intervals: int
         specs.update(sp)
         for k, s in sp.items():
             g = gaits[s.speed_class]
-            guesses[k] = thesis_guess(bases[m], cycle_time=g.cycle_time, stride=g.speed * g.cycle_time)
+            guesses[k] = run_guess(bases[m], how[m], cycle_time=g.cycle_time, stride=g.speed * g.cycle_time)
     recs, sols = _run(specs, guesses, root=root, scheduler=scheduler, n_workers=n_workers, serial=serial,
                       progress=progress)
-    return StudyResult(specs, recs, sols, bases, _scores(sols, gaits, lambda s: s.spec.speed_class))
+    return StudyResult(specs, recs, sols, bases, _scores(sols, gaits, lambda s: s.spec.speed_class), guess=how)
 
 
 def cot_table(ch7: StudyResult, natural: tr.GaitSolution | None = None) -> pd.DataFrame:
