@@ -102,7 +102,11 @@ def _guess_signature(guess) -> str:
     if isinstance(guess, tr.GaitSolution):
         guess = guess.solution
     if isinstance(guess, ocp.Solution):
-        return f"solution:{guess.status}:{guess.objective:.12g}:{guess.iterations}"
+        sig = f"solution:{guess.status}:{guess.objective:.12g}:{guess.iterations}"
+        # a guess derived from a solution (part of it, time-scaled, …) says how, so two
+        # different guesses from one solution never share a key (e.g. studies.predictive)
+        derived = (guess.info or {}).get("guess_derivation")
+        return f"{sig}:{derived}" if derived else sig
     return f"guess:{id(guess)}"
 
 

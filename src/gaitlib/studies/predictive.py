@@ -162,7 +162,10 @@ def thesis_guess(base: tr.GaitSolution, *, cycle_time: float | None = None, stri
             if c in ("jerk_pelvis_tx", "qddd_pelvis_tx"):
                 U[c] = U[c] * (stride / s0)
     phase = ocp.PhaseSolution("cycle", X, U, float(ph.t0), tf)
-    return replace(sol, phases={"cycle": phase}, parameters={})
+    f = lambda v: "None" if v is None else f"{float(v):.12g}"  # noqa: E731
+    how = f"thesis_guess(full={bool(full)}, cycle_time={f(cycle_time)}, stride={f(stride)})"
+    # the derivation is part of the warm start's cache signature (studies.gait._guess_signature)
+    return replace(sol, phases={"cycle": phase}, parameters={}, info={**(sol.info or {}), "guess_derivation": how})
 
 
 def ch6_specs(model: str, base: tr.GaitSolution, costs=CH6_COSTS, *, n_intervals: int = 20, degree: int = 5,
