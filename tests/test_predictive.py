@@ -82,6 +82,12 @@ def test_full_guess_scales_every_state_and_control_consistently(base):
     for c in ("tau_mtp_r", "R_y", tr.MTG_CONTROLS[0]):
         np.testing.assert_array_equal(ph.controls[c], src.controls[c])
     assert pr.GUESS_POLICY == {"MSK": "thesis", "NMSK": "ch5"}
+    # guesses derived differently from one solution are cached under different keys
+    spec = pr.ch6_specs("MSK", base, ("DT",), **MESH)["MSK DT"]
+    dirs = {sg.cache_dir(spec, guess=g) for g in (pr.run_guess(base, "thesis"), pr.run_guess(base, "ch5"),
+                                                   pr.run_guess(base, "thesis", cycle_time=1.0, stride=1.0), base)}
+    assert len(dirs) == 4
+    assert sg.cache_dir(spec, guess=pr.run_guess(base, "ch5")) == sg.cache_dir(spec, guess=pr.run_guess(base, "ch5"))
     with pytest.raises(ValueError, match="guess must be"):
         pr.run_guess(base, "data")
 
