@@ -88,6 +88,20 @@ res_thesis_guess = pr.cost_function_study(("NMSK",), pr.CH6_COSTS, progress=Fals
 tg = res_thesis_guess.stats()[["status", "iterations", "solve (s)", "objective", "max violation"]]
 tg
 
+# %% [markdown]
+# **Runs that stopped at the iteration limit, investigated.** Each is run again from the
+# same initial guess with IPOPT allowed 3000 iterations (Ch 5's limit). This is a separate,
+# labelled result: the tables and figures above and below keep the 1000-iteration run and
+# its status.
+
+# %%
+failed = [k for k, r in res.records.items() if not r.ok]
+inv = {k: res.rerun(k, max_iter=3000) for k in failed}
+pd.DataFrame({k: {"status (1000 it)": res.records[k].status, "objective (1000 it)": res.solutions[k].stats["objective"],
+                  "status (3000 it)": s.stats["status"], "iterations": s.stats["iterations"],
+                  "objective (3000 it)": s.stats["objective"], "max violation": s.stats["max_violation"],
+                  "solve (s)": s.stats["solve_time_s"]} for k, s in inv.items()}).T if inv else "every run converged"
+
 # %%
 times = pr.times_table(res, pr.THESIS_HOURS_TABLE_6_3)
 times.pivot(index="case", columns="model", values=["total (s)", "iterations", "ms/iteration", "thesis (h)", "speed-up"]).loc[list(pr.CH6_COSTS)]
@@ -176,13 +190,13 @@ display_anim
 
 # %%
 ok = stats["converged"]
-nr = summary.mean(axis=1)
+nr = summary[["angle", "torque", "grf"]].mean(axis=1)  # the same kinds for both models
 def _nr(model, case):
     return nr.get((model, case), np.nan)
 tg_ok = tg["status"] == "Solve_Succeeded"
 lines = [f"- {int(ok.sum())} of {len(ok)} runs converged (IPOPT Solve_Succeeded)"
          + ("" if ok.all() else "; not converged: " + ", ".join(f"{k} ({v})" for k, v in stats.loc[~ok, 'status'].items()))
-         + f". Wall time per run {stats['solve (s)'].min():.0f}–{stats['solve (s)'].max():.0f} s here, "
+         + f". IPOPT solve time per run {stats['solve (s)'].min():.0f}–{stats['solve (s)'].max():.0f} s here, "
          f"against 1–15 h in the thesis (Table 6.3). NMSK runs start from the whole Ch 5 NMSK solution; from the "
          f"thesis's partial guess {int(tg_ok.sum())} of {len(tg)} NMSK runs converged"
          + ("" if tg_ok.all() else " (not: " + ", ".join(f"{k} {v}" for k, v in tg.loc[~tg_ok, 'status'].items()) + ")") + ".",
@@ -195,9 +209,23 @@ fp_claim = _nr("NMSK", "FP") < _nr("MSK", "FP")
 lines.append(f"- Thesis claim *NMSK FP more accurate than MSK FP*: {'holds' if fp_claim else 'does not hold'} on our data "
              f"({_nr('NMSK', 'FP'):.3f} vs {_nr('MSK', 'FP'):.3f}). "
              f"*NMSK FP faster than MSK FP*: {'holds' if stats.loc['NMSK FP', 'solve (s)'] < stats.loc['MSK FP', 'solve (s)'] else 'does not hold'} "
-             f"({stats.loc['NMSK FP', 'solve (s)']:.0f} s vs {stats.loc['MSK FP', 'solve (s)']:.0f} s).")
-sdt3 = _nr("NMSK", "SDT3") <= _nr("NMSK", "DT") * 1.1
-lines.append(f"- Thesis claim *SDT3 (Trq + Ang) is enough for NMSK*: NMSK SDT3 mean NRMSE {_nr('NMSK', 'SDT3'):.3f} vs DT "
+             f"({stats.loc['NMSK FP', 'solve (s)']:.0f} s vs {stats.loc['MSK FP', 'solve (s)']:.0f} s; not a like-for-like "
+             "comparison: the NMSK runs start from the whole Ch 5 solution, the MSK runs from the thesis's partial guess).")
+def _nr_of(sol):
+    d = pr.score(sol, free)
+    return d[d["kind"].isin(["angle", "torque", "grf"])].groupby("kind")["nrmse"].mean().mean()
+
+
+sdt3_val, note = _nr("NMSK", "SDT3"), ""
+if not stats.loc["NMSK SDT3", "converged"]:
+    r = inv.get("NMSK SDT3")
+    if r is not None and r.stats["success"]:
+        sdt3_val = _nr_of(r)
+        note = f" (the 1000-iteration run did not converge; its converged 3000-iteration rerun, {r.stats['iterations']} iterations)"
+    else:
+        note = " (NOT converged — the comparison is indicative only)"
+sdt3 = sdt3_val <= _nr("NMSK", "DT") * 1.1
+lines.append(f"- Thesis claim *SDT3 (Trq + Ang) is enough for NMSK*: NMSK SDT3 mean NRMSE {sdt3_val:.3f}{note} vs DT "
              f"{_nr('NMSK', 'DT'):.3f} — {'holds (within 10 %)' if sdt3 else 'does not hold'}.")
 exc = sc[sc["kind"] == "excitation"].groupby("case")["rmse"].mean()
 if len(exc):

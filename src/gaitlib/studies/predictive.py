@@ -263,6 +263,14 @@ class StudyResult:
     baselines: dict
     scores: pd.DataFrame = field(default_factory=pd.DataFrame)
     guess: dict = field(default_factory=dict)  # model → "thesis" | "ch5" (run_guess)
+    guesses: dict = field(default_factory=dict, repr=False)  # run → the initial guess used
+
+    def rerun(self, name: str, *, root=None, progress: bool = False, **changes) -> tr.GaitSolution:
+        """Run ``name`` again from the same initial guess with spec fields changed (e.g.
+        ``max_iter=3000`` to see where a run that hit the iteration limit ends); cached like
+        every solve. A separate, labelled result — the study's record keeps its own status."""
+        spec = replace(self.specs[name], **changes)
+        return sg.solve_cached(spec, guess=self.guesses.get(name), root=root, progress=progress)
 
     def stats(self) -> pd.DataFrame:
         rows = []
@@ -327,7 +335,8 @@ def cost_function_study(models=("MSK", "NMSK"), costs=CH6_COSTS, *, n_intervals:
     recs, sols = _run(specs, guesses, root=root, scheduler=scheduler, n_workers=n_workers, serial=serial,
                       progress=progress)
     gaits = {"Free": data_mod.load_gait_data("Free", source)}
-    return StudyResult(specs, recs, sols, bases, _scores(sols, gaits, lambda s: "Free"), guess=how)
+    return StudyResult(specs, recs, sols, bases, _scores(sols, gaits, lambda s: "Free"), guess=how,
+                       guesses=guesses)
 
 
 def speed_study(models=("MSK", "NMSK"), classes=CH7_CLASSES, *, n_intervals: int = 20, degree: int = 5,
@@ -351,7 +360,8 @@ def speed_study(models=("MSK", "NMSK"), classes=CH7_CLASSES, *, n_intervals: int
             guesses[k] = run_guess(bases[m], how[m], cycle_time=g.cycle_time, stride=g.speed * g.cycle_time)
     recs, sols = _run(specs, guesses, root=root, scheduler=scheduler, n_workers=n_workers, serial=serial,
                       progress=progress)
-    return StudyResult(specs, recs, sols, bases, _scores(sols, gaits, lambda s: s.spec.speed_class), guess=how)
+    return StudyResult(specs, recs, sols, bases, _scores(sols, gaits, lambda s: s.spec.speed_class),
+                       guess=how, guesses=guesses)
 
 
 def cot_table(ch7: StudyResult, natural: tr.GaitSolution | None = None) -> pd.DataFrame:
