@@ -180,4 +180,9 @@ if len(cc) >= 3:
     lines.append(f"- COT: {', '.join(f'{i} {v:.2f}' for i, v in cc['COT (J/kg/m)'].items())} J/(kg·m); minimum at {imin} "
                  f"({'the natural speed — a U-curve as the thesis reports' if imin == 'Free' else 'not at the natural speed — no U-curve with the minimum at Free'}). "
                  "Thesis (Fig 7.5): 2.18, 1.99, 1.53, 1.96, 1.99 at XS, S, N, M, L.")
+for k, r in inv.items():
+    if k.startswith("NMSK "):
+        lines.append(f"- {k} stopped at 1000 iterations; rerun at 3000 it {'converged' if r.stats['success'] else 'did NOT converge'} "
+                     f"({r.stats['status']}, {r.stats['iterations']} iterations) with COT {r.stats.get('COT', float('nan')):.2f} J/(kg·m) "
+                     "(not in the figure, which keeps the study's own runs).")
 print("\n".join(lines))
