@@ -95,12 +95,8 @@ tg
 # its status.
 
 # %%
-failed = [k for k, r in res.records.items() if not r.ok]
-inv = {k: res.rerun(k, max_iter=3000) for k in failed}
-pd.DataFrame({k: {"status (1000 it)": res.records[k].status, "objective (1000 it)": res.solutions[k].stats["objective"],
-                  "status (3000 it)": s.stats["status"], "iterations": s.stats["iterations"],
-                  "objective (3000 it)": s.stats["objective"], "max violation": s.stats["max_violation"],
-                  "solve (s)": s.stats["solve_time_s"]} for k, s in inv.items()}).T if inv else "every run converged"
+inv = res.rerun_failed(max_iter=3000)
+res.rerun_table(inv) if inv else "every run converged"
 
 # %%
 times = pr.times_table(res, pr.THESIS_HOURS_TABLE_6_3)

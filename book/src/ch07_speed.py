@@ -56,24 +56,20 @@ tg = res_thesis_guess.stats()[["status", "iterations", "solve (s)", "objective",
 tg
 
 # %% [markdown]
-# ## Compute times (thesis Table 7.2)
-#
-# Ours on this 2-core machine beside the thesis's hours for the class of the same rank
-# (labelled; different classes and data).
-
-# %% [markdown]
 # **Runs that stopped at the iteration limit, investigated.** Each is run again from the
 # same initial guess with IPOPT allowed 3000 iterations (Ch 5's limit). This is a separate,
 # labelled result: the tables and figures above and below keep the 1000-iteration run and
 # its status.
 
 # %%
-failed = [k for k, r in res.records.items() if not r.ok]
-inv = {k: res.rerun(k, max_iter=3000) for k in failed}
-pd.DataFrame({k: {"status (1000 it)": res.records[k].status, "objective (1000 it)": res.solutions[k].stats["objective"],
-                  "status (3000 it)": s.stats["status"], "iterations": s.stats["iterations"],
-                  "objective (3000 it)": s.stats["objective"], "max violation": s.stats["max_violation"],
-                  "solve (s)": s.stats["solve_time_s"]} for k, s in inv.items()}).T if inv else "every run converged"
+inv = res.rerun_failed(max_iter=3000)
+res.rerun_table(inv) if inv else "every run converged"
+
+# %% [markdown]
+# ## Compute times (thesis Table 7.2)
+#
+# Ours on this 2-core machine beside the thesis's hours for the class of the same rank
+# (labelled; different classes and data).
 
 # %%
 times = pr.times_table(res, pr.THESIS_HOURS_TABLE_7_2, lambda s: pr.THESIS_CLASS[s.speed_class])

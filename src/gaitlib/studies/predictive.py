@@ -272,6 +272,23 @@ class StudyResult:
         spec = replace(self.specs[name], **changes)
         return sg.solve_cached(spec, guess=self.guesses.get(name), root=root, progress=progress)
 
+    def rerun_failed(self, max_iter: int = 3000, **kw) -> dict:
+        """:meth:`rerun` every run whose record is not ok with ``max_iter`` iterations:
+        name → GaitSolution (the investigation of runs that stopped at the limit)."""
+        return {k: self.rerun(k, max_iter=max_iter, **kw) for k, r in self.records.items() if not r.ok}
+
+    def rerun_table(self, reruns: dict) -> pd.DataFrame:
+        """The study's own status and objective of each rerun run beside the rerun's."""
+        rows = {}
+        for k, s in reruns.items():
+            own = self.solutions.get(k)
+            rows[k] = {"status (study)": self.records[k].status,
+                       "objective (study)": own.stats["objective"] if own is not None else np.nan,
+                       "max_iter (rerun)": s.spec.max_iter, "status (rerun)": s.stats["status"],
+                       "iterations (rerun)": s.stats["iterations"], "objective (rerun)": s.stats["objective"],
+                       "max violation (rerun)": s.stats["max_violation"], "solve (s, rerun)": s.stats["solve_time_s"]}
+        return pd.DataFrame(rows).T
+
     def stats(self) -> pd.DataFrame:
         rows = []
         for name, rec in self.records.items():
