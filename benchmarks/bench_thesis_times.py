@@ -473,7 +473,8 @@ def write_markdown(doc: dict, path: Path) -> None:
     s = doc["summary"]
     lines += ["", f"{s['n_rows']} rows: {s['n_converged']} converged, {s['n_not_converged']} not converged, "
               f"{s['n_missing']} not collected; speed-up over the {s['n_with_thesis']} converged rows with a thesis "
-              f"time: {s['speedup_min']:.0f}–{s['speedup_max']:.0f}× (median {s['speedup_median']:.0f}×); "
+              f"time: {_fmt(s['speedup_min'], 'speedup')}–{_fmt(s['speedup_max'], 'speedup')} (median "
+              f"{_fmt(s['speedup_median'], 'speedup')}); "
               f"sum of our wall times {s['total_wall_s'] / 3600:.2f} h."]
     path.write_text("\n".join(lines) + "\n")
 
@@ -492,6 +493,8 @@ def main(argv=None) -> int:
         os.environ.setdefault(v, "1")
     chapters = [c for c in CHAPTERS if c in args.chapters]
     mode_name = "cached-only" if args.cached_only else "resolve" if args.resolve else "cached"
+    if args.cached_only and args.measure_uncached:
+        mode_name += " + measure-uncached"
     out_json = args.out / "thesis_times.json"
     previous = json.loads(out_json.read_text()) if out_json.is_file() else None
 

@@ -22,7 +22,8 @@ Thesis times (issue 8 item 1; :file:`benchmarks/bench_thesis_times.py`):
 :func:`thesis_reference_times`  every compute time the thesis prints, as labelled references.
 :func:`parse_duration`     "6 min (…)" → 360 s.
 :func:`time_row`, :func:`missing_row`  one row of the table (speed-up only for converged runs).
-:func:`thesis_times_table`, :func:`thesis_times_summary`  the stored table for the page.
+:func:`thesis_times_table`, :func:`thesis_times_summary`, :func:`thesis_times_by_chapter`,
+:func:`thesis_times_figure`  the stored table for the page.
 :func:`no_solving`         context manager: any attempt to solve raises :class:`NotInCache`.
 """
 
@@ -37,7 +38,8 @@ import pandas as pd
 __all__ = ["results_dir", "load", "fit_power_law", "scaling_table", "scaling_fits", "hessian_table",
            "linear_solver_table", "moco_table", "gait_table", "measured_on", "ThesisTime", "THESIS_SILENT",
            "thesis_reference_times", "parse_duration", "time_row", "missing_row", "NOT_COMPUTED", "NO_CACHE",
-           "TIME_COLUMNS", "thesis_times_table", "thesis_times_summary", "NotInCache", "no_solving"]
+           "TIME_COLUMNS", "thesis_times_table", "thesis_times_summary", "thesis_times_by_chapter",
+           "thesis_times_figure", "NotInCache", "no_solving"]
 
 #: Runs of the scaling benchmark whose time per iteration is a measurement (the solver ran
 #: to the end: converged or stopped by its own criterion), as opposed to "timeout"/"error".
@@ -361,7 +363,7 @@ def thesis_times_summary(res: dict | None = None) -> dict:
     ``total_wall_s`` (sum of our wall times, every measured row)."""
     res = load("thesis_times") if res is None else res
     df = pd.DataFrame(res["rows"])
-    missing = df["status"].isin([NOT_COMPUTED, NO_CACHE])
+    missing = _missing_mask(df)
     conv = df["converged"].astype(bool) & ~missing
     sp = pd.to_numeric(df.loc[conv, "speedup"], errors="coerce").dropna()
     measured = df[~missing]
@@ -372,6 +374,74 @@ def thesis_times_summary(res: dict | None = None) -> dict:
             "speedup_max": float(sp.max()) if len(sp) else float("nan"),
             "n_from_cache": int(measured["from_cache"].fillna(False).astype(bool).sum()),
             "total_wall_s": float(pd.to_numeric(measured["wall_s"], errors="coerce").sum())}
+
+
+def _missing_mask(df: pd.DataFrame) -> pd.Series:
+    return df["status"].isin([NOT_COMPUTED, NO_CACHE])
+
+
+def thesis_times_by_chapter(res: dict | None = None) -> pd.DataFrame:
+    """Per chapter: optimisations, how many converged / did not / were not collected, the sum
+    of our wall times (h, every measured row) and the speed-up range over the converged rows
+    that have a thesis time."""
+    res = load("thesis_times") if res is None else res
+    df = pd.DataFrame(res["rows"])
+    rows = []
+    for ch, g in df.groupby("chapter", sort=True):
+        miss = _missing_mask(g)
+        conv = g["converged"].astype(bool) & ~miss
+        sp = pd.to_numeric(g.loc[conv, "speedup"], errors="coerce").dropna()
+        rows.append({"chapter": ch, "optimisations": len(g), "converged": int(conv.sum()),
+                     "not converged": int((~conv & ~miss).sum()), "not collected": int(miss.sum()),
+                     "our wall, sum (h)": float(pd.to_numeric(g.loc[~miss, "wall_s"], errors="coerce").sum()) / 3600,
+                     "with a thesis time": int(len(sp)),
+                     "speed-up min": float(sp.min()) if len(sp) else np.nan,
+                     "speed-up median": float(sp.median()) if len(sp) else np.nan,
+                     "speed-up max": float(sp.max()) if len(sp) else np.nan})
+    return pd.DataFrame(rows).set_index("chapter")
+
+
+def thesis_times_figure(res: dict | None = None):
+    """Horizontal log-scale bars, one pair per optimisation with a thesis time: our wall
+    time (build + solve) and the thesis's. A run that did not converge is drawn hatched and
+    grey with its IPOPT status; a run not collected has no bar of ours. Returns the figure."""
+    import matplotlib.pyplot as plt
+
+    res = load("thesis_times") if res is None else res
+    df = pd.DataFrame(res["rows"])
+    df = df[df["thesis_time_s"].notna()].reset_index(drop=True)
+    n = len(df)
+    fig, ax = plt.subplots(figsize=(10, 0.26 * n + 1.8))
+    y = np.arange(n)[::-1]
+    h = 0.38
+    ax.barh(y + h / 2, df["thesis_time_s"].astype(float), h, color="0.75", label="thesis (GPOPS-II, i7-6700; printed)")
+    miss = _missing_mask(df)
+    conv = df["converged"].astype(bool) & ~miss
+    wall = pd.to_numeric(df["wall_s"], errors="coerce")
+    ax.barh(y[conv] - h / 2, wall[conv], h, color="C0", label="ours, converged (wall = build + solve)")
+    bad = ~conv & ~miss & wall.notna()
+    if bad.any():
+        ax.barh(y[bad] - h / 2, wall[bad], h, color="white", edgecolor="C3", hatch="///",
+                label="ours, did NOT converge (IPOPT status at the bar)")
+        for yi, w, st in zip(y[bad], wall[bad], df.loc[bad, "status"]):
+            ax.text(w * 1.15, yi - h / 2, st, va="center", fontsize=6, color="C3")
+    for yi, r in zip(y[miss], df.loc[miss, "status"]):
+        ax.text(1.0, yi - h / 2, r, va="center", fontsize=6, color="0.4")
+    for yi, sp, w in zip(y[conv], df.loc[conv, "speedup"], wall[conv]):
+        ax.text(w * 1.15, yi - h / 2, f"{sp:.0f}×" if sp >= 10 else f"{sp:.1f}×", va="center", fontsize=6)
+    ax.set_yticks(y)
+    short = df["run"].str.replace(", rerun max_iter=3000 (investigation)", ", rerun at 3000 it", regex=False)
+    ax.set_yticklabels([f"{c} {r}" for c, r in zip(df["chapter"], short)], fontsize=6)
+    ax.set_xscale("log")
+    ax.set_xlabel("time (s), log scale")
+    for t, lab in ((60, "1 min"), (3600, "1 h"), (36000, "10 h")):
+        ax.axvline(t, color="0.85", lw=0.6, zorder=0)
+        ax.text(t, n - 0.3, lab, fontsize=6, color="0.5", ha="center")
+    ax.set_ylim(-0.8, n)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.9 / (0.26 * n + 1.8)), ncol=2)
+    ax.set_title("Every optimisation with a thesis time: ours vs the thesis's (speed-up at our bar)", fontsize=9)
+    fig.tight_layout()
+    return fig
 
 
 class NotInCache(RuntimeError):
