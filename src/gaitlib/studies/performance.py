@@ -475,3 +475,26 @@ def no_solving(what: str = "solving is disabled (--cached-only)"):
     finally:
         for obj, name, val in saved:
             setattr(obj, name, val)
+
+
+def machine_info() -> dict:
+    """The machine a benchmark ran on: CPU model, cores, memory (GiB), platform, Python, host."""
+    import os
+    import platform
+    from pathlib import Path
+
+    cpu = platform.processor() or ""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    mem = None
+    try:
+        mem = round(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2 ** 30, 1)
+    except (ValueError, OSError, AttributeError):
+        pass
+    return {"cpu": cpu, "cores": os.cpu_count(), "memory_gb": mem, "platform": platform.platform(),
+            "python": platform.python_version(), "node": platform.node()}
