@@ -49,6 +49,7 @@ import numpy as np
 import pandas as pd
 
 from .. import transcription as tr
+from ..ocp import _json_default  # the same JSON encoding as saved solutions
 from . import effects as fx
 from . import io as gio
 from . import locate as L
@@ -247,14 +248,6 @@ class Diagnosis:
                 first = next(iter(self.shrink))
                 F.shrink_heatmaps(self.located, self.fits[first].located, first).savefig(out / "shrink.png", dpi=110)
         return out
-
-
-def _json_default(o):
-    if isinstance(o, (np.floating, np.integer)):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    return str(o)
 
 
 def _stats(sol) -> dict:
