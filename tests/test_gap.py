@@ -296,3 +296,65 @@ def test_diagnose_names_the_injected_effect_on_a_twin(tmp_path):
 
     j = json.loads((out / "diagnosis.json").read_text())
     assert j["top_effect"] == "friction" and j["ranking"][0]["effect"] == "friction"
+
+
+# -------------------------------------------------------------------------- the shell interface
+
+def test_cli_gap_on_a_hand_written_csv(tmp_path):
+    """``gaitlib gap --data CSV --out DIR`` from a fresh process on a tidy CSV written line by
+    line (another lab's name, only the quantities the problem needs, every 10 % of the
+    cycle; ``--like schwartz2008`` for speed, cycle time and events): diagnosis.json has
+    the located gap, the ranking (effect, parameters added, identified values, RSS before/
+    after, % closed, ΔAIC/ΔBIC), the shrink with its interval, and a top effect that is
+    either the best eligible candidate or "unexplained"."""
+    import json
+    import os
+    import shutil
+    import subprocess
+    import sys
+
+    df = data_mod.load_tidy(data_mod.DATA_DIR / "schwartz2008_curves.csv")
+    df = df[(df.speed_class == "Free") & df.quantity.isin(gio.REQUIRED_QUANTITIES) & (df.percent_cycle % 10 == 0)]
+    csv = tmp_path / "mylab.csv"
+    with open(csv, "w") as f:
+        f.write("source,speed_class,quantity,side,percent_cycle,mean,sd,unit\n")
+        for r in df.itertuples(index=False):
+            f.write(f"mylab,Free,{r.quantity},{r.side},{r.percent_cycle:g},{r.mean:.6g},{r.sd:.6g},{r.unit}\n")
+    exe = shutil.which("gaitlib", path=os.path.dirname(sys.executable)) or shutil.which("gaitlib")
+    assert exe, "the gaitlib console script is not installed"
+    out = tmp_path / "out"
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
+    cmd = [exe, "gap", "--data", str(csv), "--out", str(out), "--like", "schwartz2008",
+           "--effects", "friction,hat_com,segment_inertia", "--intervals", "6", "--degree", "3",
+           "--resamples", "40", "--serial", "--cache", str(tmp_path / "cache")]
+    p = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=240)
+    assert p.returncode == 0, p.stderr[-3000:]
+    j = json.loads((out / "diagnosis.json").read_text())
+    for f in ("gap_heatmap.png", "ranking.png", "located.csv", "ranking.csv"):
+        assert (out / f).is_file(), f
+    assert j["data"]["base_source"] == "schwartz2008" and j["data"]["n_subjects"] == 82
+    # located: 16 channels (angles, torques, GRFs; both legs) × 6 phases
+    loc = j["located"]
+    assert loc["summary"]["cells"] == 16 * 6 and len(loc["channels"]) == 16
+    assert loc["summary"]["rss"] == pytest.approx(sum(c["rss"] for c in loc["channels"]))
+    assert {"channel", "phase", "rms_z", "mean_z", "frac_out", "p_min", "significant"} <= set(loc["table"][0])
+    # ranking: every candidate, with its added parameters and identified values
+    rk = {r["effect"]: r for r in j["ranking"]}
+    assert set(rk) == {"friction", "hat_com", "segment_inertia"}
+    for name, r in rk.items():
+        e = fx.EFFECTS[name]
+        assert r["n_params"] == e.n_params and set(r["parameters"]) == {q.name for q in e.params}
+        assert r["rss_before"] == pytest.approx(loc["summary"]["rss"])
+        assert r["pct_closed"] == pytest.approx(100 * (1 - r["rss_after"] / r["rss_before"]))
+        n_eff = j["criterion"]["n_eff"]
+        assert r["dBIC"] == pytest.approx(n_eff * np.log(r["rss_after"] / r["rss_before"]) + e.n_params * np.log(n_eff))
+    # shrink of the top effects: before/after per channel and phase, % closed and its interval
+    assert j["shrink"]
+    for name, s in j["shrink"].items():
+        lo, hi = s["interval_95"]
+        assert lo <= s["pct_closed"] <= hi
+        assert {"rms_before", "rms_after", "pct_closed"} <= set(s["table"][0])
+    # top effect: the best converged candidate within the threshold, else "unexplained"
+    elig = [r for r in j["ranking"] if r["ok"] and r["dBIC"] is not None and r["dBIC"] <= j["criterion"]["threshold_dBIC"]]
+    assert j["top_effect"] == (elig[0]["effect"] if elig else "unexplained")
+    assert j["verdict"] in ("explained", "partial", "unexplained")

@@ -59,7 +59,11 @@ def guess_signature(guess) -> str | None:
     if isinstance(guess, tr.GaitSolution):
         guess = guess.solution
     if isinstance(guess, ocp.Solution):
-        return f"solution:{guess.status}:{guess.objective:.12g}:{guess.iterations}"
+        sig = f"solution:{guess.status}:{guess.objective:.12g}:{guess.iterations}"
+        # a guess derived from a solution (e.g. studies.predictive.thesis_guess) says how;
+        # two derivations of one solution must not share a key
+        der = (getattr(guess, "info", None) or {}).get("guess_derivation")
+        return sig if der is None else f"{sig}:{der}"
     raise TypeError(f"warm start must be a GaitSolution or ocp.Solution, got {type(guess).__name__}")
 
 

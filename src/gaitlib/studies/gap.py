@@ -1,0 +1,228 @@
+"""Chapter "Where the model misses reality" (issue 7): the studies behind the gap diagnosis.
+
+Functions
+---------
+:func:`effect_table`        the effect library (:data:`gaitlib.gap.EFFECTS`) as a table.
+:func:`twin_validation`     the diagnosis on twins (every SK effect × three magnitudes ×
+                            seeds) with the coarse SK baseline of :data:`TWIN_BASE`.
+:func:`sk_diagnosis`        the diagnosis of a real data set with the SK baseline.
+:func:`nmsk_attribution`    the muscle-level candidates (co-contraction, joint stiffness,
+                            activation timing) re-solved from the Ch 5 NMSK solution.
+:func:`emg_gap_table`       the EMG part of the gap (TA, medial gastrocnemius …) before and
+                            after each muscle-level candidate.
+
+All solutions go through :mod:`gaitlib.gap.solve` (cached under ``<cache>/gap``); the
+functions run serially (one process) unless ``serial=False`` is passed.
+"""
+
+from __future__ import annotations
+
+import contextlib
+
+import numpy as np
+import pandas as pd
+
+from .. import transcription as tr
+from ..gap import diagnose as D
+from ..gap import effects as fx
+from ..gap import io as gio
+from ..gap import locate as L
+
+__all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "NMSK_CANDIDATES", "effect_table", "twin_validation",
+           "sk_diagnosis", "nmsk_attribution", "emg_gap_table"]
+
+#: Baseline of the twin study: SK, data tracking (Eq 4.11), 10 × 3 LGR — the coarse mesh (the full 20 × 5 mesh costs ≈ 10× per solve and the twin study
+#: needs ≈ 170 solves per seed).
+TWIN_BASE = dict(model="SK", cost="DT", n_intervals=10, degree=3)
+#: Baseline of the SK diagnoses of the real data sets: the thesis's full 20 × 5 LGR mesh.
+SK_BASE = dict(model="SK", cost="DT", n_intervals=20, degree=5)
+#: Noise seeds of the twin study.
+TWIN_SEEDS = (1, 2)
+#: Candidates tested on the NMSK baseline (the effects whose signature is muscle-level).
+NMSK_CANDIDATES = ("co_contraction", "joint_stiffness", "activation_timing")
+
+
+def effect_table() -> pd.DataFrame:
+    """One row per effect: name, title, parameters (with units and bounds), models, where it
+    shows, how it is identified, twin magnitudes."""
+    rows = []
+    for n, e in fx.EFFECTS.items():
+        rows.append({"effect": n, "title": e.title, "k (parameters)": e.n_params,
+                     "parameters": ", ".join(f"{p.name} [{p.unit}] in [{p.lower:g}, {p.upper:g}]" for p in e.params),
+                     "models": "/".join(e.models), "signature": e.signature,
+                     "identified by": {"nlp": "NLP variable", "profile": "profile of the gap"}[e.identify]
+                     + ("" if e.resolve else " (comparison only)"),
+                     "twin magnitudes": ", ".join(f"{m:g}" for m in e.twin_magnitudes) if n in fx.TWIN_EFFECTS else "—"})
+    return pd.DataFrame(rows)
+
+
+def twin_validation(seeds=TWIN_SEEDS, base: dict | None = None, serial: bool = True, **kw):
+    """:func:`gaitlib.gap.twin.validate_twins` over every SK twin effect × its three
+    magnitudes × ``seeds`` with the coarse SK baseline (:data:`TWIN_BASE`)."""
+    from ..gap import twin
+
+    return twin.validate_twins(seeds=tuple(seeds), base=dict(base or TWIN_BASE), serial=serial, progress=False, **kw)
+
+
+def sk_diagnosis(source: str = "schwartz2008", speed_class: str = "Free", resamples: int = 200,
+                 serial: bool = True, **kw) -> D.Diagnosis:
+    """The SK diagnosis (:func:`gaitlib.gap.diagnose`) of a committed data set. gaitutils has
+    no GRFs: they are taken from Schwartz 2008 (same class) to make the problem complete and
+    excluded from the gap (:func:`gaitlib.gap.io.load_real` ``fill_from``)."""
+    fill = "schwartz2008" if source == "gaitutils" else None
+    ds = gio.load_real(speed_class, source, fill_from=fill)
+    base = dict(SK_BASE, speed_class=speed_class, source=source)
+    if not serial and ds.filled:
+        raise ValueError("a filled data set is solved in this process only (serial=True): see own_data")
+    with own_data(ds.gait if ds.filled else None):
+        return D.diagnose(ds, base=base, resamples=resamples, serial=serial, progress=False, **kw)
+
+
+@contextlib.contextmanager
+def own_data(gait):
+    """While active, :func:`gaitlib.data.load_gait_data` returns ``gait`` for its own speed
+    class and source (defaults of the other arguments only) — so that a gait problem of a
+    source whose committed data lack quantities the problem needs (gaitutils: no GRFs) is
+    built, solved and reloaded on the data set completed by ``fill_from``. In this process
+    only (serial solves). ``gait=None``: no change.
+
+    The solutions' cache keys hash the spec (source ``gaitutils``) and the completed data
+    set's numbers; the committed gaitutils data alone cannot build a gait problem, so a key
+    has only this one meaning."""
+    if gait is None:
+        yield
+        return
+    from .. import data as data_mod
+
+    orig = data_mod.load_gait_data
+
+    def patched(speed_class="Free", source="schwartz2008", *a, **k):
+        if speed_class == gait.speed_class and source == gait.source and not a and not k:
+            return gait
+        return orig(speed_class, source, *a, **k)
+
+    data_mod.load_gait_data = patched
+    try:
+        yield
+    finally:
+        data_mod.load_gait_data = orig
+
+
+def nmsk_attribution(candidates=NMSK_CANDIDATES, resamples: int = 200, serial: bool = True,
+                     root=None) -> D.Diagnosis:
+    """Muscle-level candidates on the Ch 5 NMSK solution (thesis Sec 5.3.5's question: does
+    co-contraction close the TA/GAM gap?).
+
+    Baseline: the Ch 5 NMSK data-tracking solution (:func:`gaitlib.studies.msk.solve`,
+    Eq 5.55 on the full 20 × 5 mesh) — not re-fitted. Candidates are re-solved with the
+    spec's own cost function (``objective="cost"``: the thesis's problem plus the effect),
+    warm-started from it, on the same mesh; profiled effects on their grid
+    (:data:`gaitlib.gap.diagnose.PROFILE_GRID`), activation timing on the comparison only.
+    Ranked as :func:`gaitlib.gap.diagnose.assemble` does."""
+    from . import msk
+
+    base_sol = msk.solve("NMSK", root=root)
+    spec0 = base_sol.spec
+    ds = gio.load_real(spec0.speed_class, spec0.source)
+    names, skipped = D.candidates(spec0, ds.gait, candidates)
+    fits = D.candidate_fits(spec0, {"data": ds}, {"data": base_sol}, names, objective="cost", root=root,
+                            serial=serial, progress=False)["data"]
+    return D.assemble(ds, spec0, base_sol, fits, objective="cost", resamples=resamples, skipped=skipped,
+                      settings={"objective": "cost", "candidates": names, "baseline": "Ch 5 NMSK solution"})
+
+
+def _emg_rss(loc: L.Located, stems) -> dict:
+    ch = loc.channels
+    out = {}
+    for s in stems:  # channel names of EMG are "<stem without emg_>_<side>", e.g. "TA_r"
+        sel = ch[(ch["kind"] == "emg") & ch["name"].str.startswith(s[4:] + "_")]
+        out[s] = float(sel["rss"].sum()) if len(sel) else np.nan
+    return out
+
+
+def emg_gap_table(diag: D.Diagnosis, stems=("emg_TA", "emg_MG", "emg_RF", "emg_LH")) -> pd.DataFrame:
+    """The EMG channels' RSS (both legs, SD-standardised, :mod:`gaitlib.gap.locate`) of the
+    baseline and of each candidate's best fit, with the identified magnitude and status;
+    ``mean_z`` of TA and MG tells the sign (model below/above the EMG)."""
+    rows = []
+    base = _emg_rss(diag.located, stems)
+
+    def mean_z(loc, s):
+        m = loc.points.groupby("channel")["z"].mean()
+        v = [m[c] for c in m.index if c.startswith(f"emg:{s[4:]}_")]
+        return float(np.mean(v)) if v else np.nan
+
+    rows.append({"model": "baseline", "parameters": "", "status": diag.baseline.stats["status"],
+                 **{f"RSS {s[4:]}": base[s] for s in stems},
+                 "mean z TA": mean_z(diag.located, "emg_TA"), "mean z MG": mean_z(diag.located, "emg_MG")})
+    for n, f in diag.fits.items():
+        if f.located is None:
+            rows.append({"model": n, "parameters": "", "status": f.status})
+            continue
+        r = _emg_rss(f.located, stems)
+        th = f.thetas.get(n, {})
+        rows.append({"model": n, "parameters": ", ".join(f"{k} = {v:.3g}" for k, v in th.items()), "status": f.status,
+                     **{f"RSS {s[4:]}": r[s] for s in stems},
+                     "mean z TA": mean_z(f.located, "emg_TA"), "mean z MG": mean_z(f.located, "emg_MG")})
+    return pd.DataFrame(rows)
+
+
+def top_cells(loc: L.Located, n: int = 6) -> pd.DataFrame:
+    """The ``n`` channel × phase cells with the largest RMS SD-standardised residual."""
+    t = loc.table.sort_values("rms_z", ascending=False).head(n)
+    return t[["channel", "phase", "rms_z", "mean_z", "frac_out", "p_min", "significant"]].reset_index(drop=True)
+
+
+def ranking_table(diag: D.Diagnosis) -> pd.DataFrame:
+    """The ranking for printing: effect, k, identified values, status, % closed (with its
+    95 % resampling interval where computed), ΔAIC, ΔBIC."""
+    r = diag.ranking.copy()
+    r["identified"] = r["parameters"].map(lambda th: ", ".join(f"{k} = {v:.3g}" for k, v in (th or {}).items()))
+    cols = ["rank", "effect", "n_params", "identified", "status", "rss_after", "pct_closed"]
+    cols += [c for c in ("pct_closed_lo", "pct_closed_hi") if c in r.columns] + ["dAIC", "dBIC"]
+    return r[cols]
+
+
+def summary(diag: D.Diagnosis) -> dict:
+    """Numbers for the text: baseline RSS, n_eff, significant cells, top effect, verdict, its
+    % closed and interval."""
+    s = {"label": diag.data.label, "rss": diag.located.rss, "n_eff": diag.located.n_eff,
+         "rms_z": diag.located.rms_z, "significant_cells": int(diag.located.table["significant"].sum()),
+         "cells": int(len(diag.located.table)), "top": diag.top_effect, "verdict": diag.verdict,
+         "best": None, "best_pct": np.nan, "best_dBIC": np.nan, "interval": [np.nan, np.nan],
+         "baseline_status": diag.baseline.stats.get("status")}
+    ok = diag.ranking[diag.ranking["ok"] & np.isfinite(diag.ranking["dBIC"])]
+    if len(ok):
+        b = ok.iloc[0]
+        s.update(best=str(b["effect"]), best_pct=float(b["pct_closed"]), best_dBIC=float(b["dBIC"]),
+                 interval=list(diag.intervals.get(str(b["effect"]), [np.nan, np.nan])))
+    return s
+
+
+def profile_table(diag: D.Diagnosis, effect: str, stems=("emg_TA", "emg_MG", "emg_RF", "emg_LH")) -> pd.DataFrame:
+    """Every profile point of a profiled effect (``identify="profile"``) of ``diag``: its
+    magnitude, IPOPT status and iterations, the whole gap's RSS and the EMG channels' RSS
+    and mean z — the solutions reloaded from the cache (:func:`gaitlib.gap.solve.solve_on`
+    with the same warm start; nothing is solved if :func:`nmsk_attribution` ran)."""
+    from ..gap.solve import solve_on
+
+    f = diag.fits[effect]
+    rows = [{"magnitude": 0.0, "status": diag.baseline.stats["status"], "iterations": diag.baseline.stats.get("iterations"),
+             "RSS (all)": diag.located.rss, **_emg_cols(diag.located, stems)}]
+    for m, _, _ in f.profile:
+        spec = D._with_effects(diag.spec, ((effect, m),))
+        sol = solve_on(spec, diag.data.gait, diag.baseline, objective=diag.objective)
+        loc = L.locate(sol, diag.data, thetas=sol.stats.get("effects"))
+        rows.append({"magnitude": m, "status": sol.stats["status"], "iterations": sol.stats.get("iterations"),
+                     "RSS (all)": loc.rss, **_emg_cols(loc, stems)})
+    return pd.DataFrame(rows)
+
+
+def _emg_cols(loc: L.Located, stems) -> dict:
+    r = _emg_rss(loc, stems)
+    out = {f"RSS {s[4:]}": r[s] for s in stems}
+    m = loc.points.groupby("channel")["z"].mean()
+    for s in ("emg_TA", "emg_MG"):
+        v = [m[c] for c in m.index if c.startswith(f"emg:{s[4:]}_")]
+        out[f"mean z {s[4:]}"] = float(np.mean(v)) if v else np.nan
+    return out
