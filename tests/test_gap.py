@@ -358,3 +358,31 @@ def test_cli_gap_on_a_hand_written_csv(tmp_path):
     elig = [r for r in j["ranking"] if r["ok"] and r["dBIC"] is not None and r["dBIC"] <= j["criterion"]["threshold_dBIC"]]
     assert j["top_effect"] == (elig[0]["effect"] if elig else "unexplained")
     assert j["verdict"] in ("explained", "partial", "unexplained")
+
+
+def test_exact_left_leg_is_the_right_leg_rolled_by_half_a_cycle():
+    """With the left-leg shift at exactly half the 50-interval data cycle, the exact left leg
+    is the right leg's samples rolled by 25; the Fourier-generated left leg is not (it rings
+    where the GRF is zero), and a left channel that is the source's own is kept."""
+    from gaitlib.studies.gap import exact_left_leg
+
+    g = data_mod.load_gait_data("Free", "schwartz2008", left_shift=0.5)
+    gx, replaced = exact_left_leg(g)
+    assert {"hip_l", "tau_ankle_l", "grf_x_l", "grf_y_l", "emg_TA_l"} <= set(replaced)
+    for c in ("hip_l", "tau_ankle_l", "grf_y_l"):
+        r = g.mean[c[:-2] + "_r"].to_numpy()[:-1]  # 50 distinct samples of the cycle
+        np.testing.assert_allclose(gx.mean[c].to_numpy()[:-1], np.roll(r, -25), atol=1e-12)
+        np.testing.assert_allclose(gx.sd[c].to_numpy()[:-1], np.roll(g.sd[c[:-2] + "_r"].to_numpy()[:-1], -25),
+                                   atol=1e-12)
+    # the Fourier series of a GRF that is zero in swing is not zero there: its ringing, in N
+    # (here it even pulls the foot down: a negative vertical GRF of more than 5 N)
+    swing_r = np.abs(g.mean["grf_y_r"].to_numpy()[:-1]) < 1.0
+    swing_l = np.roll(swing_r, -25)
+    assert swing_l.sum() >= 15
+    yl_exact, yl_fourier = gx.mean["grf_y_l"].to_numpy()[:-1], g.mean["grf_y_l"].to_numpy()[:-1]
+    assert np.all(np.abs(yl_exact[swing_l]) < 1.0)
+    assert np.min(yl_fourier[swing_l]) < -5.0
+    # a left leg that is not the Fourier series of the right one is left alone
+    g2 = g.__class__(**{**g.__dict__, "mean": g.mean.assign(knee_l=g.mean["knee_l"] + 0.01)})
+    _, rep2 = exact_left_leg(g2)
+    assert "knee_l" not in rep2 and "hip_l" in rep2

@@ -72,6 +72,13 @@ def main(argv) -> int:
                 for e in kind.iterdir():
                     if not (new / kind.name / e.name).exists():
                         shutil.copytree(e, new / kind.name / e.name)
+    if subset and (STORE / "README.md").exists():  # keep the other notebooks' times, in book order
+        old = dict(line[2:].rsplit(": ", 1) for line in (STORE / "README.md").read_text().splitlines()
+                   if line.startswith("- ") and ": " in line)
+        order = [p.name for p in notebooks([])]
+        merged = {k: float(v.rstrip(" s")) for k, v in old.items()}
+        merged.update(times)
+        times = {k: merged[k] for k in sorted(merged, key=lambda k: order.index(k) if k in order else len(order))}
     if STORE.exists():
         shutil.rmtree(STORE)
     shutil.move(str(new), STORE)
@@ -79,7 +86,7 @@ def main(argv) -> int:
         "Solutions the book loads instead of re-solving, keyed by spec + code + data hash\n"
         "(gaitlib.cache). Written by tools/store_solutions.py; never edit by hand.\n\n"
         + "\n".join(f"- {k}: {v:.0f} s" for k, v in times.items()) + "\n")
-    print(f"store: {len(used)} entries, total {sum(times.values()):.0f} s")
+    print(f"store: {len(used)} entries used by this run; times (s): {times}")
     shutil.rmtree(tmp, ignore_errors=True)
     return 0
 

@@ -131,3 +131,26 @@ def channel_curves(loc0, loc1, channels, labels=("baseline", "with effect")):
     axs[0][0].legend(fontsize=7)
     fig.tight_layout()
     return fig
+
+
+def data_views(loc_a, loc_b, channels, labels=("data as tracked", "left leg shifted exactly"), sim_label="simulation"):
+    """One solution located against two views of the data (e.g. the Fourier-generated left
+    leg and the exactly shifted one, :func:`gaitlib.studies.gap.left_leg_check`): both data
+    means, the first view's ±1 SD band, and the (same) simulated curve."""
+    import matplotlib.pyplot as plt
+
+    n = len(channels)
+    fig, axs = plt.subplots(1, n, figsize=(3.3 * n, 2.8), squeeze=False)
+    for ax, ch in zip(axs[0], channels):
+        pa = loc_a.points[loc_a.points["channel"] == ch]
+        pb = loc_b.points[loc_b.points["channel"] == ch]
+        ax.fill_between(100 * pa["tau"], pa["mean"] - pa["sd_eff"], pa["mean"] + pa["sd_eff"], color="0.85",
+                        label=f"{labels[0]} ±1 SD*")
+        ax.plot(100 * pa["tau"], pa["mean"], color="k", lw=1, label=labels[0])
+        ax.plot(100 * pb["tau"], pb["mean"], color="tab:green", lw=1.3, ls="--", label=labels[1])
+        ax.plot(100 * pa["tau"], pa["sim"], color="tab:red", lw=1.1, label=sim_label)
+        ax.set_title(_label(ch), fontsize=9)
+        ax.set_xlabel("% cycle")
+    axs[0][0].legend(fontsize=7)
+    fig.tight_layout()
+    return fig
