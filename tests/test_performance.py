@@ -59,3 +59,37 @@ def test_scaling_fits_use_finished_runs_and_report_linear_growth():
 def test_missing_results_name_the_file_and_the_script(tmp_path):
     with pytest.raises(FileNotFoundError, match="bench_scaling.py"):
         perf.load("scaling", root=tmp_path)
+
+
+def test_load_note_says_shared_only_when_the_machine_was_busy():
+    """bench_scaling's note follows the recorded load averages: quiet only if every run
+    started below QUIET_LOAD."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_scaling.py"
+    spec = importlib.util.spec_from_file_location("bench_scaling", path)
+    bs = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bs)
+    doc = {"meta": {"loadavg_start": [0.9, 0.8, 0.7]}, "runs": [{"loadavg_start": [1.05, 1, 1]}, {"loadavg_start": [0.97, 1, 1]}]}
+    assert "no other job" in bs._load_note(doc) and "1.05" in bs._load_note(doc)
+    doc["runs"].append({"loadavg_start": [2.4, 2, 2]})
+    assert bs._load_note(doc) == bs.SHARED_NOTE
+
+
+def test_kkt_and_msk_profile_tables_keep_errors_out_and_units_in_names():
+    kkt = {"rows": [{"model": "SK", "n_intervals": 5, "nodes": 25, "kkt_dim": 100, "kkt_nnz": 900, "hessian_ms": 1.0,
+                     "jacobian_ms": 0.5, "other_evals_ms": 0.5, "evaluations_ms": 2.0, "factorisation_ms": 1.0,
+                     "factor_solve_ms": 1.2, "iteration_ms": 3.2},
+                    {"model": "SK", "n_intervals": 10, "error": "boom"}],
+           "fits": [{"model": "SK", "quantity": "iteration_ms", "exponent": 1.0}]}
+    rows, fits = perf.kkt_scaling_tables(kkt)
+    assert list(rows["n_intervals"]) == [5] and "iteration_ms" in rows.columns and len(fits) == 1
+    prof = {"runs": [{"variant": "default", "status": "Solve_Succeeded", "iterations": 10, "solve_s": 2.0,
+                      "ms_per_iteration": 200.0, "hessian_s": 0.5, "other_evals_s": 0.3, "linear_systems_s": 1.0,
+                      "rest_s": 0.2, "perturbed_iterations": 4, "objective": 1.0}],
+            "graph_sizes": [{"model": "SK", "n_variables": 10, "n_constraints": 8, "constraint_instructions": 100,
+                             "hessian_instructions": 1000, "hessian_nnz": 30}]}
+    runs, sizes = perf.msk_profile_tables(prof)
+    assert runs.loc[0, "solve (s)"] == 2.0 and runs.loc[0, "iterations with Hessian perturbation"] == 4
+    assert sizes.loc[0, "Hessian SX instructions"] == 1000

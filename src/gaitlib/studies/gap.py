@@ -305,3 +305,51 @@ def left_leg_check(diag: D.Diagnosis) -> dict:
         ranking = ranking.sort_values("% closed (left leg shifted exactly)", ascending=False).reset_index(drop=True)
     return {"replaced": replaced, "generation": g.reset_index(drop=True), "cells": cells, "ranking": ranking,
             "located_exact": loc_x, "rss": {"data as tracked": diag.located.rss, "left leg shifted exactly": loc_x.rss}}
+
+
+def _rms(ch: pd.DataFrame) -> float:
+    n = float(ch["n"].sum())
+    return float(np.sqrt(ch["rss"].sum() / n)) if n else np.nan
+
+
+def book_gaps(root=None) -> pd.DataFrame:
+    """The located gap of the book's own Ch 5–7 solutions (nothing is re-solved: every
+    solution is reloaded through its study function).
+
+    Ch 5: the MSK and NMSK data-tracking solutions; Ch 6: the 16 cost-function runs; Ch 7:
+    the 8 speed runs — each located against **its own speed class's data** (Schwartz 2008),
+    which Ch 7 never tracked (it tracks the Free data scaled in time). One row per solution:
+    chapter, model, case (cost function or class), IPOPT status, RMS z of the angles, torques
+    and GRFs (against the data as tracked and with the left leg shifted exactly,
+    :func:`exact_left_leg`), RMS z of the EMG channels (muscle models), the number of
+    significant channel × phase cells (non-EMG) and the largest such cell.
+    """
+    from dataclasses import replace as _replace
+
+    from . import msk
+    from . import predictive as pr
+
+    items = [("Ch 5", m, "DT (Eq 5.33)" if m == "MSK" else "DT (Eq 5.55)", msk.solve(m, root=root)) for m in ("MSK", "NMSK")]
+    r6 = pr.cost_function_study(("MSK", "NMSK"), pr.CH6_COSTS, progress=False, root=root)
+    items += [("Ch 6", r6.specs[k].model, r6.specs[k].cost, s) for k, s in r6.solutions.items()]
+    r7 = pr.speed_study(("MSK", "NMSK"), pr.CH7_CLASSES, progress=False, root=root)
+    items += [("Ch 7", r7.specs[k].model, r7.specs[k].speed_class, s) for k, s in r7.solutions.items()]
+    data, rows = {}, []
+    for chapter, model, case, sol in items:
+        cls = sol.spec.speed_class
+        if cls not in data:
+            ds = gio.load_real(cls, "schwartz2008")
+            data[cls] = (ds, _replace(ds, gait=exact_left_leg(ds.gait)[0]))
+        ds, ds_x = data[cls]
+        loc, loc_x = L.locate(sol, ds), L.locate(sol, ds_x)
+        ch, chx = loc.channels, loc_x.channels
+        t = loc.table[loc.table["kind"] != "emg"] if "kind" in loc.table.columns else loc.table
+        top = t.sort_values("rms_z", ascending=False).iloc[0]
+        rows.append({"chapter": chapter, "model": model, "case": case, "speed class (data)": cls,
+                     "status": sol.stats["status"],
+                     "RMS z, angles/torques/GRFs": _rms(ch[ch["kind"] != "emg"]),
+                     "RMS z, same, left leg shifted exactly": _rms(chx[chx["kind"] != "emg"]),
+                     "RMS z, EMG": _rms(ch[ch["kind"] == "emg"]),
+                     "significant cells (non-EMG)": int(t["significant"].sum()), "cells (non-EMG)": int(len(t)),
+                     "largest cell": f"{top['channel']} {top['phase']}", "its RMS z": float(top["rms_z"])})
+    return pd.DataFrame(rows)

@@ -36,7 +36,7 @@ import numpy as np
 import pandas as pd
 
 __all__ = ["results_dir", "load", "fit_power_law", "scaling_table", "scaling_fits", "hessian_table",
-           "linear_solver_table", "moco_table", "gait_table", "measured_on", "ThesisTime", "THESIS_SILENT",
+           "linear_solver_table", "moco_table", "gait_table", "msk_profile_tables", "kkt_scaling_tables", "measured_on", "ThesisTime", "THESIS_SILENT",
            "thesis_reference_times", "parse_duration", "time_row", "missing_row", "NOT_COMPUTED", "NO_CACHE",
            "TIME_COLUMNS", "thesis_times_table", "thesis_times_summary", "thesis_times_by_chapter",
            "thesis_times_figure", "NotInCache", "no_solving"]
@@ -183,6 +183,39 @@ def gait_table(res: dict | None = None) -> pd.DataFrame:
             "build_s", "objective", "thesis"]
     df = pd.DataFrame(res["rows"])
     return df[[c for c in cols if c in df.columns]].rename(columns={"thesis": "thesis time (GPOPS-II, labelled)"})
+
+
+def msk_profile_tables(res: dict | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """``bench_msk_profile.py``: (runs, graph sizes). Runs: per IPOPT option variant, status,
+    iterations, solve time (s), ms per iteration, IPOPT's split of the solve (Lagrangian
+    Hessian, the other function/derivative evaluations, the linear systems — MUMPS — and
+    the rest, s), iterations that needed a Hessian perturbation, objective. Graph sizes: SX
+    instructions of the constraints and of the Lagrangian's Hessian, SK beside MSK."""
+    res = load("msk_profile") if res is None else res
+    cols = {"variant": "variant", "status": "status", "iterations": "iterations", "solve_s": "solve (s)",
+            "ms_per_iteration": "ms / iteration", "hessian_s": "Hessian (s)", "other_evals_s": "other evaluations (s)",
+            "linear_systems_s": "linear systems, MUMPS (s)", "rest_s": "rest (s)",
+            "perturbed_iterations": "iterations with Hessian perturbation", "objective": "objective"}
+    runs = pd.DataFrame(res["runs"])
+    runs = runs[[c for c in cols if c in runs.columns]].rename(columns=cols)
+    sizes = pd.DataFrame(res["graph_sizes"]).rename(columns={
+        "n_variables": "variables", "n_constraints": "constraints", "constraint_instructions": "constraint SX instructions",
+        "hessian_instructions": "Hessian SX instructions", "hessian_nnz": "Hessian non-zeros"})
+    return runs, sizes
+
+
+def kkt_scaling_tables(res: dict | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """``bench_kkt_scaling.py``: (sizes, fits). Sizes: per model and mesh, the KKT matrix's
+    dimension and non-zeros and the median times (ms) of one iteration's pieces at a fixed
+    point — the NLP functions' evaluations, one MUMPS numeric factorisation, factorisation +
+    solve, and their sum (``iteration_ms``). Fits: exponent b of ``t ∝ nodes^b`` per model and
+    quantity."""
+    res = load("kkt_scaling") if res is None else res
+    rows = pd.DataFrame([r for r in res["rows"] if "error" not in r])
+    cols = ["model", "n_intervals", "nodes", "kkt_dim", "kkt_nnz", "hessian_ms", "jacobian_ms", "other_evals_ms",
+            "evaluations_ms", "factorisation_ms", "factor_solve_ms", "iteration_ms"]
+    fits = pd.DataFrame(res["fits"])
+    return rows[[c for c in cols if c in rows.columns]], fits
 
 
 def measured_on(res: dict) -> str:
