@@ -20,7 +20,8 @@ the book's notebooks call* (book/src/ch02_gait.py … ch07_speed.py):
   ch06  studies.predictive.cost_function_study (16 runs), its NMSK runs from the thesis's
         partial guess (8), and the 3000-iteration reruns of the runs that stopped at the limit
   ch07  studies.predictive.speed_study (8 runs), NMSK from the thesis's guess (4), reruns
-  ch08  studies.gap (our chapter, not in the thesis): twin_validation(), sk_diagnosis
+  ch08  studies.gap (our chapter, not in the thesis): twin_validation(),
+        twin_validation_full_mesh(), sk_diagnosis
         ("schwartz2008"), ("gaitutils"), nmsk_attribution() — one row per study, summed
         over its NLP solves (the gap cache entries the study used)
 
@@ -399,6 +400,8 @@ def ch08(perf, ctx):
 
     studies = (("twin validation (38 twins, coarse 10 × 3 mesh)", "studies.gap.twin_validation()",
                 G.twin_validation),
+               ("twin check on 20 × 5 (middle magnitude, 7 twins)", "studies.gap.twin_validation_full_mesh()",
+                G.twin_validation_full_mesh),
                ("SK diagnosis, Schwartz 2008 Free (20 × 5)", 'studies.gap.sk_diagnosis("schwartz2008")',
                 lambda: G.sk_diagnosis("schwartz2008")),
                ("SK diagnosis, gaitutils (20 × 5)", 'studies.gap.sk_diagnosis("gaitutils")',

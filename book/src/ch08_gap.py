@@ -66,7 +66,8 @@ T0 = time.perf_counter()
 # The baseline here is the SK model (data tracking, Eq 4.11) **fitted** to Schwartz 2008
 # *Free* by the diagnosis's objective: the SD-standardised tracking error of these channels
 # plus a tenth of the thesis's regularisation (`gaitlib.gap.solve`), on the thesis's full
-# 20 × 5 LGR mesh. (The twin validation of Sec. 3, ≈ 340 solves, runs on a coarse mesh.)
+# 20 × 5 LGR mesh. (The twin validation of Sec. 3, ≈ 340 solves, runs on a coarse mesh and is
+# repeated on 20 × 5 at the middle magnitude.)
 
 # %%
 dS = G.sk_diagnosis("schwartz2008")
@@ -208,6 +209,49 @@ for t, bt, bn in true_not_better:
 # local optimum than a neighbouring effect's (arm swing and foot-contact geometry both
 # reshape the stance-phase GRFs). The identified magnitudes in the table above show how
 # well each effect is identifiable from angles, torques and GRFs.
+
+# %% [markdown]
+# **The same check on the thesis's mesh.** The real-data diagnoses below run on the 20 × 5
+# mesh, the twin study above on 10 × 3. The check is repeated on 20 × 5 at the middle
+# magnitude of every effect, with one noise seed and the effect-free twin (≈ 70 full-mesh
+# solves, `gaitlib.studies.gap.twin_validation_full_mesh`):
+
+# %%
+tvf = G.twin_validation_full_mesh()
+rf = tvf.rows
+display(rf[["twin", "injected", "magnitude", "top", "verdict", "correct", "identified_magnitude", "rss_base",
+            "rss_top", "rss_true_fixed", "rss_gen", "shrink_injected_top", "shrink_vs_noise_top", "dBIC_top",
+            "dBIC_true"]])
+inj_f = rf[rf["injected"] != "none"]
+acc_f = 100 * float(inj_f["correct"].mean())
+shr_f = float(inj_f["shrink_injected_top"].clip(upper=100.0).mean())
+shr_f_noise = float(inj_f["shrink_vs_noise_top"].mean())
+none_f = rf.loc[rf["injected"] == "none", "correct"]
+gen_f = sum(v["status"] == "Solve_Succeeded" for v in tvf.gen_stats.values())
+print(f"20 × 5 mesh, middle magnitude: top-1 accuracy {acc_f:.0f} % ({int(inj_f['correct'].sum())} of {len(inj_f)}); "
+      f"mean shrink of the injected gap (capped at 100 %) {shr_f:.0f} % ({int(inj_f['shrink_injected_top'].count())} "
+      f"defined), against the noise floor {shr_f_noise:.0f} %; effect-free twin named 'unexplained': "
+      f"{int(none_f.sum())} of {len(none_f)}; twin generation {gen_f} of {len(tvf.gen_stats)} converged")
+wrong_f = rf[~rf["correct"]]
+for r in wrong_f.itertuples():
+    if r.injected == "none":
+        print(f"  {r.twin}: named {r.top} (ΔBIC {r.dBIC_top:.1f}) on a baseline fit with RSS {r.rss_base:.1f}, "
+              f"{r.rss_base / r.rss_gen:.1f}× the generating solution's own RSS on its twin")
+    else:
+        print(f"  {r.twin}: named {r.top}; the true model fitted the same way reaches RSS {r.rss_true_fixed:.1f} "
+              f"against the baseline's {r.rss_base:.1f} (ΔBIC_true {r.dBIC_true:+.1f}) and the generating "
+              f"solution's {r.rss_gen:.1f}")
+
+# %% [markdown]
+# On the 20 × 5 mesh the check is **not** passed. Where it fails (listed above), the ranking
+# is not the culprit: the fits themselves stop in local optima far from the twin's
+# generating solution — the true model, fitted from the same starts with its magnitude
+# fixed, does not improve on the baseline fit, and an effect-free twin whose baseline fit
+# stalls at a multiple of the noise gets "rescued" by a candidate's extra freedom. The
+# diagnosis is only as good as its fits: on the thesis's mesh, the baseline fitting
+# (data-based guess, warm start from the real-data fit) needs more starts, or a
+# continuation from the coarse mesh, before the ranking can be trusted. The real-data
+# results of Sec. 4 are on 20 × 5 and carry this caveat.
 
 # %% [markdown]
 # ## 4. Findings on the real data
@@ -403,6 +447,12 @@ lines.append(
     f"{'met' if shr_mean >= 60 else 'not met'}; median {shr_med:.0f} %), but only {shr_noise:.0f} % of the gap down to "
     f"the noise floor, which also counts the coarse mesh's own residual: on the 10 × 3 mesh the true model "
     f"itself does not reach the noise.")
+lines.append(
+    f"**Twins on the thesis's 20 × 5 mesh** (middle magnitude, one seed): top-1 accuracy {acc_f:.0f} % — the 90 % "
+    f"target is {'met' if acc_f >= 90 else '**not met** on this mesh'} — effect-free twin 'unexplained' "
+    f"{int(none_f.sum())} of {len(none_f)}, mean shrink of the injected gap {shr_f:.0f} % (capped), {shr_f_noise:.0f} % "
+    f"against the noise floor. The validated configuration is the 10 × 3 mesh; on 20 × 5 the fits, not the "
+    f"criterion, limit the diagnosis, and the real-data findings below carry that caveat.")
 lines.append(
     f"**Schwartz 2008 Free.** The SK baseline fit leaves {sS['significant_cells']} of {sS['cells']} channel × phase "
     f"cells significantly outside the band (RMS z = {sS['rms_z']:.2f}); the largest cell is "
