@@ -135,11 +135,7 @@ display(perf.gait_table(gait_bench))
 # Hessian perturbation (inertia correction) is factorised at least twice.
 
 # %%
-try:
-    prof = perf.load("msk_profile")
-except FileNotFoundError as e:
-    prof = None
-    print(e)
+prof = perf.load_optional("msk_profile")
 if prof is not None:
     print(perf.measured_on(prof))
     pr_runs, pr_sizes = perf.msk_profile_tables(prof)
@@ -256,11 +252,7 @@ display(perf.moco_table(moco))
 # MSK profile) does not show to that extent.
 
 # %%
-try:
-    kkt = perf.load("kkt_scaling")
-except FileNotFoundError as e:
-    kkt = None
-    print(e)
+kkt = perf.load_optional("kkt_scaling")
 if kkt is not None:
     print(perf.measured_on(kkt))
     kkt_rows, kkt_fits = perf.kkt_scaling_tables(kkt)

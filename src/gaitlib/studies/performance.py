@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-__all__ = ["results_dir", "load", "fit_power_law", "scaling_table", "scaling_fits", "hessian_table",
+__all__ = ["results_dir", "load", "load_optional", "fit_power_law", "scaling_table", "scaling_fits", "hessian_table",
            "linear_solver_table", "moco_table", "gait_table", "msk_profile_tables", "kkt_scaling_tables", "measured_on", "ThesisTime", "THESIS_SILENT",
            "thesis_reference_times", "parse_duration", "time_row", "missing_row", "NOT_COMPUTED", "NO_CACHE",
            "TIME_COLUMNS", "thesis_times_table", "thesis_times_summary", "thesis_times_by_chapter",
@@ -69,6 +69,16 @@ def load(name: str, root=None) -> dict:
     if not f.is_file():
         raise FileNotFoundError(f"{f}: benchmark results missing — run benchmarks/bench_{name}.py")
     return json.loads(f.read_text())
+
+
+def load_optional(name: str, root=None) -> dict | None:
+    """:func:`load`, or ``None`` (with the reason printed) when the results file is missing —
+    for page sections whose benchmark may not have been run yet."""
+    try:
+        return load(name, root)
+    except FileNotFoundError as e:
+        print(e)
+        return None
 
 
 def fit_power_law(n, y) -> dict:
