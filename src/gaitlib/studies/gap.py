@@ -10,9 +10,13 @@ Functions
                             activation timing) re-solved from the Ch 5 NMSK solution.
 :func:`emg_gap_table`       the EMG part of the gap (TA, medial gastrocnemius …) before and
                             after each muscle-level candidate.
+:func:`exact_left_leg`      a data set whose generated left leg is the right leg shifted
+                            exactly instead of through the Fourier fit.
 :func:`left_leg_check`      how much of a located gap is the left leg's generation from the
                             right (the thesis's 5th-order Fourier fit, Eqs 4.1–4.3) rather
                             than the model.
+:func:`book_gaps`           the located gap of the book's own Ch 5–7 solutions.
+:func:`twin_validation_full_mesh`  the twin check on the 20 × 5 mesh (middle magnitude).
 
 All solutions go through :mod:`gaitlib.gap.solve` (cached under ``<cache>/gap``); the
 functions run serially (one process) unless ``serial=False`` is passed.
@@ -33,7 +37,8 @@ from ..gap import io as gio
 from ..gap import locate as L
 
 __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "NMSK_CANDIDATES", "effect_table", "twin_validation",
-           "sk_diagnosis", "nmsk_attribution", "emg_gap_table", "exact_left_leg", "left_leg_check"]
+           "sk_diagnosis", "nmsk_attribution", "emg_gap_table", "exact_left_leg", "left_leg_check",
+           "book_gaps", "twin_validation_full_mesh"]
 
 #: Baseline of the twin study: SK, data tracking (Eq 4.11), 10 × 3 LGR — the coarse mesh (the full 20 × 5 mesh costs ≈ 10× per solve and the twin study
 #: needs ≈ 170 solves per seed).
@@ -232,22 +237,24 @@ def _emg_cols(loc: L.Located, stems) -> dict:
     return out
 
 
-def exact_left_leg(gait, order: int = 5):
+def exact_left_leg(gait, order: int | None = None):
     """``gait`` with every left-leg channel that was generated from the right one by the
-    Fourier fit (:func:`gaitlib.data.fourier_shift`, thesis Eqs 4.1–4.3, order ``order``)
-    replaced by the right leg shifted **exactly** — periodic linear interpolation of the
-    right leg's mean and SD at τ + ``left_shift`` on the data's own grid, with no smoothing.
-    Left channels that are the source's own (gaitutils EMG) are kept.
+    Fourier fit (:func:`gaitlib.data.fourier_shift`, thesis Eqs 4.1–4.3, order ``order``,
+    default the loader's) replaced by the right leg shifted **exactly** — periodic linear
+    interpolation of the right leg's mean and SD at τ + ``left_shift`` on the data's own
+    grid, with no smoothing. Left channels that are the source's own (gaitutils EMG) and the
+    planned metatarsal trajectory are kept.
 
     Returns ``(gait_exact, replaced)``: a new GaitData and the replaced column names.
     """
     from .. import data as data_mod
 
+    order = fx._FOURIER_ORDER if order is None else order
     tau = gait.time / float(gait.cycle_time)
     shift = float(gait.left_shift)
     mean, sd, replaced = gait.mean.copy(), gait.sd.copy(), []
     for c in gait.channels:
-        if not c.endswith("_l") or f"{c[:-2]}_r" not in gait.mean.columns:
+        if not c.endswith("_l") or c.startswith("mtp_") or f"{c[:-2]}_r" not in gait.mean.columns:
             continue
         r = c[:-2] + "_r"
         xr = gait.mean[r].to_numpy(float)
@@ -324,8 +331,6 @@ def book_gaps(root=None) -> pd.DataFrame:
     :func:`exact_left_leg`), RMS z of the EMG channels (muscle models), the number of
     significant channel × phase cells (non-EMG) and the largest such cell.
     """
-    from dataclasses import replace as _replace
-
     from . import msk
     from . import predictive as pr
 
@@ -339,11 +344,11 @@ def book_gaps(root=None) -> pd.DataFrame:
         cls = sol.spec.speed_class
         if cls not in data:
             ds = gio.load_real(cls, "schwartz2008")
-            data[cls] = (ds, _replace(ds, gait=exact_left_leg(ds.gait)[0]))
+            data[cls] = (ds, replace(ds, gait=exact_left_leg(ds.gait)[0]))
         ds, ds_x = data[cls]
         loc, loc_x = L.locate(sol, ds), L.locate(sol, ds_x)
         ch, chx = loc.channels, loc_x.channels
-        t = loc.table[loc.table["kind"] != "emg"] if "kind" in loc.table.columns else loc.table
+        t = loc.table[loc.table["kind"] != "emg"]
         top = t.sort_values("rms_z", ascending=False).iloc[0]
         rows.append({"chapter": chapter, "model": model, "case": case, "speed class (data)": cls,
                      "status": sol.stats["status"],
