@@ -400,7 +400,7 @@ def ch08(perf, ctx):
 
     studies = (("twin validation (38 twins, coarse 10 × 3 mesh)", "studies.gap.twin_validation()",
                 G.twin_validation),
-               ("twin check on 20 × 5 (middle magnitude, 7 twins)", "studies.gap.twin_validation_full_mesh()",
+               ("twin check on 20 × 5 (middle magnitude, 2 seeds, 14 twins)", "studies.gap.twin_validation_full_mesh()",
                 G.twin_validation_full_mesh),
                ("SK diagnosis, Schwartz 2008 Free (20 × 5)", 'studies.gap.sk_diagnosis("schwartz2008")',
                 lambda: G.sk_diagnosis("schwartz2008")),

@@ -275,6 +275,31 @@ def test_criteria_pay_for_parameters():
     assert dbic == pytest.approx(200 * np.log(0.9) + 2 * np.log(200))
 
 
+def test_baseline_fit_keeps_the_best_converged_start(tmp_path, real, monkeypatch):
+    """The multistart baseline fit solves from every start (cold, warm, the spec's own cost
+    then the fit, a coarser mesh then the fit) and keeps the converged fit with the lowest
+    objective, naming its start; a mesh no finer than the coarse one has no coarse start."""
+    from gaitlib.gap import diagnose as D
+
+    spec = tr.GaitSpec(model="SK", cost="DT", n_intervals=4, degree=2)
+    monkeypatch.setattr(D, "COARSE_MESH", (2, 2))
+    root = tmp_path / "sol"
+    warm = D.solve_many({"w": (spec, [("w", real.gait, None)])}, root=root, serial=True, progress=False)["w"]
+    out = D.baseline_fits(spec, {"d": real}, warm, root=root, detail=True, serial=True, progress=False)["d"]
+    assert set(out) == {"cold", "warm", "dt", "coarse", "best"}
+    conv = {k: s for k, s in out.items() if k != "best" and D._status(s)[1]}
+    assert conv, {k: s.stats["status"] for k, s in out.items()}
+    best = min(conv.values(), key=lambda s: s.stats["objective"])
+    assert out["best"] is best and out["best"].stats["start"] in conv
+    assert conv[out["best"].stats["start"]] is best
+    # every start is a fit of the same problem: same objective kind, comparable objectives
+    assert all(s.stats["objective_kind"] == "fit" for k, s in out.items())
+    monkeypatch.setattr(D, "COARSE_MESH", (4, 2))
+    assert D._coarse_spec(spec) is None
+    with pytest.raises(ValueError, match="unknown baseline start"):
+        D.baseline_fits(spec, {"d": real}, starts=("cold", "hot"))
+
+
 def test_diagnose_names_the_injected_effect_on_a_twin(tmp_path):
     """A coarse SK twin with lower friction (k = −0.3): the diagnosis, given the baseline
     model and three candidates, names friction and recovers its magnitude."""

@@ -4,9 +4,11 @@
 GaitData) and a baseline model, and
 
 1. fits the baseline (objective ``"fit"``, :mod:`gaitlib.gap.solve`: the SD-standardised
-   tracking error of the located channels plus the spec's regularisation; from the data's
-   own data-based guess and, if given, warm-started from another solution — the better
-   objective is kept) and locates its gap (:func:`gaitlib.gap.locate.locate`);
+   tracking error of the located channels plus the spec's regularisation) from several
+   starts (:data:`BASELINE_STARTS`: the data's own data-based guess, a given solution, and
+   continuations from the spec's own cost function and from a coarse mesh), keeps the
+   converged fit with the lowest objective, and locates its gap
+   (:func:`gaitlib.gap.locate.locate`);
 2. re-solves with every applicable candidate effect (:data:`gaitlib.gap.effects.EFFECTS`),
    warm-started from the baseline fit, through :func:`gaitlib.sweep.sweep`:
    ``identify="nlp"`` effects with their parameters free in the NLP; ``"profile"`` effects
@@ -56,7 +58,8 @@ from . import locate as L
 from .solve import solve_many
 
 __all__ = ["BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "Fit", "Diagnosis", "diagnose", "assemble",
-           "candidates", "base_spec", "as_dataset", "baseline_fits", "pick_best"]
+           "candidates", "base_spec", "as_dataset", "baseline_fits", "pick_best", "BASELINE_STARTS",
+           "COARSE_MESH"]
 
 #: ΔBIC a top effect must reach (≤) to be named.
 BIC_THRESHOLD = -10.0
@@ -254,7 +257,7 @@ def _stats(sol) -> dict:
     if sol is None:
         return {}
     keys = ("status", "iterations", "solve_time_s", "build_time_s", "time_per_iteration_s", "objective",
-            "max_violation", "from_cache", "objective_kind", "effects")
+            "max_violation", "from_cache", "objective_kind", "effects", "start")
     return {k: sol.stats.get(k) for k in keys if k in sol.stats}
 
 
@@ -329,21 +332,73 @@ def _shrink_table(loc0: L.Located, lk: L.Located) -> pd.DataFrame:
 # Solving: baseline fits and candidates
 # ======================================================================================
 
+#: Starts of the baseline fit; the converged fit with the lowest objective is kept
+#: (:func:`pick_best`). ``cold``: the data's own data-based guess; ``warm``: the given
+#: solution; ``dt``: the spec's own cost function (e.g. the thesis's DT, Eq 4.11) solved
+#: from the data-based guess, then the fit warm-started from it; ``coarse``: the fit on the
+#: :data:`COARSE_MESH`, then the fit on the spec's mesh warm-started from it (only when the
+#: spec's mesh is finer). On the 20 × 5 mesh a single start often stops in a local optimum
+#: far from the data (an RSS 10–100× the noise's); the two continuation starts cost three
+#: more solves per data set.
+BASELINE_STARTS = ("cold", "warm", "dt", "coarse")
+#: (intervals, degree) of the ``coarse`` start.
+COARSE_MESH = (10, 3)
+
+
+def _coarse_spec(spec0):
+    import dataclasses
+
+    n, d = COARSE_MESH
+    if spec0.n_intervals * spec0.degree <= n * d:
+        return None
+    return dataclasses.replace(spec0, n_intervals=n, degree=d)
+
+
 def baseline_fits(spec0, datasets: dict, warm=None, *, objective="fit", root=None, use_cache=True, chunks: int = 2,
-                  **sweep_kw) -> dict:
-    """Baseline fits of several data sets (key → DataSet): from each data set's own guess and,
-    with ``warm`` (a solution), warm-started from it; the better objective is kept.
-    Returns key → GaitSolution."""
+                  starts=BASELINE_STARTS, detail: bool = False, **sweep_kw) -> dict:
+    """Baseline fits of several data sets (key → DataSet) from each of ``starts``
+    (:data:`BASELINE_STARTS`; ``warm`` only with a ``warm`` solution, ``coarse`` only on a
+    mesh finer than :data:`COARSE_MESH`); the converged fit with the lowest objective is
+    kept. Returns key → GaitSolution (``detail``: key → {start: GaitSolution}, the kept one
+    under ``"best"``); each kept solution's ``stats["start"]`` names its start."""
+    unknown = set(starts) - set(BASELINE_STARTS)
+    if unknown:
+        raise ValueError(f"unknown baseline start(s) {sorted(unknown)}; expected some of {BASELINE_STARTS}")
     keys = list(datasets)
+    parts = [p for p in (keys[i::chunks] for i in range(chunks)) if p]
+    coarse = _coarse_spec(spec0) if "coarse" in starts else None
+    kw = dict(root=root, use_cache=use_cache, **sweep_kw)
+    # round 1: the single-stage fits and the first stage of the continuations
     groups = {}
-    for i in range(chunks):
-        part = keys[i::chunks]
-        if part:
+    for i, part in enumerate(parts):
+        if "cold" in starts:
             groups[f"baseline-cold-{i}"] = (spec0, [(f"{k}|cold", datasets[k].gait, None) for k in part])
-            if warm is not None:
-                groups[f"baseline-warm-{i}"] = (spec0, [(f"{k}|warm", datasets[k].gait, warm) for k in part])
-    res = solve_many(groups, root=root, use_cache=use_cache, objective=objective, **sweep_kw)
-    return {k: pick_best([res.get(f"{k}|cold"), res.get(f"{k}|warm")]) for k in keys}
+        if "warm" in starts and warm is not None:
+            groups[f"baseline-warm-{i}"] = (spec0, [(f"{k}|warm", datasets[k].gait, warm) for k in part])
+        if coarse is not None:
+            groups[f"baseline-coarse1-{i}"] = (coarse, [(f"{k}|coarse1", datasets[k].gait, None) for k in part])
+    res = solve_many(groups, objective=objective, **kw) if groups else {}
+    if "dt" in starts and objective != "cost":
+        res.update(solve_many({f"baseline-dt1-{i}": (spec0, [(f"{k}|dt1", datasets[k].gait, None) for k in part])
+                               for i, part in enumerate(parts)}, objective="cost", **kw))
+    # round 2: the fits warm-started from the first stages
+    groups = {}
+    for i, part in enumerate(parts):
+        for st in ("dt", "coarse"):
+            jobs = [(f"{k}|{st}", datasets[k].gait, res[f"{k}|{st}1"]) for k in part
+                    if res.get(f"{k}|{st}1") is not None]
+            if jobs:
+                groups[f"baseline-{st}-{i}"] = (spec0, jobs)
+    if groups:
+        res.update(solve_many(groups, objective=objective, **kw))
+    out = {}
+    for k in keys:
+        per = {st: res.get(f"{k}|{st}") for st in BASELINE_STARTS if res.get(f"{k}|{st}") is not None}
+        best = pick_best(list(per.values()))
+        if best is not None:
+            best.stats["start"] = next(st for st, s in per.items() if s is best)
+        out[k] = dict(per, best=best) if detail else best
+    return out
 
 
 def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit", root=None, use_cache=True,
@@ -445,7 +500,7 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
     effects : candidate names (default: every applicable effect of :data:`EFFECTS`).
     objective : ``"fit"`` (default) or ``"cost"`` (the spec's cost function), see
         :mod:`gaitlib.gap.solve`.
-    warm : a solution to warm-start the baseline fit from (in addition to the cold start).
+    warm : a solution to warm-start the baseline fit from (one of :data:`BASELINE_STARTS`).
     solution : a solution (e.g. a thesis chapter's) whose own gap is also located and reported.
     like, fill_from : passed to :func:`gaitlib.gap.io.read_data`.
     resamples, seed : data resampling for the % closed intervals.

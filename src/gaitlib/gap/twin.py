@@ -177,8 +177,9 @@ def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), 
     """Generate twins (each effect × magnitude × seed, plus the effect-free twin of each
     seed), diagnose each with the baseline model only, and score the diagnosis.
 
-    Returns a :class:`TwinValidation`. Cost: (#twins + #seeds) twin solves, 2 baseline fits
-    per twin (cold + warm start) and one re-solve per candidate per twin, all through
+    Returns a :class:`TwinValidation`. Cost: (#twins + #seeds) twin solves, the baseline
+    fits per twin (:data:`gaitlib.gap.diagnose.BASELINE_STARTS`: up to 6 solves) and one
+    re-solve per candidate per twin, all through
     :func:`gaitlib.sweep.sweep` (one item per spec, built once and re-solved on every twin
     by swapping the NLP's data).
     """
@@ -223,7 +224,7 @@ def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), 
                     frame.to_csv(p, index=False, float_format="%.8g")
                     datasets[key] = gio.read_data(p)
             truth[key] = {"effects": v, "seed": seed, "level": (int(k.split("@")[1]) if "@" in k else None)}
-    # 2. the baseline fits (cold and warm from the baseline's fit of the real data)
+    # 2. the baseline fits (every start of D.BASELINE_STARTS; warm: the baseline's fit of the real data)
     warm = solve_on(spec0, real.gait, root=root, use_cache=use_cache, objective=objective)
     bases = D.baseline_fits(spec0, datasets, warm, objective=objective, root=root, use_cache=use_cache, **sweep_kw)
     # 3. candidates: every twin effect, re-solved on every twin
@@ -287,7 +288,8 @@ class TwinValidation:
     ``shrink_vs_free_twin`` = (RSS_base − RSS_top) / (RSS_base − RSS_0) with RSS_0 the
     baseline fit of the effect-free twin of the same seed (a different gait: noisy, kept
     for reference). ``_true`` variants use the true effect's fit instead of the top one.
-    ``identified_magnitude``: the true effect's fitted magnitude. ``confusion``: injected
+    ``identified_magnitude``: the true effect's fitted magnitude. ``base_start``: the start
+    of the kept baseline fit (:data:`gaitlib.gap.diagnose.BASELINE_STARTS`). ``confusion``: injected
     × named counts.
     """
 
@@ -333,7 +335,7 @@ class TwinValidation:
                 "identified_magnitude": true_mag,
                 "dBIC_top": float(rk.loc[d.top_effect, "dBIC"]) if d.top_effect in rk.index else np.nan,
                 "dBIC_true": float(rk.loc[inj, "dBIC"]) if inj in rk.index else np.nan,
-                "n_eff": d.located.n_eff,
+                "n_eff": d.located.n_eff, "base_start": d.baseline.stats.get("start"),
             })
         return cls(pd.DataFrame(rows), diags, gen_stats, settings)
 

@@ -360,16 +360,16 @@ def book_gaps(root=None) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def twin_validation_full_mesh(seed: int = 1, serial: bool = True):
+def twin_validation_full_mesh(seeds=TWIN_SEEDS, serial: bool = True):
     """The twin check repeated on the thesis's 20 × 5 mesh (:data:`SK_BASE`, the mesh of the
     real-data diagnoses): every SK twin effect at its **middle** magnitude and the
-    effect-free twin, one noise seed. Rows are labelled with the middle level (``level`` 1,
+    effect-free twin, for each noise seed. Rows are labelled with the middle level (``level`` 1,
     twin names ``effect@1#seed``) so that :meth:`TwinValidation.accuracy` reads "middle"."""
     from ..gap import twin
 
     effects = tuple(twin.TWIN_EFFECTS_DEFAULT())
     mags = {e: (fx.EFFECTS[e].twin_magnitudes[1],) for e in effects}
-    tv = twin.validate_twins(effects, magnitudes=mags, seeds=(seed,), base=dict(SK_BASE), serial=serial,
+    tv = twin.validate_twins(effects, magnitudes=mags, seeds=tuple(seeds), base=dict(SK_BASE), serial=serial,
                              progress=False)
     inj = tv.rows["injected"] != "none"
     tv.rows.loc[inj, "level"] = 1
