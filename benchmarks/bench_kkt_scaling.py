@@ -166,19 +166,14 @@ def main(argv=None) -> int:
            "code": __import__("gaitlib.cache").cache.fingerprint(), "quick": args.quick,
            "note": ("loads at start " + ", ".join(f"{r['load_at_start']:.2f}" for r in rows)),
            "rows": rows, "fits": fits}
-    OUT.mkdir(exist_ok=True)
     stem = "kkt_scaling_quick" if args.quick else "kkt_scaling"
-    (OUT / f"{stem}.json").write_text(json.dumps(doc, indent=1, default=str))
     cols = ["model", "n_intervals", "nodes", "kkt_dim", "kkt_nnz", *QUANTITIES, "load_at_start"]
-    md = [f"# One iteration's pieces at a fixed point vs mesh size ({doc['measured']}, {doc['machine']})", "",
-          "| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
-    md += ["| " + " | ".join(f"{r.get(c):.4g}" if isinstance(r.get(c), float) else str(r.get(c, "")) for c in cols) + " |"
-           for r in rows]
+    md = [f"# One iteration's pieces at a fixed point vs mesh size ({doc['measured']}, {doc['machine']})", ""]
+    md += perf.md_table(cols, rows)
     md += ["", "| model | quantity | exponent b | ± | R² | nodes |", "|---|---|---|---|---|---|"]
     md += [f"| {f['model']} | {f['quantity']} | {f['exponent']:.3f} | {f.get('exponent_se', float('nan')):.3f} | "
            f"{f['r2']:.4f} | {f['nodes']} |" for f in fits]
-    (OUT / f"{stem}.md").write_text("\n".join(md) + "\n")
-    print("\n".join(md))
+    perf.write_report(OUT, stem, doc, md)
     return 0
 
 

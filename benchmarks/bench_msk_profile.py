@@ -155,23 +155,19 @@ def main(argv=None) -> int:
            "machine": f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}",
            "code": __import__("gaitlib.cache").cache.fingerprint(), "quick": args.quick,
            "runs": rows, "graph_sizes": sizes}
-    OUT.mkdir(exist_ok=True)
+    from gaitlib.studies.performance import md_table, write_report
+
     stem = "msk_profile_quick" if args.quick else "msk_profile"
-    (OUT / f"{stem}.json").write_text(json.dumps(doc, indent=1, default=str))
     cols = ["variant", "status", "iterations", "solve_s", "ms_per_iteration", "hessian_s", "other_evals_s",
             "linear_systems_s", "rest_s", "perturbed_iterations", "objective", "load_at_start"]
-    md = [f"# MSK data tracking (Eq 5.33), full mesh: where the time goes ({doc['measured']}, {doc['machine']})", "",
-          "| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
-    for r in rows:
-        md.append("| " + " | ".join(f"{r.get(c):.4g}" if isinstance(r.get(c), float) else str(r.get(c, ""))
-                                    for c in cols) + " |")
+    md = [f"# MSK data tracking (Eq 5.33), full mesh: where the time goes ({doc['measured']}, {doc['machine']})", ""]
+    md += md_table(cols, rows)
     md += ["", "Expression graphs (SX instructions; ca.hessian of the Lagrangian):", "",
            "| model | variables | constraints | constraint instructions | Hessian instructions | Hessian nnz |",
            "|---|---|---|---|---|---|"]
     md += [f"| {s['model']} | {s['n_variables']} | {s['n_constraints']} | {s['constraint_instructions']:,} | "
            f"{s['hessian_instructions']:,} | {s['hessian_nnz']:,} |" for s in sizes]
-    (OUT / f"{stem}.md").write_text("\n".join(md) + "\n")
-    print("\n".join(md))
+    write_report(OUT, stem, doc, md)
     return 0
 
 

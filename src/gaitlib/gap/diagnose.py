@@ -338,8 +338,8 @@ def _shrink_table(loc0: L.Located, lk: L.Located) -> pd.DataFrame:
 #: from the data-based guess, then the fit warm-started from it; ``coarse``: the fit on the
 #: :data:`COARSE_MESH`, then the fit on the spec's mesh warm-started from it (only when the
 #: spec's mesh is finer). On the 20 × 5 mesh a single start often stops in a local optimum
-#: far from the data (an RSS 10–100× the noise's); the two continuation starts cost three
-#: more solves per data set.
+#: far from the data (twins: an RSS 3–120× the noise's); the two continuation starts cost
+#: four more solves per data set (one of them on the coarse mesh).
 BASELINE_STARTS = ("cold", "warm", "dt", "coarse")
 #: (intervals, degree) of the ``coarse`` start.
 COARSE_MESH = (10, 3)

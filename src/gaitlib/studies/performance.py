@@ -39,7 +39,7 @@ __all__ = ["results_dir", "load", "load_optional", "fit_power_law", "scaling_tab
            "linear_solver_table", "moco_table", "gait_table", "msk_profile_tables", "kkt_scaling_tables", "measured_on", "ThesisTime", "THESIS_SILENT",
            "thesis_reference_times", "parse_duration", "time_row", "missing_row", "NOT_COMPUTED", "NO_CACHE",
            "TIME_COLUMNS", "thesis_times_table", "thesis_times_summary", "thesis_times_by_chapter",
-           "thesis_times_figure", "NotInCache", "no_solving"]
+           "thesis_times_figure", "NotInCache", "no_solving", "md_table", "write_report"]
 
 #: Runs of the scaling benchmark whose time per iteration is a measurement (the solver ran
 #: to the end: converged or stopped by its own criterion), as opposed to "timeout"/"error".
@@ -79,6 +79,28 @@ def load_optional(name: str, root=None) -> dict | None:
     except FileNotFoundError as e:
         print(e)
         return None
+
+
+def md_table(cols, rows) -> list[str]:
+    """A markdown table of ``rows`` (dicts) over ``cols``: floats to 4 significant digits,
+    missing values empty. Returns its lines (header, separator, one per row)."""
+    def cell(v):
+        return f"{v:.4g}" if isinstance(v, float) else ("" if v is None else str(v))
+
+    return ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)] + [
+        "| " + " | ".join(cell(r.get(c)) for c in cols) + " |" for r in rows]
+
+
+def write_report(out: Path, stem: str, doc: dict, md: list[str]) -> None:
+    """A benchmark's results: ``<out>/<stem>.json`` (``doc``) and ``<out>/<stem>.md``
+    (``md`` lines, also printed)."""
+    import json
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / f"{stem}.json").write_text(json.dumps(doc, indent=1, default=str))
+    (out / f"{stem}.md").write_text("\n".join(md) + "\n")
+    print("\n".join(md))
 
 
 def fit_power_law(n, y) -> dict:
