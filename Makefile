@@ -8,6 +8,11 @@ STAMP := $(VENV)/.installed
 export OPENBLAS_NUM_THREADS := 1
 export OMP_NUM_THREADS := 1
 export MKL_NUM_THREADS := 1
+# One OpenBLAS kernel on every x86-64 machine (AVX2, "Haswell"; OpenBLAS picks it itself on
+# AMD Zen). With the kernel chosen per CPU, an AVX-512 machine computes the data's Fourier
+# left leg differently in the last bits, and the gap diagnosis's cache keys (which hash the
+# data's numbers) miss every stored solution (see environment.md).
+export OPENBLAS_CORETYPE := Haswell
 
 .PHONY: book test venv data clean
 
