@@ -411,3 +411,25 @@ def test_exact_left_leg_is_the_right_leg_rolled_by_half_a_cycle():
     g2 = g.__class__(**{**g.__dict__, "mean": g.mean.assign(knee_l=g.mean["knee_l"] + 0.01)})
     _, rep2 = exact_left_leg(g2)
     assert "knee_l" not in rep2 and "hip_l" in rep2
+
+
+def test_stored_gap_solutions_are_reachable(real):
+    """The gap solutions' keys hash the data's numbers (:func:`gaitlib.gap.io.signature`),
+    which depend in the last bits on OpenBLAS's kernel (the Fourier left leg): under the
+    Makefile's ``OPENBLAS_CORETYPE`` the real data's signature is the one the committed
+    store was written with, so the book's gap chapter reloads instead of re-solving (hours)."""
+    import os
+
+    from gaitlib import cache
+    from gaitlib.gap import twin
+    from gaitlib.gap.solve import _where
+
+    store = cache.store_dir()
+    if store is None or not (store / "gap").is_dir():
+        pytest.skip("no solution store")
+    spec = twin.twin_spec(())  # the effect-free twin's generating solve (Ch 8), on the real data
+    where = _where(spec, real.gait, None, None, objective="cost")
+    assert (store / "gap" / where.name).is_dir(), (
+        f"the effect-free twin generator {where.name} is not in {store / 'gap'} (data signature "
+        f"{gio.signature(real.gait)}, OPENBLAS_CORETYPE={os.environ.get('OPENBLAS_CORETYPE')!r}): run under "
+        "the Makefile's settings, or refresh the store (tools/store_solutions.py)")
