@@ -277,7 +277,7 @@ def test_criteria_pay_for_parameters():
 
 def test_baseline_fit_keeps_the_best_converged_start(tmp_path, real, monkeypatch):
     """The multistart baseline fit solves from every start (cold, warm, the spec's own cost
-    then the fit, a coarser mesh then the fit) and keeps the converged fit with the lowest
+    then the fit, a coarser mesh then the fit, the GRF-weighted fit then the fit) and keeps the converged fit with the lowest
     objective, naming its start; a mesh no finer than the coarse one has no coarse start."""
     from gaitlib.gap import diagnose as D
 
@@ -286,7 +286,7 @@ def test_baseline_fit_keeps_the_best_converged_start(tmp_path, real, monkeypatch
     root = tmp_path / "sol"
     warm = D.solve_many({"w": (spec, [("w", real.gait, None)])}, root=root, serial=True, progress=False)["w"]
     out = D.baseline_fits(spec, {"d": real}, warm, root=root, detail=True, serial=True, progress=False)["d"]
-    assert set(out) == {"cold", "warm", "dt", "coarse", "best"}
+    assert set(out) == {"cold", "warm", "dt", "coarse", "grf", "best"}
     conv = {k: s for k, s in out.items() if k != "best" and D._status(s)[1]}
     assert conv, {k: s.stats["status"] for k, s in out.items()}
     best = min(conv.values(), key=lambda s: s.stats["objective"])
@@ -298,6 +298,78 @@ def test_baseline_fit_keeps_the_best_converged_start(tmp_path, real, monkeypatch
     assert D._coarse_spec(spec) is None
     with pytest.raises(ValueError, match="unknown baseline start"):
         D.baseline_fits(spec, {"d": real}, starts=("cold", "hot"))
+
+
+def test_grf_weighted_scales_only_the_grf_sds(real):
+    """The first stage of the ``grf`` start: GRF SDs × factor, everything else identical,
+    and a different data signature (its own cache key)."""
+    from gaitlib.gap import diagnose as D
+
+    g = real.gait
+    w = D.grf_weighted(g, 0.1)
+    grf = list(tr.GRF_CHANNELS)
+    other = [c for c in g.sd.columns if c not in grf]
+    np.testing.assert_array_equal(w.sd[grf].to_numpy(), 0.1 * g.sd[grf].to_numpy())
+    np.testing.assert_array_equal(w.sd[other].to_numpy(), g.sd[other].to_numpy())
+    np.testing.assert_array_equal(w.mean.to_numpy(), g.mean.to_numpy())
+    assert gio.signature(w) != gio.signature(g)
+    # the Fit objective's SD columns follow: the GRF weight grows by 1/factor²
+    from gaitlib.gap.solve import sd_columns
+
+    tau = np.linspace(0, 0.98, 7)
+    a, b = sd_columns(g, tau), sd_columns(w, tau)
+    np.testing.assert_allclose(b["sd_grf_y_r"], 0.1 * a["sd_grf_y_r"])
+    np.testing.assert_allclose(b["sd_knee_r"], a["sd_knee_r"])
+
+
+class _S:
+    def __init__(self, status, objective):
+        self.stats = {"status": status, "objective": objective}
+
+
+def test_needs_retry_on_failure_or_a_nested_fit_worse_than_the_baseline():
+    from gaitlib.gap import diagnose as D
+
+    base = _S("Solve_Succeeded", 10.0)
+    nested = next(n for n, e in fx.EFFECTS.items() if D._nested(e))
+    assert D.needs_retry(nested, None, base)
+    assert D.needs_retry(nested, _S("Maximum_Iterations_Exceeded", 1.0), base)
+    assert D.needs_retry(nested, _S("Solve_Succeeded", 10.5), base)
+    assert not D.needs_retry(nested, _S("Solve_Succeeded", 10.0 * (1 + 0.5 * D.RETRY_MARGIN)), base)
+    assert not D.needs_retry(nested, _S("Solve_Succeeded", 9.0), base)
+
+
+def test_candidate_retry_keeps_the_best_start(tmp_path, real):
+    """A candidate fit that ends above the baseline's objective is re-solved from the
+    baseline's other starts; the converged fit with the lowest objective is kept and its
+    start named."""
+    from gaitlib.gap import diagnose as D
+
+    spec = tr.GaitSpec(model="SK", cost="DT", **TINY)
+    root = tmp_path / "sol"
+    det = D.baseline_fits(spec, {"d": real}, None, root=root, detail=True, starts=("cold", "dt"), serial=True,
+                          progress=False)
+    base = det["d"]["best"]
+    assert base is not None and D._status(base)[1]
+    alts = D.alternates_of(det)
+    assert set(alts["d"]) == {"cold", "dt"} - {base.stats["start"]}
+    # an impossible baseline objective forces the retry of every nested candidate
+    import copy
+
+    low = copy.copy(base)
+    low.stats = dict(base.stats, objective=-1.0)
+    name = "friction"
+    assert D._nested(fx.EFFECTS[name])
+    fits = D.candidate_fits(spec, {"d": real}, {"d": low}, [name], root=root, alternates=alts, serial=True,
+                            progress=False)["d"]
+    f = fits[name]
+    assert f.solution is not None and "retry_start" in f.solution.stats
+    assert f.solution.stats["retry_start"] in {"best"} | set(alts["d"])
+    # without alternates: no retry, the first solve is kept
+    f1 = D.candidate_fits(spec, {"d": real}, {"d": low}, [name], root=root, serial=True, progress=False)["d"][name]
+    assert "retry_start" not in f1.solution.stats
+    if f.ok and f1.ok:
+        assert f.solution.stats["objective"] <= f1.solution.stats["objective"] + 1e-12
 
 
 def test_diagnose_names_the_injected_effect_on_a_twin(tmp_path):

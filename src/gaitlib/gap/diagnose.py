@@ -6,14 +6,17 @@ GaitData) and a baseline model, and
 1. fits the baseline (objective ``"fit"``, :mod:`gaitlib.gap.solve`: the SD-standardised
    tracking error of the located channels plus the spec's regularisation) from several
    starts (:data:`BASELINE_STARTS`: the data's own data-based guess, a given solution, and
-   continuations from the spec's own cost function and from a coarse mesh), keeps the
-   converged fit with the lowest objective, and locates its gap
+   continuations from the spec's own cost function, from a coarse mesh and from the fit
+   with the GRFs weighted up), keeps the converged fit with the lowest objective, and
+   locates its gap
    (:func:`gaitlib.gap.locate.locate`);
 2. re-solves with every applicable candidate effect (:data:`gaitlib.gap.effects.EFFECTS`),
    warm-started from the baseline fit, through :func:`gaitlib.sweep.sweep`:
    ``identify="nlp"`` effects with their parameters free in the NLP; ``"profile"`` effects
    (signature in EMG only) on a grid of fixed magnitudes, keeping the one with the smallest
-   gap; comparison-only effects (``resolve=False``) by a bounded scalar search of the gap
+   gap; an NLP candidate that does not converge, or ends above the baseline's objective
+   although it contains the baseline model (a worse local optimum), is re-solved from each
+   of the baseline's other starts and the best converged fit kept; comparison-only effects (``resolve=False``) by a bounded scalar search of the gap
    on the baseline's solution;
 3. ranks the effects by a criterion that pays for parameters and says "unexplained" when
    none is good enough;
@@ -59,7 +62,8 @@ from .solve import solve_many
 
 __all__ = ["BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "Fit", "Diagnosis", "diagnose", "assemble",
            "candidates", "base_spec", "as_dataset", "baseline_fits", "pick_best", "BASELINE_STARTS",
-           "COARSE_MESH"]
+           "COARSE_MESH", "GRF_SD_FACTOR", "RETRY_MARGIN", "grf_weighted", "candidate_fits", "needs_retry",
+           "alternates_of"]
 
 #: ΔBIC a top effect must reach (≤) to be named.
 BIC_THRESHOLD = -10.0
@@ -337,12 +341,37 @@ def _shrink_table(loc0: L.Located, lk: L.Located) -> pd.DataFrame:
 #: solution; ``dt``: the spec's own cost function (e.g. the thesis's DT, Eq 4.11) solved
 #: from the data-based guess, then the fit warm-started from it; ``coarse``: the fit on the
 #: :data:`COARSE_MESH`, then the fit on the spec's mesh warm-started from it (only when the
-#: spec's mesh is finer). On the 20 × 5 mesh a single start often stops in a local optimum
-#: far from the data (twins: an RSS 3–120× the noise's); the two continuation starts cost
-#: four more solves per data set (one of them on the coarse mesh).
-BASELINE_STARTS = ("cold", "warm", "dt", "coarse")
+#: spec's mesh is finer); ``grf``: the fit with the GRF channels' SDs multiplied by
+#: :data:`GRF_SD_FACTOR` (their weight by its inverse square) from the data-based guess,
+#: then the fit of the data as they are warm-started from it — a continuation that first
+#: finds the contact pattern (e.g. a brief second contact after toe-off) and then the
+#: kinematics. On the 20 × 5 mesh a single start often stops in a local optimum far from
+#: the data (twins: an RSS 3–120× the noise's); the three continuation starts cost six more
+#: solves per data set (two of them on the coarse mesh).
+BASELINE_STARTS = ("cold", "warm", "dt", "coarse", "grf")
 #: (intervals, degree) of the ``coarse`` start.
 COARSE_MESH = (10, 3)
+#: Factor on the GRF channels' SDs in the first stage of the ``grf`` start.
+GRF_SD_FACTOR = 0.1
+#: A nested candidate (its null parameters are the baseline model) whose fit ends with an
+#: objective above the baseline fit's by more than this relative margin has stopped in a
+#: worse local optimum; :func:`candidate_fits` then re-solves it from the baseline's other
+#: starts.
+RETRY_MARGIN = 1e-3
+
+
+def grf_weighted(gait, factor: float = GRF_SD_FACTOR):
+    """A copy of ``gait`` whose GRF channels' SDs are multiplied by ``factor`` (the Fit
+    objective then weights their residual by 1/factor²); means, time and events unchanged.
+    Its numbers differ, so its solutions get their own cache keys."""
+    import dataclasses
+
+    sd = gait.sd.copy()
+    cols = [c for c in tr.GRF_CHANNELS if c in sd.columns]
+    if not cols:
+        raise ValueError("grf_weighted: the data set has no GRF channels " + repr(list(tr.GRF_CHANNELS)))
+    sd[cols] = sd[cols] * float(factor)
+    return dataclasses.replace(gait, sd=sd)
 
 
 def _coarse_spec(spec0):
@@ -358,8 +387,8 @@ def baseline_fits(spec0, datasets: dict, warm=None, *, objective="fit", root=Non
                   starts=BASELINE_STARTS, detail: bool = False, **sweep_kw) -> dict:
     """Baseline fits of several data sets (key → DataSet) from each of ``starts``
     (:data:`BASELINE_STARTS`; ``warm`` only with a ``warm`` solution, ``coarse`` only on a
-    mesh finer than :data:`COARSE_MESH`); the converged fit with the lowest objective is
-    kept. Returns key → GaitSolution (``detail``: key → {start: GaitSolution}, the kept one
+    mesh finer than :data:`COARSE_MESH`, ``grf`` only for the ``"fit"`` objective); the
+    converged fit with the lowest objective is kept. Returns key → GaitSolution (``detail``: key → {start: GaitSolution}, the kept one
     under ``"best"``); each kept solution's ``stats["start"]`` names its start."""
     unknown = set(starts) - set(BASELINE_STARTS)
     if unknown:
@@ -377,6 +406,9 @@ def baseline_fits(spec0, datasets: dict, warm=None, *, objective="fit", root=Non
             groups[f"baseline-warm-{i}"] = (spec0, [(f"{k}|warm", datasets[k].gait, warm) for k in part])
         if coarse is not None:
             groups[f"baseline-coarse1-{i}"] = (coarse, [(f"{k}|coarse1", datasets[k].gait, None) for k in part])
+        if "grf" in starts and objective == "fit":
+            groups[f"baseline-grf1-{i}"] = (spec0, [(f"{k}|grf1", grf_weighted(datasets[k].gait), None)
+                                                    for k in part])
     res = solve_many(groups, objective=objective, **kw) if groups else {}
     if "dt" in starts and objective != "cost":
         res.update(solve_many({f"baseline-dt1-{i}": (spec0, [(f"{k}|dt1", datasets[k].gait, None) for k in part])
@@ -384,7 +416,7 @@ def baseline_fits(spec0, datasets: dict, warm=None, *, objective="fit", root=Non
     # round 2: the fits warm-started from the first stages
     groups = {}
     for i, part in enumerate(parts):
-        for st in ("dt", "coarse"):
+        for st in ("dt", "coarse", "grf"):
             jobs = [(f"{k}|{st}", datasets[k].gait, res[f"{k}|{st}1"]) for k in part
                     if res.get(f"{k}|{st}1") is not None]
             if jobs:
@@ -401,9 +433,45 @@ def baseline_fits(spec0, datasets: dict, warm=None, *, objective="fit", root=Non
     return out
 
 
+def _nested(e) -> bool:
+    """An NLP-identified effect whose null parameters lie inside its bounds: the baseline
+    model is one of its members, so its fit can reach the baseline's objective."""
+    return e.identify == "nlp" and all(p.lower <= p.null <= p.upper for p in e.params)
+
+
+def _nlp_fit(n: str, sol, ds, error: bool = False) -> Fit:
+    e = fx.EFFECTS[n]
+    st, ok = _status(sol)
+    if sol is None and error:
+        st = "error"
+    th = sol.stats.get("effects", {}) if sol is not None else {}
+    loc = L.locate(sol, ds, thetas=th) if sol is not None else None
+    return Fit(n, sol, th, loc, e.n_params, e.identify, st, ok)
+
+
+def needs_retry(n: str, sol, base_sol) -> bool:
+    """A candidate fit to re-solve from the baseline's other starts: it did not converge, or
+    (a nested effect, :func:`_nested`) it ends with an objective above the baseline fit's by
+    more than :data:`RETRY_MARGIN` (relative) — a worse local optimum than the model it
+    contains."""
+    if sol is None or not _status(sol)[1]:
+        return True
+    if not _nested(fx.EFFECTS[n]) or base_sol is None:
+        return False
+    f0, f1 = float(base_sol.stats["objective"]), float(sol.stats["objective"])
+    return f1 > f0 + RETRY_MARGIN * abs(f0)
+
+
 def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit", root=None, use_cache=True,
-                   **sweep_kw) -> dict:
-    """Fits of every candidate on every data set: key → {effect: Fit}."""
+                   alternates: dict | None = None, **sweep_kw) -> dict:
+    """Fits of every candidate on every data set: key → {effect: Fit}.
+
+    Each candidate is warm-started from ``bases[key]`` (the baseline fit). ``alternates``
+    (key → {start: solution}: the baseline's fits from its other starts, see
+    :func:`baseline_fits` ``detail``) enables the retry: an NLP-identified candidate whose
+    fit :func:`needs_retry` is re-solved warm-started from each of them, and the converged
+    fit with the lowest objective (:func:`pick_best`) is kept; its ``stats["retry_start"]``
+    names the start it came from (``"best"``: the first solve)."""
     groups = {}
     for n in names:
         e = fx.EFFECTS[n]
@@ -417,8 +485,24 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
                 spec = _with_effects(spec0, ((n, m),))
                 groups[f"{n}@{m}"] = (spec, [(f"{k}|{n}@{m}", ds.gait, bases[k]) for k, ds in datasets.items()
                                              if bases[k] is not None])
-    res = solve_many(groups, root=root, use_cache=use_cache, objective=objective, **sweep_kw) if groups else {}
+    kw = dict(root=root, use_cache=use_cache, objective=objective, **sweep_kw)
+    res = solve_many(groups, **kw) if groups else {}
     recs = res.get("__records__", {})
+    # the retry: failed or worse-than-baseline nested candidates from the other starts
+    retry = {}
+    if alternates:
+        for n in names:
+            e = fx.EFFECTS[n]
+            if not (e.resolve and e.identify == "nlp"):
+                continue
+            spec = _with_effects(spec0, ((n, None),))
+            jobs = [(f"{k}|{n}|{st}", ds.gait, alt) for k, ds in datasets.items()
+                    if bases[k] is not None and needs_retry(n, res.get(f"{k}|{n}"), bases[k])
+                    for st, alt in (alternates.get(k) or {}).items() if alt is not None and alt is not bases[k]]
+            if jobs:
+                retry[f"{n}|retry"] = (spec, jobs)
+    if retry:
+        res.update({k: v for k, v in solve_many(retry, **kw).items() if k != "__records__"})
     out = {}
     for k, ds in datasets.items():
         fits = {}
@@ -427,13 +511,13 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
             if not e.resolve:
                 fits[n] = _comparison_fit(n, bases[k], ds)
             elif e.identify == "nlp":
-                sol = res.get(f"{k}|{n}")
-                st, ok = _status(sol)
-                if sol is None and n in recs and recs[n].error:
-                    st = "error"
-                th = sol.stats.get("effects", {}) if sol is not None else {}
-                loc = L.locate(sol, ds, thetas=th) if sol is not None else None
-                fits[n] = Fit(n, sol, th, loc, e.n_params, e.identify, st, ok)
+                tried = {"best": res.get(f"{k}|{n}")}
+                tried.update({st: res.get(f"{k}|{n}|{st}") for st in (alternates or {}).get(k) or {}
+                              if res.get(f"{k}|{n}|{st}") is not None})
+                sol = pick_best(list(tried.values()))
+                if sol is not None and len(tried) > 1:
+                    sol.stats["retry_start"] = next(st for st, s in tried.items() if s is sol)
+                fits[n] = _nlp_fit(n, sol, ds, error=n in recs and bool(recs[n].error))
             else:
                 prof, best = [], None
                 for m in PROFILE_GRID[n]:
@@ -453,6 +537,13 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
                     fits[n] = Fit(n, best[0], best[1], best[2], e.n_params, e.identify, best[3], True, prof)
         out[k] = fits
     return out
+
+
+def alternates_of(detail: dict) -> dict:
+    """key → {start: solution} of the baseline's starts other than the kept one, from
+    :func:`baseline_fits` with ``detail=True``."""
+    return {k: {st: s for st, s in per.items() if st != "best" and s is not None and s is not per.get("best")}
+            for k, per in detail.items()}
 
 
 def _with_effects(spec0, effects) -> tr.GaitSpec:
@@ -510,12 +601,13 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
     ds = as_dataset(data, like, fill_from)
     spec0 = base_spec(base)
     names, skipped = candidates(spec0, ds.gait, effects)
-    b = baseline_fits(spec0, {"data": ds}, warm, objective=objective, root=root, use_cache=use_cache, **sweep_kw)
-    base_sol = b["data"]
+    b = baseline_fits(spec0, {"data": ds}, warm, objective=objective, root=root, use_cache=use_cache, detail=True,
+                      **sweep_kw)
+    base_sol = b["data"]["best"]
     if base_sol is None:
         raise RuntimeError("the baseline fit failed (no solution returned); see the sweep's error report")
     fits = candidate_fits(spec0, {"data": ds}, {"data": base_sol}, names, objective=objective, root=root,
-                          use_cache=use_cache, **sweep_kw)["data"]
+                          use_cache=use_cache, alternates=alternates_of(b), **sweep_kw)["data"]
     settings = {"objective": objective, "candidates": names, "warm": warm is not None}
     return assemble(ds, spec0, base_sol, fits, objective=objective, resamples=resamples, seed=seed, skipped=skipped,
                     settings=settings, solution=solution)

@@ -178,8 +178,9 @@ def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), 
     seed), diagnose each with the baseline model only, and score the diagnosis.
 
     Returns a :class:`TwinValidation`. Cost: (#twins + #seeds) twin solves, the baseline
-    fits per twin (:data:`gaitlib.gap.diagnose.BASELINE_STARTS`: up to 6 solves) and one
-    re-solve per candidate per twin, all through
+    fits per twin (:data:`gaitlib.gap.diagnose.BASELINE_STARTS`: up to 8 solves), one
+    re-solve per candidate per twin (and, for a candidate that fails or ends above the
+    baseline, one per other baseline start), all through
     :func:`gaitlib.sweep.sweep` (one item per spec, built once and re-solved on every twin
     by swapping the NLP's data).
     """
@@ -226,11 +227,14 @@ def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), 
             truth[key] = {"effects": v, "seed": seed, "level": (int(k.split("@")[1]) if "@" in k else None)}
     # 2. the baseline fits (every start of D.BASELINE_STARTS; warm: the baseline's fit of the real data)
     warm = solve_on(spec0, real.gait, root=root, use_cache=use_cache, objective=objective)
-    bases = D.baseline_fits(spec0, datasets, warm, objective=objective, root=root, use_cache=use_cache, **sweep_kw)
-    # 3. candidates: every twin effect, re-solved on every twin
+    detail = D.baseline_fits(spec0, datasets, warm, objective=objective, root=root, use_cache=use_cache, detail=True,
+                             **sweep_kw)
+    bases = {k: v["best"] for k, v in detail.items()}
+    # 3. candidates: every twin effect, re-solved on every twin (a failed or worse-than-
+    #    baseline fit again from the baseline's other starts)
     names, _ = D.candidates(spec0, next(iter(datasets.values())).gait, effects)
     fits = D.candidate_fits(spec0, datasets, bases, names, objective=objective, root=root, use_cache=use_cache,
-                            **sweep_kw)
+                            alternates=D.alternates_of(detail), **sweep_kw)
     # 4. the reference of the shrink: the true model (injected effect fixed at its injected
     #    magnitude) fitted by the same method (warm-started from the baseline fit), and the
     #    generating solution's own RSS (noise only)
@@ -289,7 +293,10 @@ class TwinValidation:
     baseline fit of the effect-free twin of the same seed (a different gait: noisy, kept
     for reference). ``_true`` variants use the true effect's fit instead of the top one.
     ``identified_magnitude``: the true effect's fitted magnitude. ``base_start``: the start
-    of the kept baseline fit (:data:`gaitlib.gap.diagnose.BASELINE_STARTS`). ``confusion``: injected
+    of the kept baseline fit (:data:`gaitlib.gap.diagnose.BASELINE_STARTS`). ``retried``: how
+    many candidate fits were re-solved from the baseline's other starts
+    (:func:`gaitlib.gap.diagnose.candidate_fits`); ``true_start``: the start the injected
+    effect's kept fit came from (``"best"``: the baseline fit itself). ``confusion``: injected
     × named counts.
     """
 
@@ -336,6 +343,9 @@ class TwinValidation:
                 "dBIC_top": float(rk.loc[d.top_effect, "dBIC"]) if d.top_effect in rk.index else np.nan,
                 "dBIC_true": float(rk.loc[inj, "dBIC"]) if inj in rk.index else np.nan,
                 "n_eff": d.located.n_eff, "base_start": d.baseline.stats.get("start"),
+                "retried": sum(f.solution is not None and "retry_start" in f.solution.stats for f in d.fits.values()),
+                "true_start": (d.fits[inj].solution.stats.get("retry_start", "best")
+                               if inj in d.fits and d.fits[inj].solution is not None else None),
             })
         return cls(pd.DataFrame(rows), diags, gen_stats, settings)
 
