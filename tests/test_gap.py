@@ -506,3 +506,19 @@ def test_stored_gap_solutions_are_reachable(real):
         f"the effect-free twin generator {where.name} is not in {store / 'gap'} (data signature "
         f"{gio.signature(real.gait)}, OPENBLAS_CORETYPE={os.environ.get('OPENBLAS_CORETYPE')!r}): run under "
         "the Makefile's settings, or refresh the store (tools/store_solutions.py)")
+
+
+def test_ranking_bars_draws_an_interval_that_excludes_the_point():
+    """The resampled interval of % closed need not contain the point estimate (the redrawn
+    noise raises every RSS): the figure draws it as the segment [lo, hi] it is."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from gaitlib.gap import figures as F
+
+    r = pd.DataFrame({"effect": ["a", "b"], "n_params": [1, 1], "ok": [True, True], "pct_closed": [2.2, 10.0],
+                      "pct_closed_lo": [0.9, 8.0], "pct_closed_hi": [2.19, 12.0], "dBIC": [0.2, -20.0]})
+    fig = F.ranking_bars(r, top="b")
+    segs = [c for c in fig.axes[0].collections if hasattr(c, "get_segments")]
+    ends = sorted(tuple(np.round(s[:, 0], 2)) for c in segs for s in c.get_segments())
+    assert ends == [(0.9, 2.19), (8.0, 12.0)]

@@ -66,7 +66,7 @@ T0 = time.perf_counter()
 # The baseline here is the SK model (data tracking, Eq 4.11) **fitted** to Schwartz 2008
 # *Free* by the diagnosis's objective: the SD-standardised tracking error of these channels
 # plus a tenth of the thesis's regularisation (`gaitlib.gap.solve`), on the thesis's full
-# 20 × 5 LGR mesh. (The twin validation of Sec. 3, ≈ 340 solves, runs on a coarse mesh and is
+# 20 × 5 LGR mesh. (The twin validation of Sec. 3, ≈ 560 solves, runs on a coarse mesh and is
 # repeated on 20 × 5 at the middle magnitude.)
 
 # %%
@@ -93,17 +93,25 @@ G.top_cells(dS.located)
 G.effect_table()
 
 # %% [markdown]
-# **Re-solving.** For a data set the baseline is fitted from four starts
+# **Re-solving.** For a data set the baseline is fitted from five starts
 # (`gaitlib.gap.diagnose.BASELINE_STARTS`): the data's own data-based guess; a given
 # solution (here the fit of the real data); the spec's own cost function (Eq 4.11) solved
-# first, then the fit from it; and — on a mesh finer than 10 × 3 — the fit on 10 × 3 first,
-# then the fit from it. The converged fit with the lowest objective is kept, and the table
-# columns `base_start` say which start won. (The two continuation starts were added after
-# the 20 × 5 twin check below found single-start fits stalling in local optima.) Each candidate
-# is then re-solved with its parameter free in the NLP, warm-started from the baseline fit,
-# through the sweep (`gaitlib.sweep`: one NLP per effect, re-solved on every data set by
-# swapping its data). Effects the NLP cannot see (their signature is EMG-only) are
-# *profiled*: re-solved at a grid of fixed magnitudes, the one with the smallest gap kept.
+# first, then the fit from it; on a mesh finer than 10 × 3, the fit on 10 × 3 first, then
+# the fit from it; and the fit with the GRF channels weighted 100× (their SDs × 0.1) first,
+# then the fit of the data as they are from it — a continuation that finds the contact
+# pattern before the kinematics. The converged fit with the lowest objective is kept, and
+# the table columns `base_start` say which start won. Each candidate is then re-solved with
+# its parameter free in the NLP, warm-started from the baseline fit, through the sweep
+# (`gaitlib.sweep`: one NLP per effect, re-solved on every data set by swapping its data).
+# A candidate contains the baseline model (its parameter's null value), so its fit can
+# never be worse than the baseline's; where it did not converge or ends above the
+# baseline's objective, it has stopped in a worse local optimum and is re-solved from each
+# of the baseline's other starts, the best converged fit kept (`retried` counts these in
+# the twin tables, `true_start` says where the injected effect's fit came from). The
+# continuation starts and the retry were added, in that order, after the 20 × 5 twin check
+# below found single-start fits stalling in local optima. Effects the NLP cannot see (their
+# signature is EMG-only) are *profiled*: re-solved at a grid of fixed magnitudes, the one
+# with the smallest gap kept.
 #
 # **Ranking by a penalised criterion.** With RSS the sum of $z^2$ over the located channels
 # and points, each model is a Gaussian likelihood with unknown variance on $n_{eff}$
@@ -138,8 +146,9 @@ print(f"threshold: ΔBIC ≤ {D.BIC_THRESHOLD:g}; 'explained' from {D.EXPLAINED_
 # seed (correct answer: "unexplained").
 #
 # **Mesh.** The twin study runs on the coarse 10 × 3 LGR mesh (the default baseline of
-# `gaitlib gap`): it takes ≈ 11 solves per twin (four for the baseline's three starts, six
-# candidates, the true model) for 38 twins, ≈ 2–4 s each here, against ≈ 10× that per solve on the
+# `gaitlib gap`): it takes ≈ 13 solves per twin (six for the baseline's four starts — the
+# coarse-mesh start does not apply —, six candidates, the true model, plus the retries) for
+# 38 twins, ≈ 2–4 s each here, against ≈ 10× that per solve on the
 # thesis's 20 × 5 mesh. The coarse mesh has a cost we measured and report: its 30 nodes
 # are sparser than the data's 50 points, so even the true model fitted to its own twin
 # leaves a residual above the noise (the heel-strike GRF between nodes); this is why the
@@ -170,7 +179,8 @@ F.confusion_plot(tv.confusion, title="twins: injected effect (rows) vs effect na
 plt.show()
 rows = tv.rows.copy()
 rows[["twin", "injected", "magnitude", "top", "verdict", "correct", "identified_magnitude", "rss_base", "base_start", "rss_top",
-      "rss_true_fixed", "rss_gen", "shrink_injected_top", "shrink_vs_noise_top", "dBIC_top", "dBIC_true"]]
+      "rss_true_fixed", "rss_gen", "shrink_injected_top", "shrink_vs_noise_top", "dBIC_top", "dBIC_true", "retried",
+      "true_start"]]
 
 # %%
 gen_ok = sum(v["status"] == "Solve_Succeeded" for v in tv.gen_stats.values())
@@ -218,7 +228,7 @@ for t, bt, bn in true_not_better:
 # %% [markdown]
 # **The same check on the thesis's mesh.** The real-data diagnoses below run on the 20 × 5
 # mesh, the twin study above on 10 × 3. The check is repeated on 20 × 5 at the middle
-# magnitude of every effect and the effect-free twin, with both noise seeds (≈ 170 full-mesh
+# magnitude of every effect and the effect-free twin, with both noise seeds (≈ 250 full-mesh
 # solves, `gaitlib.studies.gap.twin_validation_full_mesh`):
 
 # %%
@@ -226,7 +236,7 @@ tvf = G.twin_validation_full_mesh()
 rf = tvf.rows
 display(rf[["twin", "injected", "magnitude", "top", "verdict", "correct", "identified_magnitude", "rss_base",
             "base_start", "rss_top", "rss_true_fixed", "rss_gen", "shrink_injected_top", "shrink_vs_noise_top", "dBIC_top",
-            "dBIC_true"]])
+            "dBIC_true", "retried", "true_start"]])
 inj_f = rf[rf["injected"] != "none"]
 acc_f = 100 * float(inj_f["correct"].mean())
 shr_f = float(inj_f["shrink_injected_top"].clip(upper=100.0).mean())
@@ -250,26 +260,42 @@ for r in wrong_f.itertuples():
               f"baseline's {r.rss_base:.1f} (start: {r.base_start}) and the generating solution's {r.rss_gen:.1f}")
 
 # %% [markdown]
-# On the 20 × 5 mesh the check is **not** passed. With a single start (data-based guess
-# and the warm start from the real-data fit, the previous version of this chapter) it was
-# 4 of 6 at seed 1, and the effect-free twin was misnamed: its baseline fit had stalled at
-# 3× the noise and a candidate's extra freedom "rescued" it. With the four starts both
-# effect-free twins now come out "unexplained" and the baseline fits reach far lower RSS,
-# but fits still stall, now mostly the candidates' (listed above):
-#
-# - a **segment-inertia** twin whose generating gait has a second, brief right-foot contact
-#   just after toe-off (the GRF drops to near zero and returns to ≈ 180 N within 3 % of the
-#   cycle): no start of the baseline fit finds that bounce, every fit ends near the same RSS,
-#   and neither does the true model fitted from there. In a scratch experiment a further
-#   continuation — the fit with the GRF channels weighted 100× first — brought the baseline
-#   to about a quarter of that RSS; it is not part of the method yet;
-# - where the candidates are re-solved from the baseline fit with one warm start, the fit of
-#   the injected effect itself can stop in a worse optimum than the baseline (RSS_true
-#   above the baseline's), so a neighbouring effect wins or nothing is named.
-#
-# The diagnosis is only as good as its fits: on the thesis's mesh the candidates need the
-# same multistart as the baseline before the ranking can be trusted. The real-data results
-# of Sec. 4 are on 20 × 5 and carry this caveat.
+# **How the method got here.** The earlier versions of this chapter ran the same check
+# (measured then, on the same twins): with a single start (data-based guess and the warm
+# start from the real-data fit) it named 4 of 6 twins at seed 1 and misnamed the effect-free
+# twin, whose baseline fit had stalled at 3× the noise; with the four starts without the GRF
+# continuation and without the retry, 9 of 12 over both seeds. The misses were fits, not the
+# criterion: a **segment-inertia** twin whose generating gait has a second, brief right-foot
+# contact just after toe-off (the GRF drops to near zero and returns within 3 % of the
+# cycle), which no start found until the GRF-weighted continuation; and candidates that,
+# warm-started only from the kept baseline fit, stopped above the baseline's own objective —
+# which the retry now catches. What the current method gives:
+
+# %%
+wf = rf[rf["injected"] != "none"]
+base_wins = rf["base_start"].value_counts().to_dict()
+retried_twins = int((rf["retried"] > 0).sum())
+lines_f = [f"Baseline fits kept, by start: {', '.join(f'{k} {v}' for k, v in base_wins.items())}. "
+           f"Twins with at least one candidate re-solved from another start: {retried_twins} of {len(rf)} "
+           f"({int(rf['retried'].sum())} candidate fits); the injected effect's kept fit came from another start "
+           f"than the baseline fit in {int((wf['true_start'].fillna('best') != 'best').sum())} of {len(wf)} twins."]
+if acc_f >= 90 and shr_f >= 60 and bool(none_f.all()):
+    lines_f.append(f"On the 20 × 5 mesh the check **is passed**: {acc_f:.0f} % top-1 at the middle magnitude "
+                   f"(target ≥ 90 %), {shr_f:.0f} % mean shrink (target ≥ 60 %), every effect-free twin "
+                   f"'unexplained'.")
+else:
+    lines_f.append(f"On the 20 × 5 mesh the check is **not passed** ({acc_f:.0f} % top-1 at the middle magnitude, "
+                   f"target ≥ 90 %; {shr_f:.0f} % mean shrink, target ≥ 60 %; effect-free twins 'unexplained' "
+                   f"{int(none_f.sum())} of {len(none_f)}); the real-data results of Sec. 4 are on 20 × 5 and carry "
+                   f"this caveat.")
+for r in wrong_f.itertuples():
+    if r.injected != "none":
+        why = ("its own candidate fit ends above the baseline's even after the retry"
+               if np.isfinite(r.rss_true) and r.rss_true >= r.rss_base else
+               "its own fit closes less of the gap, by the criterion, than the named effect's")
+        lines_f.append(f"The miss {r.twin} (named {r.top}): {why} (RSS {r.rss_true:.1f} against the baseline's "
+                       f"{r.rss_base:.1f}; the true model with its magnitude fixed {r.rss_true_fixed:.1f}).")
+display(Markdown("\n\n".join(lines_f)))
 
 # %% [markdown]
 # ## 4. Findings on the real data
@@ -469,23 +495,26 @@ lines.append(
     f"**Twins on the thesis's 20 × 5 mesh** (middle magnitude, two seeds): top-1 accuracy {acc_f:.0f} % — the 90 % "
     f"target is {'met' if acc_f >= 90 else '**not met** on this mesh'} — effect-free twin 'unexplained' "
     f"{int(none_f.sum())} of {len(none_f)}, mean shrink of the injected gap {shr_f:.0f} % (capped), {shr_f_noise:.0f} % "
-    f"against the noise floor. The validated configuration is the 10 × 3 mesh; on 20 × 5 the fits, not the "
-    f"criterion, limit the diagnosis, and the real-data findings below carry that caveat.")
+    f"against the noise floor. "
+    + ("The method is validated on both meshes, including the one of the real-data diagnoses below."
+       if acc_f >= 90 and shr_f >= 60 and bool(none_f.all()) else
+       "The validated configuration is the 10 × 3 mesh; on 20 × 5 the fits, not the criterion, limit the "
+       "diagnosis, and the real-data findings below carry that caveat."))
 lines.append(
     f"**Schwartz 2008 Free.** The SK baseline fit leaves {sS['significant_cells']} of {sS['cells']} channel × phase "
     f"cells significantly outside the band (RMS z = {sS['rms_z']:.2f}); the largest cell is "
     f"{G.top_cells(dS.located, 1).iloc[0]['channel']} in {G.top_cells(dS.located, 1).iloc[0]['phase']}. "
     + (f"The diagnosis names **{sS['top']}** ({sS['verdict']}): it closes {sS['best_pct']:.0f} % of the RSS "
-       f"(95 % interval {sS['interval'][0]:.0f}–{sS['interval'][1]:.0f} %, ΔBIC = {sS['best_dBIC']:.0f})."
+       f"(95 % interval {sS['interval'][0]:.0f}–{sS['interval'][1]:.0f} %, ΔBIC = {sS['best_dBIC']:.1f})."
        if sS["top"] != "unexplained" else
        f"No candidate passes the criterion: **unexplained** (best {sS['best']}, {sS['best_pct']:.0f} % closed, "
-       f"ΔBIC = {sS['best_dBIC']:.0f})."))
+       f"ΔBIC = {sS['best_dBIC']:.1f}; threshold {D.BIC_THRESHOLD:g})."))
 lines.append(
     f"**gaitutils.** On angles and moments only, RMS z = {sU['rms_z']:.2f}; "
     + (f"the diagnosis names **{sU['top']}** ({sU['verdict']}, {sU['best_pct']:.0f} % closed, "
        f"interval {sU['interval'][0]:.0f}–{sU['interval'][1]:.0f} %)."
        if sU["top"] != "unexplained" else
-       f"**unexplained** (best {sU['best']}, {sU['best_pct']:.0f} % closed, ΔBIC = {sU['best_dBIC']:.0f})."))
+       f"**unexplained** (best {sU['best']}, {sU['best_pct']:.0f} % closed, ΔBIC = {sU['best_dBIC']:.1f}; threshold {D.BIC_THRESHOLD:g})."))
 def _flip(c):
     r = c["ranking"]
     f = r[(r["% closed (data as tracked)"] >= 5) & (r["% closed (left leg shifted exactly)"] <= 0)]["effect"]

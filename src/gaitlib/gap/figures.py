@@ -75,10 +75,11 @@ def ranking_bars(ranking: pd.DataFrame, top: str | None = None, threshold: float
     axs[0].barh(y, r["pct_closed"], color=colors)
     if "pct_closed_lo" in r.columns:
         lo, hi = r["pct_closed_lo"].to_numpy(), r["pct_closed_hi"].to_numpy()
-        m = np.isfinite(lo)
-        axs[0].errorbar(r["pct_closed"].to_numpy()[m], y[m], xerr=[r["pct_closed"].to_numpy()[m] - lo[m],
-                                                                    hi[m] - r["pct_closed"].to_numpy()[m]],
-                        fmt="none", ecolor="k", capsize=3)
+        m = np.isfinite(lo) & np.isfinite(hi)
+        # the interval as drawn from the resampled data: it need not contain the point
+        # estimate (the redrawn noise raises every RSS), so it is a segment, not ± errors
+        axs[0].hlines(y[m], lo[m], hi[m], color="k", lw=1.2)
+        axs[0].plot(np.r_[lo[m], hi[m]], np.r_[y[m], y[m]], "k|", ms=7)
     axs[0].axvline(0, color="k", lw=0.8)
     axs[0].set_xlabel("RSS closed (%) — raw")
     axs[0].set_yticks(y, [f"{e} (k={int(k)})" for e, k in zip(r["effect"], r["n_params"])], fontsize=8)
