@@ -10,9 +10,9 @@ solver's own derivative functions, [[H, Jᵀ], [J, 0]] (H: the Lagrangian's Hess
 J: the constraint Jacobian's, plus the diagonal IPOPT regularises). Its LDLᵀ factor is
 computed *symbolically* (CasADi ``Sparsity.ldl`` with an approximate-minimum-degree
 ordering — the family of MUMPS's default orderings, not MUMPS itself) with and without the
-periodic-gait constraint. Per mesh: KKT rows and non-zeros, non-zeros of L, the largest
-column of L, and Σ_j c_j² over L's column counts c_j — the flop count of the numeric
-factorisation up to a constant. Each quantity's growth exponent b (∝ nodes^b) is fitted
+periodic-gait constraint. Per mesh: KKT rows and non-zeros, non-zeros of L (strictly lower:
+CasADi does not store the unit diagonal), the largest column of L, and Σ_j c_j² over L's
+column counts c_j — the flop count of the numeric factorisation up to a constant. Each quantity's growth exponent b (∝ nodes^b) is fitted
 (:func:`gaitlib.studies.performance.fit_power_law`). No solve, no timing: the numbers are
 exact and machine-independent.
 

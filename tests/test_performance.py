@@ -93,3 +93,37 @@ def test_kkt_and_msk_profile_tables_keep_errors_out_and_units_in_names():
     runs, sizes = perf.msk_profile_tables(prof)
     assert runs.loc[0, "solve (s)"] == 2.0 and runs.loc[0, "iterations with Hessian perturbation"] == 4
     assert sizes.loc[0, "Hessian SX instructions"] == 1000
+
+
+def _bench(name):
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(name, path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_kkt_fill_counts_of_known_patterns():
+    """bench_kkt_fill's symbolic counts (strictly lower L; the unit diagonal is not stored) on
+    patterns with a known factor: a tridiagonal (path) matrix factorises without fill (n − 1
+    entries; columns of at most 2, as the ordering picks the elimination order); closing the path into a cycle (the
+    periodic constraint's shape) adds fill, linear in n; a dense arrow (one row coupled to
+    all) adds none when that row is eliminated last."""
+    import casadi as ca
+
+    kf = _bench("bench_kkt_fill")
+    n = 40
+    path = ca.Sparsity.band(n, 1) + ca.Sparsity.band(n, -1) + ca.Sparsity.diag(n)
+    f = kf.fill(path)
+    assert f["L_nnz"] == n - 1 and f["L_max_column"] <= 2 and n - 1 <= f["flops_proxy"] <= 4 * (n - 1)
+    r, c = path.get_triplet()
+    cyc = ca.Sparsity.triplet(n, n, list(r) + [0, n - 1], list(c) + [n - 1, 0])
+    g = kf.fill(cyc)
+    assert g["L_nnz"] > f["L_nnz"] and g["flops_proxy"] > f["flops_proxy"]
+    assert g["L_nnz"] <= 2 * n  # a cycle's minimum-degree fill is linear: one extra entry per column at most
+    arrow = ca.Sparsity.diag(n) + ca.Sparsity.triplet(n, n, [0] * n + list(range(n)), list(range(n)) + [0] * n)
+    a = kf.fill(arrow)
+    assert a["L_nnz"] == n - 1
