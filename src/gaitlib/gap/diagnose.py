@@ -16,8 +16,8 @@ GaitData) and a baseline model, and
    (signature in EMG only) on a grid of fixed magnitudes, keeping the one with the smallest
    gap; an NLP candidate that does not converge, or ends above the baseline's objective
    although it contains the baseline model (a worse local optimum), is re-solved from each
-   of the baseline's other starts and the best converged fit kept; comparison-only effects (``resolve=False``) by a bounded scalar search of the gap
-   on the baseline's solution;
+   of the baseline's other starts and the best converged fit kept; comparison-only effects
+   (``resolve=False``) by a bounded scalar search of the gap on the baseline's solution;
 3. ranks the effects by a criterion that pays for parameters and says "unexplained" when
    none is good enough;
 4. for the top effects: the gap before/after per channel and phase, % closed, and an
@@ -388,8 +388,9 @@ def baseline_fits(spec0, datasets: dict, warm=None, *, objective="fit", root=Non
     """Baseline fits of several data sets (key → DataSet) from each of ``starts``
     (:data:`BASELINE_STARTS`; ``warm`` only with a ``warm`` solution, ``coarse`` only on a
     mesh finer than :data:`COARSE_MESH`, ``grf`` only for the ``"fit"`` objective); the
-    converged fit with the lowest objective is kept. Returns key → GaitSolution (``detail``: key → {start: GaitSolution}, the kept one
-    under ``"best"``); each kept solution's ``stats["start"]`` names its start."""
+    converged fit with the lowest objective is kept. Returns key → GaitSolution
+    (``detail``: key → {start: GaitSolution}, the kept one under ``"best"``); each kept
+    solution's ``stats["start"]`` names its start."""
     unknown = set(starts) - set(BASELINE_STARTS)
     if unknown:
         raise ValueError(f"unknown baseline start(s) {sorted(unknown)}; expected some of {BASELINE_STARTS}")
