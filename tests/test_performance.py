@@ -64,13 +64,7 @@ def test_missing_results_name_the_file_and_the_script(tmp_path):
 def test_load_note_says_shared_only_when_the_machine_was_busy():
     """bench_scaling's note follows the recorded load averages: quiet only if every run
     started below QUIET_LOAD."""
-    import importlib.util
-    from pathlib import Path
-
-    path = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_scaling.py"
-    spec = importlib.util.spec_from_file_location("bench_scaling", path)
-    bs = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(bs)
+    bs = _bench("bench_scaling")
     doc = {"meta": {"loadavg_start": [0.9, 0.8, 0.7]}, "runs": [{"loadavg_start": [1.05, 1, 1]}, {"loadavg_start": [0.97, 1, 1]}]}
     assert "no other job" in bs._load_note(doc) and "1.05" in bs._load_note(doc)
     doc["runs"].append({"loadavg_start": [2.4, 2, 2]})
