@@ -11,7 +11,9 @@ thread), one after another:
 * ``default``: the book's solver options;
 * IPOPT option variants that might cut iterations or factorisations (initial barrier
   parameter, NLP scaling, bound push, Hessian-perturbation decrease factor) or the cost of
-  a factorisation (MUMPS's fill-reducing ordering; IPOPT's default lets MUMPS choose). They are
+  a factorisation (MUMPS's fill-reducing ordering; IPOPT's default lets MUMPS choose), how
+  fast the barrier parameter falls, IPOPT's inertia-free curvature test instead of inertia
+  corrections, and (not an IPOPT option, key ``_env``) glibc's malloc settings. They are
   **measurements, not tuning**: a variant that is faster but lands in a different local
   optimum (objective) is not the same solve.
 
@@ -52,6 +54,15 @@ VARIANTS = {
     "mumps_pivot_order = 0 (AMD)": {"mumps_pivot_order": 0},
     "mumps_pivot_order = 2 (AMF)": {"mumps_pivot_order": 2},
     "mumps_pivot_order = 6 (QAMD)": {"mumps_pivot_order": 6},
+    "barrier_tol_factor = 100": {"barrier_tol_factor": 100.0},
+    "barrier_tol_factor = 1000": {"barrier_tol_factor": 1000.0},
+    "barrier_tol_factor = 100, mu_init = 1e-2": {"barrier_tol_factor": 100.0, "mu_init": 1e-2},
+    "mu_linear_decrease_factor = 0.1": {"mu_linear_decrease_factor": 0.1},
+    "neg_curv_test_tol = 1e-12 (inertia-free)": {"neg_curv_test_tol": 1e-12},
+    # not an IPOPT option: glibc's malloc told not to return MUMPS's work arrays to the
+    # system (no mmap/munmap per factorisation); the same arithmetic, so the same path
+    "default, glibc malloc without mmap/trim": {"_env": {
+        "GLIBC_TUNABLES": "glibc.malloc.mmap_threshold=4294967296:glibc.malloc.trim_threshold=4294967296"}},
 }
 TIMING = {"Lagrangian Hessian": "hessian_s", "Function Evaluations": "function_evals_s",
           "StdAugSystemSolverMultiSolve": "linear_systems_s", "OverallAlgorithm": "overall_s",
@@ -95,6 +106,8 @@ def parse(log: str) -> dict:
         m = re.match(r"\s*([A-Za-z ]+?)\.*:\s+([\d.]+) \(sys:\s+([\d.]+) wall:\s+([\d.]+)\)", line)
         if m and m.group(1).strip() in TIMING:
             out[TIMING[m.group(1).strip()]] = float(m.group(4))
+            if TIMING[m.group(1).strip()] == "linear_systems_s":  # system time: page faults of MUMPS's allocations
+                out["linear_systems_sys_s"] = float(m.group(3))
     its = [ln.split() for ln in log.splitlines() if re.match(r"^\s*\d+r?\s+[-+\d.e]+\s+[\d.e+-]+\s", ln)]
     out["perturbed_iterations"] = sum(1 for t in its if len(t) > 6 and t[6] != "-")
     out["logged_iterations"] = len(its)
@@ -133,9 +146,10 @@ def main(argv=None) -> int:
     env = {**os.environ, **ENV1}
     rows = []
     for name, opts in VARIANTS.items():
-        cmd = [sys.executable, __file__, "--child", json.dumps(opts)] + (["--quick"] if args.quick else [])
+        ipopt = {k: v for k, v in opts.items() if k != "_env"}
+        cmd = [sys.executable, __file__, "--child", json.dumps(ipopt)] + (["--quick"] if args.quick else [])
         load = os.getloadavg()[0]
-        p = subprocess.run(cmd, env=env, capture_output=True, text=True)
+        p = subprocess.run(cmd, env={**env, **opts.get("_env", {})}, capture_output=True, text=True)
         res = [ln for ln in p.stdout.splitlines() if ln.startswith("RESULT ")]
         if p.returncode or not res:
             rows.append({"variant": name, "ipopt_options": opts, "status": "error",
@@ -159,7 +173,7 @@ def main(argv=None) -> int:
 
     stem = "msk_profile_quick" if args.quick else "msk_profile"
     cols = ["variant", "status", "iterations", "solve_s", "ms_per_iteration", "hessian_s", "other_evals_s",
-            "linear_systems_s", "rest_s", "perturbed_iterations", "objective", "load_at_start"]
+            "linear_systems_s", "linear_systems_sys_s", "rest_s", "perturbed_iterations", "objective", "load_at_start"]
     md = [f"# MSK data tracking (Eq 5.33), full mesh: where the time goes ({doc['measured']}, {doc['machine']})", ""]
     md += md_table(cols, rows)
     md += ["", "Expression graphs (SX instructions; ca.hessian of the Lagrangian):", "",

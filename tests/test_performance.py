@@ -121,3 +121,67 @@ def test_kkt_fill_counts_of_known_patterns():
     arrow = ca.Sparsity.diag(n) + ca.Sparsity.triplet(n, n, [0] * n + list(range(n)), list(range(n)) + [0] * n)
     a = kf.fill(arrow)
     assert a["L_nnz"] == n - 1
+
+
+def test_eval_floor_per_node_hessian_blocks_and_floors():
+    """bench_eval_floor: the per-node Hessian of μᵀẋ + νᵀg + aᵀL equals the analytic one; the
+    block check accepts a node-block-diagonal pattern and counts a coupling between nodes;
+    the floors are the profile's linear systems + rest plus the (scaled) evaluations."""
+    from types import SimpleNamespace
+
+    import casadi as ca
+
+    ef = _bench("bench_eval_floor")
+    x, u, p, t, d = ca.SX.sym("x", 2), ca.SX.sym("u"), ca.SX.sym("p", 0), ca.SX.sym("t"), ca.SX.sym("d", 1)
+    node = ca.Function("node", [x, u, p, t, d], [ca.vertcat(x[1], x[0] * u), u ** 3, (x[0] - d) ** 2 * t])
+    hess, jac = ef.per_node_functions(node)
+    xv, uv, tv, dv, mu, nu, a = np.array([0.3, -1.2]), 0.7, 2.0, 0.1, np.array([5.0, -2.0]), 3.0, 0.5
+    H = np.asarray(ca.DM(hess(xv, uv, [], tv, dv, mu, nu, a))).copy()
+    # z = (x0, x1, u): ∂²/∂x0² = 2 a t; ∂²/∂x0∂u = μ2; ∂²/∂u² = 6 ν u; upper triangle only
+    expected = np.array([[2 * a * tv, 0, mu[1]], [0, 0, 0], [0, 0, 6 * nu * uv]])
+    assert np.allclose(H, expected, rtol=1e-14, atol=0)
+    Y, J = jac(xv, uv, [], tv, dv)
+    assert np.allclose(np.asarray(J), [[0, 1, 0], [uv, 0, xv[0]], [0, 0, 3 * uv ** 2], [2 * (xv[0] - dv) * tv, 0, 0]])
+
+    # two collocation nodes (state nodes 1, 2; node 0 is the Radau start), 1 state and 1 control each
+    lay = SimpleNamespace(ix=np.array([[0, 1, 3]]), iu=np.array([[2, 4]]))
+    mesh = SimpleNamespace(colloc_state_nodes=[1, 2])
+    ok = ca.Sparsity.triplet(5, 5, [1, 1, 2, 3, 3, 4], [1, 2, 2, 3, 4, 4])
+    assert ef.hessian_blocks(ok, lay, mesh) == {"hessian_nnz": 6, "hessian_nnz_outside_node_blocks": 0,
+                                                "hessian_nnz_per_node_block_max": 3}
+    bad = ca.Sparsity.triplet(5, 5, [1, 1, 0], [1, 3, 0])  # x1–x3 couples nodes; x0 is in no block
+    assert ef.hessian_blocks(bad, lay, mesh)["hessian_nnz_outside_node_blocks"] == 2
+
+    m = {"mapped_compiled_ms": {"hessian": 10.0}, "solver_function_ms": {"nlp_hess_l": 40.0}}
+    prof = {"measured": "x", "runs": [{"variant": "default", "iterations": 200, "solve_s": 30.0, "hessian_s": 8.0,
+                                       "other_evals_s": 6.0, "linear_systems_s": 13.0, "rest_s": 3.0}]}
+    fl = ef.floors(m, prof)
+    assert fl["floor_evaluations_free_s"] == 16.0
+    assert fl["floor_hessian_compiled_s"] == pytest.approx(16.0 + 6.0 + 200 * 0.010)
+    assert fl["floor_all_compiled_s"] == pytest.approx(16.0 + 14.0 * 0.25)
+    assert fl["evaluation_budget_ms_per_iteration"] == pytest.approx(1e3 * 4.0 / 200)
+    tab = perf.eval_floor_table({"floors": fl})
+    assert list(tab["≤ 20 s"]) == [False, True, False, True]
+
+
+def test_mumps_orderings_parses_mumps_analysis_reports():
+    """bench_mumps_orderings reads MUMPS's analysis report (format of MUMPS 5.8.2, as printed
+    through IPOPT with mumps_print_level 2): one record per JOB = 1 call, in order; factor and
+    solve calls (JOB = 2, 3) are not analyses; a report missing a count is an error."""
+    mo = _bench("bench_mumps_orderings")
+
+    def block(n, nnz, name, used, entries, front, flops):
+        return (f"\nEntering DMUMPS 5.8.2 from C interface with JOB, N, NNZ =   1        {n}          {nnz}\n"
+                f" Ordering based on {name} \n -- (20) Number of entries in factors (estim.)  =          {entries}\n"
+                f" --  (5) Maximum frontal size      (estimated)  =             {front}\n"
+                f" --  (7) Ordering option effectively used       =               {used}\n"
+                f" RINFOG(1) Operations during elimination (estim)= {flops}\n"
+                f"Entering DMUMPS 5.8.2 from C interface with JOB, N, NNZ =   2        {n}          {nnz}\n")
+
+    log = block(2540, 21574, "AMD", 0, 260837, 281, "3.602D+07") + block(2540, 21574, "METIS", 5, 250000, 120, "4.198D+07")
+    a = mo.parse_analyses(log)
+    assert [r["ordering_name"] for r in a] == ["AMD", "METIS"] and [r["ordering_used"] for r in a] == [0, 5]
+    assert a[0]["flops"] == 3.602e7 and a[1]["max_front"] == 120 and a[0]["factor_entries"] == 260837
+    assert a[0]["kkt_n"] == 2540 and a[0]["kkt_nnz_lower"] == 21574
+    with pytest.raises(ValueError, match="RINFOG|flops"):
+        mo.parse_analyses(log.replace("RINFOG(1)", "RINFOG(9)"))

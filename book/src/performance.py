@@ -160,6 +160,46 @@ if prof is not None:
           f"{ok['objective'].min():.3f}–{ok['objective'].max():.3f} (different local optima).")
 
 # %% [markdown]
+# ## How fast could that solve be on the same path?
+#
+# The variants above that save iterations stop in other local optima, so the only change
+# that keeps the book's solution is a cheaper iteration. `bench_eval_floor.py` asks what the
+# function evaluations would cost compiled to C instead of run by CasADi's SX virtual machine.
+# Every non-linear term of the Lagrangian belongs to one collocation node (the defects, the
+# periodicity and the quadrature of the costs are linear), so the exact Hessian is a sum of
+# per-node Hessians; the script checks this on the solver's Hessian pattern, compiles the
+# per-node Hessian and Jacobian with gcc, and times them over all nodes beside the solver's
+# own functions. With the default run of the profile above (its iterations and its linear
+# systems unchanged) that gives lower bounds on the solve time. gaitlib does not solve with
+# compiled per-node code; this is a measurement of what it could gain.
+
+# %%
+floor = perf.load_optional("eval_floor")
+if floor is not None:
+    print(perf.measured_on(floor))
+    display(pd.DataFrame([floor["solver_function_ms"]]).rename(index={0: "ms per call (SX virtual machine)"}))
+    display(pd.DataFrame({"SX virtual machine (ms)": floor["mapped_vm_ms"],
+                          "compiled C (ms)": floor["mapped_compiled_ms"]}).rename_axis(
+        f"per-node, mapped over {floor['collocation_nodes']} nodes"))
+    if floor.get("floors"):
+        ft = perf.eval_floor_table(floor)
+        display(ft)
+        fl = floor["floors"]
+        print(f"• The solver's Hessian has {floor['hessian_nnz']:,} non-zeros, "
+              f"{floor['hessian_nnz_outside_node_blocks']} outside the nodes' (x, u) blocks; per node "
+              f"{floor['node_hessian_instructions']:,} SX instructions × {floor['collocation_nodes']} nodes = "
+              f"{floor['nodes_x_node_hessian_instructions']:,}, against {floor['solver_hessian_instructions']:,} in the "
+              f"solver's Hessian: the same work, evaluated per node.")
+        print(f"• Compiled with gcc {floor['gcc']} ({floor['compile_s']:.0f} s), the per-node Hessian over all nodes "
+              f"takes {floor['mapped_compiled_ms']['hessian']:.1f} ms against the solver's "
+              f"{floor['solver_function_ms']['nlp_hess_l']:.1f} ms ({fl['compiled_to_vm_hessian_ratio']:.2f}×). On the "
+              f"default path ({fl['iterations']} iterations) the solve would take at best "
+              f"{fl['floor_hessian_compiled_s']:.1f} s with the Hessian compiled and "
+              f"{fl['floor_all_compiled_s']:.1f} s with every evaluation equally faster; the linear systems and "
+              f"IPOPT's own work alone take {fl['floor_evaluations_free_s']:.1f} s. Reaching 20 s on this path would "
+              f"need all evaluations together in ≤ {fl['evaluation_budget_ms_per_iteration']:.1f} ms per iteration.")
+
+# %% [markdown]
 # ## Every optimisation of the book beside the thesis's times
 #
 # `bench_thesis_times.py` lists every optimisation the chapters run — by calling the same
@@ -286,6 +326,50 @@ if fill is not None:
                     for m in dict.fromkeys(ff["model"])))
 
 # %% [markdown]
+# ## MUMPS's own count, ordering by ordering
+#
+# The symbolic count above models MUMPS with CasADi's minimum-degree ordering.
+# `bench_mumps_orderings.py` asks MUMPS itself: IPOPT is started on each mesh once per value
+# of `mumps_pivot_order` (AMD, AMF, SCOTCH, PORD, METIS, QAMD and MUMPS's automatic choice,
+# IPOPT's default), and MUMPS's analysis report gives the ordering it actually used, the
+# estimated entries of the factors and the estimated operations of one factorisation. The
+# analysis is made once per solve on a pattern that does not change between iterations, so
+# these are the counts of every factorisation in a solve (before delayed pivots). No timing.
+
+# %%
+mo = perf.load_optional("mumps_orderings")
+if mo is not None:
+    print(perf.measured_on(mo))
+    mo_rows, mo_fits = pd.DataFrame(mo["rows"]), pd.DataFrame(mo["fits"])
+    display(mo_rows.pivot_table(index=["model", "nodes"], columns="requested_name", values="flops").map(
+        lambda v: f"{v:.3g}"))
+    fl_fits = mo_fits[mo_fits["quantity"] == "flops"]
+    display(fl_fits.pivot(index="requested_name", columns="model", values="exponent").round(3))
+    fallback = mo_rows[mo_rows["requested_name"].str.split().str[0] != mo_rows["ordering_name"]]
+    fallback = fallback[fallback["requested"] != 7]
+    if len(fallback):
+        print("• Not in this MUMPS build (MUMPS used another ordering instead): " + "; ".join(
+            f"{name} → {', '.join(f'{u} (KKT of {g2.kkt_n.min():,}–{g2.kkt_n.max():,} rows)' for u, g2 in g.groupby('ordering_name'))}"
+            for name, g in fallback.groupby("requested_name", sort=False)) + ". Their fitted exponents mix two "
+            "orderings and are left out below.")
+    mixed = set(fallback["requested_name"])
+    for model, g in fl_fits[~fl_fits["requested_name"].isin(mixed)].groupby("model", sort=False):
+        best = g.loc[g["exponent"].idxmin()]
+        at = mo_rows[mo_rows["model"] == model]
+        at = at[at["nodes"] == at["nodes"].max()].set_index("requested_name")["flops"]
+        auto = at["auto (IPOPT default)"]
+        used = mo_rows[(mo_rows["model"] == model) & (mo_rows["requested"] == 7)]["ordering_name"].unique()
+        is_default = best["used"] in used
+        print(f"• {model}: one factorisation's operations grow as nodes^{g['exponent'].min():.2f}–"
+              f"{g['exponent'].max():.2f} over the orderings; the slowest growth is {best['requested_name']}'s "
+              f"(nodes^{best['exponent']:.2f} ± {best['exponent_se']:.2f})"
+              + (f", which is what IPOPT's default (MUMPS's automatic choice) uses. " if is_default else
+                 f", but at the largest mesh its count is {at[best['requested_name']] / auto:.2f}× that of IPOPT's "
+                 f"default (MUMPS's automatic choice: {', '.join(used)}). ")
+              + ("No ordering MUMPS offers grows linearly or slower." if g["exponent"].min() > 1.0 else
+                 "At least one ordering grows no faster than linearly."))
+
+# %% [markdown]
 # ## Exact Hessian vs limited-memory (L-BFGS)
 #
 # The same problem and mesh, IPOPT's `hessian_approximation` exact (CasADi's second
@@ -372,9 +456,7 @@ if fill is not None:
               f"N^{b_L:.2f} but flops growing as N^{b_fl:.2f} (N^{b_np:.2f} without the periodic constraint)"
               + (f", beside IPOPT + MUMPS's measured N^{mu['exponent']:.2f}" if mu is not None else "")
               + ": the superlinear part of the linear algebra is the fill of the minimum-degree ordering, not "
-                "the machine. Whether nested dissection (METIS, `mumps_pivot_order = 5`, which CasADi's MUMPS has) "
-                "grows linearly is not measured here; at 20 × 5 MSK it was slower than the default (a scratch run on "
-                "2026-12-02, machine shared: 362 iterations and 49.9 s in the linear systems, against 281 and 21.4 s).")
+                "the machine (MUMPS's own counts for every ordering it offers are in the section above).")
 by_model = table[table["nodes"] == 100].set_index("model")
 if {"SK", "MSK"} <= set(by_model.index):
     msg = (f"• At the thesis mesh (100 nodes) one iteration costs {by_model.loc['SK', 'ms_per_iteration']:.0f} ms (SK), "
