@@ -91,18 +91,44 @@ def per_node_functions(node):
     return hess, jac
 
 
+def node_variables(lay, mesh) -> list[np.ndarray]:
+    """NLP indices of each collocation node's (x_k, u_k), in the per-node functions' order."""
+    return [np.concatenate([lay.ix[:, k], lay.iu[:, c]]) for c, k in enumerate(mesh.colloc_state_nodes)]
+
+
 def hessian_blocks(H, lay, mesh) -> dict:
     """Check that the NLP Hessian's pattern ``H`` is block-diagonal in the collocation nodes'
     (x_k, u_k) blocks — what makes it the sum of the per-node Hessians."""
     block = np.full(H.size1(), -1)
-    for c, k in enumerate(mesh.colloc_state_nodes):
-        block[lay.ix[:, k]] = c
-        block[lay.iu[:, c]] = c
+    for c, z in enumerate(node_variables(lay, mesh)):
+        block[z] = c
     rows, cols = np.asarray(H.get_triplet()[0]), np.asarray(H.get_triplet()[1])
     same = (block[rows] == block[cols]) & (block[rows] >= 0)
     per_block = np.bincount(block[rows][same], minlength=len(mesh.colloc_state_nodes))
     return {"hessian_nnz": int(H.nnz()), "hessian_nnz_outside_node_blocks": int((~same).sum()),
             "hessian_nnz_per_node_block_max": int(per_block.max())}
+
+
+def node_inputs(nlp, ph, w, p):
+    """The per-node function's inputs (x, u, p, t, d) at every collocation node, one column per
+    node, taken from the NLP variables ``w`` and parameters ``p`` (DM or MX). Fixed phase
+    times only (the natural-gait problems)."""
+    import casadi as ca
+
+    from gaitlib import ocp
+
+    lay, mesh = nlp.layouts[ph.name], nlp.meshes[ph.name]
+    if not (lay.t0_fixed and lay.tf_fixed):
+        raise ValueError(f"phase {ph.name!r}: free start or end time; this benchmark needs fixed times")
+    nc, cols = lay.nc, list(mesh.colloc_state_nodes)
+    Xc = ca.reshape(w[[int(i) for i in lay.ix[:, cols].ravel(order="F")]], lay.ix.shape[0], nc)
+    U = ca.reshape(w[[int(i) for i in lay.iu.ravel(order="F")]], lay.iu.shape[0], nc)
+    s0, nd, _ = nlp._data_slices[ph.name]
+    D = ca.reshape(p[s0:s0 + nd * nc], nd, nc)
+    t0, tf = float(ocp._lohi(ph.t0)[0]), float(ocp._lohi(ph.tf)[0])
+    Tc = ca.DM((t0 + (tf - t0) * np.asarray(mesh.tau_colloc)).reshape(1, -1))
+    P = ca.DM.zeros(nlp._node_functions[ph.name].size1_in(2), nc)
+    return Xc, U, P, Tc, D
 
 
 def _passthrough_class(node_sizes, path_sizes):
@@ -133,8 +159,6 @@ def compiled_hessian(nlp, gp, hess, hess_c):
     import casadi as ca
     import pandas as pd
 
-    from gaitlib import ocp
-
     (ph,) = gp.problem.phases
     node = nlp._node_functions[ph.name]
     nF, nG, nL = (node.size1_out(i) for i in range(3))
@@ -157,22 +181,13 @@ def compiled_hessian(nlp, gp, hess, hess_c):
         raise AssertionError("the Lagrangian has non-linear terms outside the nodes")
     ybar_fun = ca.Function("node_multipliers", [p2[pt._n_pdata:], lam_f, lam_g], [ca.reshape(ybar, nY, nc)])
 
-    lay, mesh = nlp.layouts[ph.name], nlp.meshes[ph.name]
-    cols = list(mesh.colloc_state_nodes)
     X, P = ca.MX.sym("x", nlp.n_variables), ca.MX.sym("p", nlp.nlp["p"].shape[0])
     LF, LG = ca.MX.sym("lam_f"), ca.MX.sym("lam_g", nlp.n_constraints)
-    Xc = ca.reshape(X[[int(i) for i in lay.ix[:, cols].ravel(order="F")]], lay.ix.shape[0], nc)
-    U = ca.reshape(X[[int(i) for i in lay.iu.ravel(order="F")]], lay.iu.shape[0], nc)
-    s0, nd, _ = nlp._data_slices[ph.name]
-    D = ca.reshape(P[s0:s0 + nd * nc], nd, nc)
-    t0 = float(ocp._lohi(ph.t0)[0])
-    tf = float(ocp._lohi(ph.tf)[0])
-    Tc = ca.DM((t0 + (tf - t0) * np.asarray(mesh.tau_colloc)).reshape(1, -1))
     YB = ybar_fun(P[nlp._n_pdata:], LF, LG)
-    Hb = hess_c.map(nc)(Xc, U, ca.MX(node.size1_in(2), nc), Tc, D, YB[:nF, :], YB[nF:nF + nG, :], YB[nF + nG:, :])
+    Hb = hess_c.map(nc)(*node_inputs(nlp, ph, X, P), YB[:nF, :], YB[nF:nF + nG, :], YB[nF + nG:, :])
     br, bc = (np.asarray(v) for v in hess.sparsity_out(0).get_triplet())
-    rows = np.concatenate([np.concatenate([lay.ix[:, cols[c]], lay.iu[:, c]])[br] for c in range(nc)])
-    colg = np.concatenate([np.concatenate([lay.ix[:, cols[c]], lay.iu[:, c]])[bc] for c in range(nc)])
+    zs = node_variables(nlp.layouts[ph.name], nlp.meshes[ph.name])
+    rows, colg = np.concatenate([z[br] for z in zs]), np.concatenate([z[bc] for z in zs])
     if np.any(rows > colg):
         raise AssertionError("node blocks are not upper-triangular in the NLP's variable order")
     sp = ca.Sparsity.triplet(nlp.n_variables, nlp.n_variables, rows.tolist(), colg.tolist())
@@ -181,12 +196,11 @@ def compiled_hessian(nlp, gp, hess, hess_c):
     return ca.Function("nlp_hess_l", [X, P, LF, LG], [H], ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"])
 
 
-def solve_both(nlp, gp, hess_lag) -> dict:
-    """Check ``hess_lag`` against the solver's Hessian, then solve with each (same start)."""
+def solve_both(nlp, w0, pv, hess_lag, options) -> dict:
+    """Check ``hess_lag`` against the solver's Hessian at ``w0`` (parameters ``pv``), then
+    solve from ``w0`` with the book's solver and with one using ``hess_lag``."""
     import casadi as ca
 
-    w0 = np.clip(nlp.initial_point(gp.guess), nlp.lbw, nlp.ubw)
-    pv = np.concatenate([nlp.data_vector(), nlp.goal_weights()])
     lg = np.random.default_rng(1).normal(size=nlp.n_constraints)
     h_ref = nlp.solver.get_function("nlp_hess_l")
     a, b = ca.DM(h_ref(w0, pv, 0.7, lg)), ca.DM(hess_lag(w0, pv, 0.7, lg))
@@ -199,8 +213,7 @@ def solve_both(nlp, gp, hess_lag) -> dict:
     out = {"hessian_check_max_rel_diff": rel,
            "hessian_ms": {"solver": _median_ms(h_ref, [w0, pv, 0.7, lg]),
                           "assembled_compiled": _median_ms(hess_lag, [w0, pv, 0.7, lg])}, "solves": []}
-    opts = gp.options.nlpsol_options()
-    compiled = ca.nlpsol("compiled_hessian", "ipopt", nlp.nlp, {**opts, "hess_lag": hess_lag})
+    compiled = ca.nlpsol("compiled_hessian", "ipopt", nlp.nlp, {**options.nlpsol_options(), "hess_lag": hess_lag})
     for name, solver in (("book (SX Hessian)", nlp.solver), ("compiled per-node Hessian", compiled)):
         t0 = time.perf_counter()
         r = solver(x0=w0, lbx=nlp.lbw, ubx=nlp.ubw, lbg=nlp.lbg, ubg=nlp.ubg, p=pv)
@@ -266,18 +279,10 @@ def measure(quick: bool) -> dict:
 
     # 2. per-node derivatives: SX virtual machine vs compiled C, one mapped call over the nodes
     nc = lay.nc
-    cols = list(mesh.colloc_state_nodes)
-    Xc = w0[lay.ix][:, cols]
-    U = w0[lay.iu]
-    P = np.zeros((node.size1_in(2), 1))
-    t0_ = float(ocp._lohi(ph.t0)[0]) if lay.t0_fixed else float(w0[lay.it0])
-    tf_ = float(ocp._lohi(ph.tf)[0]) if lay.tf_fixed else float(w0[lay.itf])
-    Tc = (t0_ + (tf_ - t0_) * np.asarray(mesh.tau_colloc)).reshape(1, -1)
-    start, nd, _ = nlp._data_slices[ph.name]
-    D = pv[start:start + nd * nc].reshape(nd, nc, order="F")
+    inputs = list(node_inputs(nlp, ph, ca.DM(w0), ca.DM(pv)))
     hess, jac = per_node_functions(node)
     mult = [rng.normal(size=(hess.size1_in(k), nc)) for k in (5, 6, 7)]
-    h_args, j_args = [Xc, U, P, Tc, D] + mult, [Xc, U, P, Tc, D]
+    h_args, j_args = inputs + mult, inputs
     opt = "-O1" if quick else "-O2"
     with tempfile.TemporaryDirectory() as tmp:
         (hess_c, jac_c), compile_s = compile_c([hess, jac], opt, Path(tmp))
@@ -285,7 +290,7 @@ def measure(quick: bool) -> dict:
         cc = {"hessian": _median_ms(hess_c.map(nc), h_args), "jacobian": _median_ms(jac_c.map(nc), j_args)}
         hv, hc = np.asarray(hess.map(nc)(*h_args)), np.asarray(hess_c.map(nc)(*h_args))
         rel = float(np.max(np.abs(hv - hc)) / max(np.max(np.abs(hv)), 1e-300))
-        solve = solve_both(nlp, gp, compiled_hessian(nlp, gp, hess, hess_c))
+        solve = solve_both(nlp, w0, pv, compiled_hessian(nlp, gp, hess, hess_c), gp.options)
     if m_blocks := blocks["hessian_nnz_outside_node_blocks"]:
         raise AssertionError(f"{m_blocks} Hessian non-zeros couple different nodes: not a sum of per-node Hessians")
     if rel > 1e-12:
