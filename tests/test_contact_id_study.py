@@ -145,7 +145,8 @@ def test_identified_file_round_trip_with_provenance(tmp_path, monkeypatch):
     prov = raw["provenance"]
     for k in ("spec", "gaitlib_version", "cache_fingerprint", "ipopt_status", "iterations", "date"):
         assert k in prov
-    assert prov["cache_fingerprint"] == cache.fingerprint(identified=ci.spec_c(4, 3).identified_sets())
+    assert prov["cache_fingerprint"] == cache.fingerprint((tr.FORMULATION, ci.FORMULATION),
+                                                          identified=ci.spec_c(4, 3).identified_sets())
     assert prov["spec"]["cost"] == "Eq4.13"
     assert raw["units"]["p_contact"]["toe.k_v"] == "N/m^3" and raw["units"]["p_body"]["mass_hat"] == "kg"
     lo, hi = contact.bounds()

@@ -137,6 +137,13 @@ from .model import ChildModel
 from .ocp import Goal, Guess, Named, Parameter, PathConstraint, Periodic, Phase, PhaseGuess, Problem, SolverOptions
 from . import ocp
 
+#: Version of the gait formulation (this module with the physics, the collocation engine, the
+#: data references, the effect library, bounds, initial guesses and solver options): part of
+#: every cache key of a gait solution (:mod:`gaitlib.cache`). Bump it when a change alters
+#: what is solved; ``tests/test_formulation_versions.py`` fails when the problem's numbers
+#: change under an unchanged version.
+FORMULATION = "gait-1"
+
 MODELS = ("SK", "MSK", "NMSK")
 TERMS = ("Jrk", "Rsd", "Imp", "HAT", "Act", "Trq", "Ang", "GRF", "Q", "Mtb")
 LEG_JOINTS = tuple(f"{j}_{s}" for s in cv.SIDES for j in ("hip", "knee", "ankle"))  # 6 tracked
@@ -357,9 +364,9 @@ class GaitSpec:
         return tuple(sets)
 
     def key(self) -> str:
-        """Cache key: hash of the full spec, the library version and the code and data
-        (:func:`gaitlib.cache.key`) — any change to either gives a new key."""
-        return cache.key({"kind": "gait", **self.to_dict()}, identified=self.identified_sets())
+        """Cache key: hash of the full spec, :data:`FORMULATION` and the data
+        (:func:`gaitlib.cache.key`)."""
+        return cache.key({"kind": "gait", **self.to_dict()}, FORMULATION, identified=self.identified_sets())
 
     def to_dict(self) -> dict:
         return json.loads(json.dumps(asdict(self)))

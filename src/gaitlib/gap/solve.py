@@ -19,8 +19,8 @@ HAT reference (pelvis height from the vertical GRF, an estimate rather than data
 cannot be computed for every synthetic GRF).
 
 Solutions are cached under ``<root>/gap/<key>``, the key hashing the spec, the data set's
-numbers (:func:`gaitlib.gap.io.signature`), the warm start, and the code (the
-:data:`gaitlib.cache.CORE` sources plus this module and :mod:`gaitlib.gap.effects`).
+numbers (:func:`gaitlib.gap.io.signature`), the warm start, and the formulation versions
+(:data:`gaitlib.transcription.FORMULATION` and this module's :data:`FORMULATION`).
 Failed solves are cached and returned as failed (their IPOPT status is the result).
 """
 
@@ -36,7 +36,7 @@ from .. import cache
 from .. import ocp
 from .. import transcription as tr
 
-__all__ = ["Runner", "solve_on", "solve_many", "guess_signature", "CACHE_MODULES", "OBJECTIVES", "FIT_WEIGHT",
+__all__ = ["Runner", "solve_on", "solve_many", "guess_signature", "FORMULATION", "OBJECTIVES", "FIT_WEIGHT",
            "fit_problem"]
 
 OBJECTIVES = ("fit", "cost")
@@ -49,8 +49,10 @@ FIT_WEIGHT = 1.0
 REG_FACTOR = 0.1
 _KEEP = ("Jrk", "Rsd", "Imp", "Act", "Mtb")
 
-#: Sources (besides the cache's CORE) that gap solutions depend on.
-CACHE_MODULES = ("gap/effects.py", "gap/solve.py")
+#: Version of the gap's re-solve formulation (the Fit objective, the Runner's parameters and
+#: warm starts) on top of :data:`gaitlib.transcription.FORMULATION`: part of every gap cache
+#: key. Bump it when a change alters what is solved (tests/test_formulation_versions.py).
+FORMULATION = "gap-fit-1"
 
 
 def guess_signature(guess) -> str | None:
@@ -72,7 +74,8 @@ def _where(spec: tr.GaitSpec, gait, guess, root, objective="fit") -> Path:
 
     desc = {"kind": "gap-solve", "spec": spec.to_dict(), "data": signature(gait), "guess": guess_signature(guess),
             "objective": objective}
-    return cache.lookup("gap", desc, root, modules=CACHE_MODULES, identified=spec.identified_sets())
+    return cache.lookup("gap", desc, root, formulation=(tr.FORMULATION, FORMULATION),
+                        identified=spec.identified_sets())
 
 
 def _check_same_cycle(gp, gait):
@@ -226,7 +229,7 @@ def solve_on(spec: tr.GaitSpec, gait, guess=None, *, root=None, use_cache: bool 
     runner = runner or Runner(spec, objective)
     sol = runner.solve(gait, guess)
     if use_cache:
-        sol.save(where)
+        cache.save(where, sol.save)
     return sol
 
 
@@ -245,7 +248,7 @@ def _work(arg):
         runner = runner or Runner(spec, objective)
         sol = runner.solve(gait, guess)
         if use_cache:
-            sol.save(where)
+            cache.save(where, sol.save)
         out[key] = sol
     return out
 

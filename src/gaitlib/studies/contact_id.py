@@ -83,6 +83,14 @@ __all__ = [
 ]
 
 #: The three approaches: key → label used in tables and figures.
+#: Version of approach (a)'s trajectory-optimisation problem (:class:`InverseDynamicsID`, its
+#: multistart and solver options): part of its cache keys.
+TRAJOPT_FORMULATION = "contact-trajopt-1"
+#: Version of approaches (b)/(c) on top of :data:`gaitlib.transcription.FORMULATION` (their
+#: starts, guesses and continuation): part of their cache keys. Bump either when a change
+#: alters what is solved (tests/test_formulation_versions.py).
+FORMULATION = "contact-id-1"
+
 APPROACHES = {"a": "(a) trajectory optimisation", "b": "(b) optimal control",
               "c": "(c) optimal control + body parameters",
               "c_wide": "(c′) = (c) with Table 4.7 widened to the thesis's (c) values"}
@@ -494,9 +502,8 @@ def trajectory_optimization(spec: TrajOptSpec = TrajOptSpec(), *, use_cache: boo
     """
     desc = {"kind": "contact_id_a", **spec.to_dict()}
     # fixed kinematics, the model's default body parameters: no identified set is read
-    where = cache.lookup("contact_id", desc, root, identified=())
+    where = cache.lookup("contact_id", desc, root, formulation=TRAJOPT_FORMULATION, identified=())
     prob = problem
-    f = where / "result.json"
     found = cache.find(where, "result.json") if use_cache else None
     if found is not None:
         rec = json.loads((found / "result.json").read_text())
@@ -522,8 +529,7 @@ def trajectory_optimization(spec: TrajOptSpec = TrajOptSpec(), *, use_cache: boo
     rec = {"rows": rows, "build_s": build_s, "wall_s": time.perf_counter() - t_wall,
            "trial_scores": [float(s) for s in scores], "spec": spec.to_dict()}
     if use_cache:
-        where.mkdir(parents=True, exist_ok=True)
-        f.write_text(json.dumps(rec, indent=1))
+        cache.save(where, lambda d: (d / "result.json").write_text(json.dumps(rec, indent=1)))
     return _result_a(prob, rec, from_cache=False)
 
 
@@ -567,8 +573,8 @@ def spec_c(n_intervals: int = 20, degree: int = 5, contact_bounds: str = "table4
                        n_intervals=n_intervals, degree=degree, **kw)
 
 
-#: How a cold-started (b)/(c) guess is built; part of the cache key of those solves (which
-#: otherwise depend on the CORE sources only): change it with the method.
+#: How a cold-started (b)/(c) guess is built; part of the cache key of those solves: change it
+#: with the method.
 GUESS_METHOD = "data-based guess of the spec (states, jerks, data torques, zero residuals) + start parameters (v1)"
 
 
@@ -582,7 +588,8 @@ def _solve_gait_cached(spec: tr.GaitSpec, start: dict, warm: tr.GaitSolution | N
         ws = warm.solution
         desc["warm_start"] = {"spec": warm.spec.to_dict(), "status": ws.status,
                               "objective": float(f"{ws.objective:.12g}"), "iterations": ws.iterations}
-    where = cache.lookup("contact_id", desc, root, modules=(), identified=spec.identified_sets())
+    where = cache.lookup("contact_id", desc, root, formulation=(tr.FORMULATION, FORMULATION),
+                         identified=spec.identified_sets())
     sol = gait.load_cached(where) if use_cache else None
     if sol is not None:
         return sol
@@ -596,7 +603,7 @@ def _solve_gait_cached(spec: tr.GaitSpec, start: dict, warm: tr.GaitSolution | N
         warnings.simplefilter("ignore", ocp.SolveFailedWarning)
         sol = tr.solve(gp, guess=guess, progress=progress)
     if use_cache:
-        sol.save(where)
+        cache.save(where, sol.save)
     sol.stats["from_cache"] = False
     return sol
 
@@ -968,7 +975,8 @@ def save_identified(res: ApproachResult, path=None) -> Path:
             "data": "Schwartz et al. 2008, Free speed class (data/schwartz2008_curves.csv), both legs",
             "spec": res.solution.spec.to_dict(),
             "gaitlib_version": __version__,
-            "cache_fingerprint": cache.fingerprint(identified=res.solution.spec.identified_sets()),
+            "cache_fingerprint": cache.fingerprint((tr.FORMULATION, FORMULATION),
+                                                   identified=res.solution.spec.identified_sets()),
             "spec_key": res.solution.stats.get("spec_key"),
             "ipopt_status": st["status"],
             "iterations": st["iterations"],

@@ -57,13 +57,12 @@ THESIS_TABLE = {"SK": "thesis, Table 4.9 (optimal control)", "MSK": "thesis, Tab
 
 def cache_dir(spec: tr.GaitSpec, *, guess=None, root=None) -> Path:
     """Where :func:`solve_cached` stores (or finds) the solution of ``spec`` from ``guess``:
-    keyed by the spec, the warm start's identity, the CORE sources (+ the effect library
-    when effects are on) and the data and identified sets the spec reads."""
+    keyed by the spec, the warm start's identity, the gait formulation's version and the
+    data and identified sets the spec reads."""
     desc = {"kind": "gait", **spec.to_dict()}
     if guess is not None:
         desc["warm_start"] = _guess_signature(guess)
-    return cache.lookup("gait", desc, root, modules=("gap/effects.py",) if getattr(spec, "effects", ()) else (),
-                        identified=spec.identified_sets())
+    return cache.lookup("gait", desc, root, formulation=tr.FORMULATION, identified=spec.identified_sets())
 
 
 def load_cached(where) -> tr.GaitSolution | None:
@@ -93,7 +92,7 @@ def solve_cached(spec: tr.GaitSpec, *, use_cache: bool = True, root=None, guess=
         return sol
     sol = tr.solve(spec, guess=guess, progress=progress)
     if use_cache:
-        sol.save(where)
+        cache.save(where, sol.save)
     sol.stats["from_cache"] = False
     return sol
 

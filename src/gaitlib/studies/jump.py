@@ -133,6 +133,11 @@ TABLE_3_5 = {
 #: The thesis's reported results (references only; never "ours"): jump height (cm,
 #: Sec 3.4.4), required static friction μ_s ≥ max |F_x/F_y| (Sec 3.4.3, Fig 3.7), most
 #: flexed knee angle (deg, Sec 3.4.1).
+#: Version of the jump formulation (:mod:`gaitlib.jump`, this module's problems, guesses,
+#: continuation and solver options with the physics below): part of every jump cache key.
+#: Bump it when a change alters what is solved (tests/test_formulation_versions.py).
+FORMULATION = "jump-1"
+
 THESIS = {
     "toeless": {"jump_height_cm": 14.0, "mu_s": 1.4, "knee_min_deg": -94.0},
     "toe": {"jump_height_cm": 66.0, "mu_s": 1.0, "knee_min_deg": -122.0},
@@ -894,8 +899,7 @@ def _result(sp: JumpSpec, model: JumpModel, p_contact, sol: ocp.Solution) -> Jum
 def cache_location(sp: "JumpSpec", root=None):
     """Where the solution of ``sp`` is (or would be) cached: keyed by the spec, the core
     sources, the jump model and this study (:mod:`gaitlib.cache`)."""
-    return cache.lookup("jump", {"kind": "jump", **sp.to_dict()}, root, modules=("jump.py", "studies/jump.py"),
-                        identified=())
+    return cache.lookup("jump", {"kind": "jump", **sp.to_dict()}, root, formulation=FORMULATION, identified=())
 
 
 def solve(sp: JumpSpec | str, guess: ocp.Guess | ocp.Solution | None = None, *,
@@ -940,7 +944,7 @@ def solve(sp: JumpSpec | str, guess: ocp.Guess | ocp.Solution | None = None, *,
     sol = tx.solve(jp.guess if guess is None else guess)
     sol.info["continuation"] = record
     if where is not None:
-        sol.save(where)
+        cache.save(where, sol.save)
     return _result(sp, jp.model, jp.p_contact, sol)
 
 
