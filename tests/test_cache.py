@@ -144,3 +144,15 @@ def test_two_writers_of_one_key_never_mix(tmp_path, monkeypatch):
             tags = {line.split(",")[0] for p in where.glob("part*.csv") for line in p.read_text().splitlines()}
             assert len(tags) == 1
     assert [p.name for p in (tmp_path / "gait").iterdir()] == ["same"]
+
+
+def test_cache_verify_command_lists_and_removes_bad_entries(tmp_path, capsys):
+    from gaitlib import cli
+
+    cache.save(tmp_path / "gait" / "good", _write({"spec.json": "{}"}))
+    cache.save(tmp_path / "gait" / "bad", _write({"spec.json": "{}"}))
+    (tmp_path / "gait" / "bad" / "spec.json").write_text("")
+    assert cli.main(["cache", "verify", "--root", str(tmp_path)]) == 1
+    assert "corrupt: " + str(tmp_path / "gait" / "bad") in capsys.readouterr().out
+    assert cli.main(["cache", "verify", "--root", str(tmp_path), "--remove"]) == 0
+    assert sorted(p.name for p in (tmp_path / "gait").iterdir()) == ["good"]

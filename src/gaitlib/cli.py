@@ -16,6 +16,8 @@ Commands
                      ranking of candidate effects, shrink; ``diagnosis.json`` + figures (gaitlib.gap)
 ``gap-twin --effect NAME --magnitude X --seed N --out CSV``   a twin data set with a known
                      injected effect, in the tidy format
+``cache verify [--remove] [--root DIR]``   check every cached solution against its checksums;
+                     ``--remove`` deletes the corrupt or incomplete ones (they are re-solved on use)
 """
 
 from __future__ import annotations
@@ -47,6 +49,9 @@ def _cmd_run(args) -> int:
     print(f"gaitlib run gait: {spec.model} {spec.cost} {spec.speed_class}, {spec.n_intervals} x {spec.degree} "
           f"{spec.scheme}, key {spec.key()}", flush=True)
     sol = gait.solve_cached(spec, use_cache=not args.no_cache, progress=not args.quiet)
+    if sol.stats.get("from_cache") and not sol.success:
+        print(f"note: a cached failed solve ({sol.stats['status']}), loaded from {sol.stats.get('cache_path')}; "
+              f"--no-cache solves it again", file=sys.stderr)
     out = gait.write_outputs(sol, args.out, figures=not args.no_figures)
     st = sol.stats
     print(json.dumps({k: st[k] for k in ("status", "iterations", "solve_time_s", "time_per_iteration_s",
@@ -99,6 +104,31 @@ def _cmd_sweep(args) -> int:
     return 0 if all(r.ok for r in recs.values()) else 2
 
 
+def _cmd_cache(args) -> int:
+    """``gaitlib cache verify``: every entry of a cache checked against its manifest."""
+    import shutil
+
+    from . import cache
+
+    rows = cache.scan(args.root)
+    bad = [(p, fault) for p, fault in rows if fault]
+    for p, fault in bad:
+        print(f"{'removed' if args.remove else 'corrupt'}: {p}: {fault}")
+        if args.remove:
+            shutil.rmtree(p, ignore_errors=True)
+    print(f"{len(rows) - len(bad)} valid, {len(bad)} corrupt entries under {args.root or cache.default_dir()}")
+    return 0 if args.remove or not bad else 1
+
+
+def _add_cache_parser(sub) -> None:
+    c = sub.add_parser("cache", help="check (and clean) the solutions cache")
+    c.add_argument("action", choices=["verify"], help="verify: check every entry against its checksums")
+    c.add_argument("--root", default=None, help="cache directory (default: $GAITLIB_SOLUTIONS or "
+                                                "~/.cache/gaitlib/solutions)")
+    c.add_argument("--remove", action="store_true", help="delete corrupt or incomplete entries")
+    c.set_defaults(func=_cmd_cache)
+
+
 def _add_sweep_parser(sub) -> None:
     w = sub.add_parser("sweep", help="solve cost functions x speed classes as one (distributed) sweep")
     w.add_argument("--model", default="MSK", choices=["SK", "MSK", "NMSK"])
@@ -149,6 +179,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--quiet", action="store_true", help="no IPOPT progress log")
     r.set_defaults(func=_cmd_run)
     _add_sweep_parser(sub)
+    _add_cache_parser(sub)
     from .gap.cli import add_parsers as _add_gap_parsers  # gaitlib gap, gaitlib gap-twin (issue 7)
 
     _add_gap_parsers(sub)

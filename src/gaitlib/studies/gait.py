@@ -76,6 +76,7 @@ def load_cached(where) -> tr.GaitSolution | None:
         warnings.simplefilter("ignore", ocp.SolveFailedWarning)
         sol = tr.GaitSolution.load(found)
     sol.stats["from_cache"] = True
+    sol.stats["cache_path"] = str(found)
     return sol
 
 
