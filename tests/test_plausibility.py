@@ -72,6 +72,13 @@ def _rad(df):  # radians labelled deg
     return scaled(df, "knee_flexion", np.pi / 180)
 
 
+def _knee_included(df):  # knee as the included angle (180° = straight)
+    df = df.copy()
+    sel = df.quantity == "knee_flexion"
+    df.loc[sel, "mean"] = 180.0 - df.loc[sel, "mean"]
+    return df
+
+
 def _pelvis_rad(df):
     return scaled(df, "pelvis_anterior_tilt", np.pi / 180)
 
@@ -155,8 +162,10 @@ def _side_r_only(df):
 
 
 BAD = [
-    ("degrees x57", _deg_x57, ["quantity 'knee_flexion'", "outside [-180, 180] deg", "converted"]),
+    ("degrees x57", _deg_x57, ["quantity 'knee_flexion'", "outside [-30, 120] deg", "converted"]),
     ("radians as deg", _rad, ["quantity 'knee_flexion'", "range of motion", "[5, 120] deg", "radians"]),
+    ("knee included angle", _knee_included, ["quantity 'knee_flexion'", "outside [-30, 120] deg",
+                                             "another angle convention"]),
     ("pelvis radians", _pelvis_rad, ["quantity 'pelvis_anterior_tilt'", "[0.3, 30] deg", "radians"]),
     ("GRF % BW", _grf_pct, ["quantity 'grf_vertical'", "outside [-0.05, 2] BW", "% body weight"]),
     ("GRF newtons", _grf_newton, ["quantity 'grf_vertical'", "outside [-0.05, 2] BW", "newtons"]),
@@ -166,7 +175,7 @@ BAD = [
     ("inf mean", _set("knee_flexion", 40.0, "mean", "inf"), ["quantity 'knee_flexion'", "'mean'", "finite"]),
     ("inf sd", _set("grf_anterior", 10.0, "sd", "inf"), ["quantity 'grf_anterior'", "'sd'", "finite"]),
     ("1e308 mean", _set("hip_flexion", 60.0, "mean", "1e308"), ["quantity 'hip_flexion'", "1e+308",
-                                                                 "[-180, 180] deg"]),
+                                                                 "[-60, 100] deg"]),
     ("SD = 0", _sd_zero, ["quantity 'knee_flexion'", "sd is 0 at every point", "sd > 0", "--allow-no-sd"]),
     ("SD in % BW", _sd_pct, ["quantity 'grf_vertical'", "sd ", "[0, 1] BW"]),
     ("second half missing", _second_half_missing, ["quantity 'hip_flexion'", "25 of 51 cycle points missing",
@@ -207,7 +216,7 @@ def test_message_names_the_row_of_the_bad_value(tmp_path, good):
     k = df[df.quantity == "knee_flexion"]
     peak = k["mean"].idxmax()
     assert good.loc[peak, "percent_cycle"] == 72.0 and good.loc[peak, "mean"] == pytest.approx(59.13, abs=0.01)
-    with pytest.raises(data_mod.DataError, match=rf"row {peak + 2}: mean 3388(\.\d+)? deg outside \[-180, 180\]"):
+    with pytest.raises(data_mod.DataError, match=rf"row {peak + 2}: mean 3388(\.\d+)? deg outside \[-30, 120\]"):
         gio.read_data(write(df, tmp_path / "bad.csv"))
 
 

@@ -76,7 +76,8 @@ class Range:
     lo, hi : bounds of every mean value. sd_max : bound of every SD. rom : (min, max) of
     the mean curve's range of motion (max − min) or None. peak : (min, max) of the curve's
     peak, max |mean|, or None. hint_low / hint_high : what a value below / above the
-    bounds usually means (for the message)."""
+    bounds usually means; hint_small : what a range of motion or peak below its bound
+    means (for the messages)."""
 
     lo: float
     hi: float
@@ -85,10 +86,18 @@ class Range:
     peak: tuple | None = None
     hint_low: str = ""
     hint_high: str = ""
+    hint_small: str = "values look too small for this unit"
 
 
-# ---- angles, deg. ±180° bounds any joint or segment angle.
-ANGLE_ABS_MAX_DEG = 180.0
+# ---- angles, deg. Within ±180° by definition; each a window about twice the span seen in
+# child gait, pathological gait included (crouch, equinus, hyperextension). Committed data:
+# trunk 15.6–23.8°, pelvis 8.2–18.1°, hip −9.8–45.0°, knee 0.4–64.0°, ankle −22.0–16.5°.
+# A knee given as the included angle (180° = straight) or with the opposite sign falls outside.
+TRUNK_TILT_DEG = (-45.0, 60.0)
+PELVIS_TILT_DEG = (-45.0, 60.0)
+HIP_FLEXION_DEG = (-60.0, 100.0)
+KNEE_FLEXION_DEG = (-30.0, 120.0)
+ANKLE_DORSIFLEXION_DEG = (-60.0, 60.0)
 #: Sagittal joint range of motion over a walking cycle: hip 30–52°, knee 40–64°, ankle
 #: 19–32° in the committed data (Schwartz 2008, five classes; gaitutils); the bounds leave
 #: room for stiff pathological joints and running. A curve in radians has a range ≤ 1.2
@@ -123,14 +132,15 @@ EMG_1 = (-0.05, 2.0)
 EMG_SD_MAX_1 = 1.0  # ≤ 0.27 in the committed data
 
 _RAD = "values look like radians; expected degrees"
-_TWICE = "values look like degrees converted from radians twice (x 57.3)"
+_TWICE = "values look like degrees converted from radians twice (x 57.3), or another angle convention"
 _BW = "values look like % body weight or newtons; expected fractions of body weight"
 _PERKG = "values look like N*m (not per kg) or another unit; expected N*m/kg"
 _PERKG_W = "values look like W (not per kg); expected W/kg"
 
 
-def _angle(rom):
-    return Range(-ANGLE_ABS_MAX_DEG, ANGLE_ABS_MAX_DEG, ANGLE_SD_MAX_DEG, rom=rom, hint_low=_RAD, hint_high=_TWICE)
+def _angle(bounds, rom):
+    return Range(*bounds, ANGLE_SD_MAX_DEG, rom=rom, hint_low=_TWICE, hint_high=_TWICE,
+                 hint_small=_RAD)
 
 
 def _moment():
@@ -143,11 +153,11 @@ def _power():
 
 #: Plausible ranges per tidy quantity (every quantity of :data:`gaitlib.data.QUANTITY_UNITS`).
 RANGES = {
-    "trunk_anterior_tilt": _angle(TILT_ROM_DEG),
-    "pelvis_anterior_tilt": _angle(TILT_ROM_DEG),
-    "hip_flexion": _angle(JOINT_ROM_DEG),
-    "knee_flexion": _angle(JOINT_ROM_DEG),
-    "ankle_dorsiflexion": _angle(JOINT_ROM_DEG),
+    "trunk_anterior_tilt": _angle(TRUNK_TILT_DEG, TILT_ROM_DEG),
+    "pelvis_anterior_tilt": _angle(PELVIS_TILT_DEG, TILT_ROM_DEG),
+    "hip_flexion": _angle(HIP_FLEXION_DEG, JOINT_ROM_DEG),
+    "knee_flexion": _angle(KNEE_FLEXION_DEG, JOINT_ROM_DEG),
+    "ankle_dorsiflexion": _angle(ANKLE_DORSIFLEXION_DEG, JOINT_ROM_DEG),
     "grf_anterior": Range(*GRF_ANTERIOR_BW, GRF_SD_MAX_BW, peak=GRF_ANTERIOR_PEAK_BW, hint_low=_BW, hint_high=_BW),
     "grf_vertical": Range(*GRF_VERTICAL_BW, GRF_SD_MAX_BW, peak=GRF_VERTICAL_PEAK_BW,
                           hint_low="a vertical ground reaction force does not pull", hint_high=_BW),
@@ -300,14 +310,14 @@ def _check_curve(g: pd.DataFrame, where: str, name: str, r: Range, unit: str, al
         rom = float(m.max() - m.min())
         if not r.rom[0] <= rom <= r.rom[1]:
             i, j = g.index[int(np.argmax(m))], g.index[int(np.argmin(m))]
-            hint = r.hint_low if rom < r.rom[0] else r.hint_high
+            hint = r.hint_small if rom < r.rom[0] else r.hint_high
             raise DataError(f"{where}: {name} {_rows([i])} (max) and {_rows([j])} (min): range of motion {rom:g} "
                             f"{unit} outside [{r.rom[0]:g}, {r.rom[1]:g}] {unit} ({hint})")
     if r.peak is not None:
         k = int(np.argmax(np.abs(m)))
         pk = float(abs(m[k]))
         if not r.peak[0] <= pk <= r.peak[1]:
-            hint = "values look too small for this unit" if pk < r.peak[0] else r.hint_high
+            hint = r.hint_small if pk < r.peak[0] else r.hint_high
             raise DataError(f"{where}: {name} {_rows([g.index[k]])}: peak |mean| {pk:g} {unit} outside "
                             f"[{r.peak[0]:g}, {r.peak[1]:g}] {unit} ({hint})")
     if not np.any(s > 0):

@@ -30,10 +30,11 @@ one-line :class:`gaitlib.data.DataError` naming file, quantity, row and expected
                    (joint/GRF quantities; EMG may have its own) with a step ≤ 10 %; no
                    missing points (a curve is never interpolated across a gap).
 ``mean, sd``       finite; within the plausible ranges of :data:`gaitlib.plausibility.RANGES`
-                   (e.g. angles within ±180° with a sagittal joint range of motion of
-                   5–120°, vertical GRF peak 0.5–2 BW, moments within ±4 N·m/kg); SD > 0 at
-                   some point of every curve, unless ``allow_no_sd=True`` (CLI
-                   ``--allow-no-sd``): such a curve is tracked but left out of the located gap.
+                   (e.g. angles in per-joint windows inside ±180°, knee −30–120°, with a
+                   sagittal joint range of motion of 5–120°; vertical GRF peak 0.5–2 BW;
+                   moments within ±4 N·m/kg); SD > 0 at some point of every curve, unless
+                   ``allow_no_sd=True`` (CLI ``--allow-no-sd``): such a curve is tracked
+                   but left out of the located gap.
 See :mod:`gaitlib.plausibility` for every threshold and its source.
 """
 
