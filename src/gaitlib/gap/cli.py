@@ -11,7 +11,9 @@ def _base(args, speed_class: str) -> dict:
 
 
 def cmd_gap(args) -> int:
-    """``gaitlib gap --data CSV --out DIR``: diagnose the gap; writes diagnosis.json + figures."""
+    """``gaitlib gap --data CSV --out DIR``: diagnose the gap; writes diagnosis.json + figures.
+    Data that fail the reader's checks (:func:`gaitlib.gap.io.read_data`,
+    :mod:`gaitlib.plausibility`): one line on stderr, exit 2, nothing built or written."""
     import sys
 
     from .. import data as data_mod
