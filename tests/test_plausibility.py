@@ -79,6 +79,10 @@ def _knee_included(df):  # knee as the included angle (180° = straight)
     return df
 
 
+def _knee_sign(df):  # knee extension positive
+    return scaled(df, "knee_flexion", -1.0)
+
+
 def _pelvis_rad(df):
     return scaled(df, "pelvis_anterior_tilt", np.pi / 180)
 
@@ -166,6 +170,7 @@ BAD = [
     ("radians as deg", _rad, ["quantity 'knee_flexion'", "range of motion", "[5, 120] deg", "radians"]),
     ("knee included angle", _knee_included, ["quantity 'knee_flexion'", "outside [-30, 120] deg",
                                              "another angle convention"]),
+    ("knee sign flipped", _knee_sign, ["quantity 'knee_flexion'", "outside [-30, 120] deg"]),
     ("pelvis radians", _pelvis_rad, ["quantity 'pelvis_anterior_tilt'", "[0.3, 30] deg", "radians"]),
     ("GRF % BW", _grf_pct, ["quantity 'grf_vertical'", "outside [-0.05, 2] BW", "% body weight"]),
     ("GRF newtons", _grf_newton, ["quantity 'grf_vertical'", "outside [-0.05, 2] BW", "newtons"]),
@@ -218,6 +223,17 @@ def test_message_names_the_row_of_the_bad_value(tmp_path, good):
     assert good.loc[peak, "percent_cycle"] == 72.0 and good.loc[peak, "mean"] == pytest.approx(59.13, abs=0.01)
     with pytest.raises(data_mod.DataError, match=rf"row {peak + 2}: mean 3388(\.\d+)? deg outside \[-30, 120\]"):
         gio.read_data(write(df, tmp_path / "bad.csv"))
+
+
+def test_range_of_motion_in_the_message(tmp_path, good):
+    """Radians labelled deg: the message's range of motion is the knee's (max − min) in
+    degrees × π/180 (Free: 59.13° − 4.03° = 55.11° → 0.9618)."""
+    k = good[good.quantity == "knee_flexion"]["mean"]
+    rom = (k.max() - k.min()) * np.pi / 180
+    assert rom == pytest.approx(0.9618, abs=1e-4)
+    with pytest.raises(data_mod.DataError, match=rf"rows? \d+ \(max\) and rows? \d+ \(min\): range of motion "
+                                                 rf"{rom:g} deg outside \[5, 120\] deg"):
+        gio.read_data(write(_rad(good), tmp_path / "bad.csv"))
 
 
 def test_without_sd_is_explicit_and_leaves_the_gap(tmp_path, good):
