@@ -11,11 +11,21 @@ def _base(args, speed_class: str) -> dict:
 
 
 def cmd_gap(args) -> int:
-    """``gaitlib gap --data CSV --out DIR``: diagnose the gap; writes diagnosis.json + figures."""
+    """``gaitlib gap --data CSV --out DIR``: diagnose the gap; writes diagnosis.json + figures.
+    Data that fail the reader's checks (:func:`gaitlib.gap.io.read_data`,
+    :mod:`gaitlib.plausibility`): one line on stderr, exit 2, nothing built or written."""
+    import sys
+
+    from .. import data as data_mod
     from . import diagnose as D
     from . import io as gio
 
-    ds = gio.read_data(args.data, like=args.like, fill_from=args.fill_from)
+    try:  # the data gates run here, before any problem is built
+        ds = gio.read_data(args.data, like=args.like, speed_class=args.speed_class, fill_from=args.fill_from,
+                           allow_no_sd=args.allow_no_sd)
+    except data_mod.DataError as e:
+        print(f"gaitlib gap: {e}", file=sys.stderr)
+        return 2
     effects = [e.strip() for e in args.effects.split(",")] if args.effects else None
     print(f"gaitlib gap: {ds.label} ({ds.base}, {ds.gait.speed_class}, n = {ds.n}); baseline {args.model} "
           f"{args.cost} {args.intervals} x {args.degree}, objective {args.objective}", flush=True)
@@ -69,6 +79,10 @@ def add_parsers(sub) -> None:
                                                 "(schwartz2008|gaitutils; default: the CSV's source)")
     g.add_argument("--fill-from", default=None, help="take quantities the problem needs but the CSV lacks from "
                                                      "this data set (e.g. schwartz2008); excluded from the gap")
+    g.add_argument("--speed-class", default=None, help="the speed class to diagnose if the CSV has several "
+                                                       "(VerySlow|Slow|Free|Fast|VeryFast)")
+    g.add_argument("--allow-no-sd", action="store_true", help="accept curves whose SD is 0 everywhere: tracked, "
+                                                              "but left out of the located gap")
     g.add_argument("--effects", default=None, help=f"comma-separated candidates (default all applicable: "
                                                    f"{','.join(EFFECTS)})")
     g.add_argument("--objective", default="fit", choices=["fit", "cost"])

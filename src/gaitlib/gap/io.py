@@ -14,6 +14,28 @@ is read with its measured left leg; otherwise the left leg is generated from the
 The base source (speed, cycle time, events, the number of subjects) is: ``like`` if given;
 else the CSV's ``source`` if it is ``schwartz2008`` or ``gaitutils``; else the name inside
 ``twin(<source>)`` (synthetic data sets written by :mod:`gaitlib.gap.twin`).
+
+Accepted values (checked by :func:`read_data` before anything is built; a failure is a
+one-line :class:`gaitlib.data.DataError` naming file, quantity, row and expected range)
+-----------------------------------------------------------------------------------------
+``source``         one value per file (see above).
+``speed_class``    one of ``VerySlow, Slow, Free, Fast, VeryFast``; a file with several
+                   classes needs ``speed_class=`` (CLI ``--speed-class``).
+``quantity/unit``  the pairs of :data:`gaitlib.data.QUANTITY_UNITS` (angles ``deg``, GRFs
+                   ``BW`` = fractions of body weight, moments ``N*m/kg``, powers ``W/kg``,
+                   EMG ``1``); the quantities of :data:`REQUIRED_QUANTITIES` must be present
+                   (or ``fill_from``).
+``side``           per quantity ``ipsilateral`` alone or both ``R`` and ``L``.
+``percent_cycle``  percent of the cycle, 0 and 100 both present, one uniform grid per class
+                   (joint/GRF quantities; EMG may have its own) with a step ≤ 10 %; no
+                   missing points (a curve is never interpolated across a gap).
+``mean, sd``       finite; within the plausible ranges of :data:`gaitlib.plausibility.RANGES`
+                   (e.g. angles in per-joint windows inside ±180°, knee −30–120°, with a
+                   sagittal joint range of motion of 5–120°; vertical GRF peak 0.5–2 BW;
+                   moments within ±4 N·m/kg); SD > 0 at some point of every curve, unless
+                   ``allow_no_sd=True`` (CLI ``--allow-no-sd``): such a curve is tracked
+                   but left out of the located gap.
+See :mod:`gaitlib.plausibility` for every threshold and its source.
 """
 
 from __future__ import annotations
@@ -29,6 +51,7 @@ import pandas as pd
 
 from .. import conventions as cv
 from .. import data as data_mod
+from .. import plausibility
 
 __all__ = ["KNOWN_SOURCES", "REQUIRED_QUANTITIES", "DataSet", "read_data", "load_real", "base_source_of",
            "n_subjects", "signature", "MODEL_QUANTITIES"]
@@ -119,33 +142,42 @@ def load_real(speed_class: str = "Free", source: str = "schwartz2008", fill_from
 
 
 def read_data(path, like: str | None = None, speed_class: str | None = None,
-              fill_from: str | None = None) -> DataSet:
+              fill_from: str | None = None, allow_no_sd: bool = False) -> DataSet:
     """Read a tidy CSV (:data:`gaitlib.data.TIDY_COLUMNS`) into a :class:`DataSet`.
 
     Parameters
     ----------
-    path : the CSV; validated by :func:`gaitlib.data.load_tidy` (errors name the file and
-        the column).
+    path : the CSV; validated by :func:`gaitlib.data.load_tidy` (form: columns, numbers,
+        units) and, for the chosen class, by :func:`gaitlib.plausibility.check_tidy`
+        (values: module docstring); errors name the file, quantity, row and expected range.
     like : base source for speed, cycle time and events (module docstring).
-    speed_class : the class to use if the CSV has several.
+    speed_class : the class to use if the CSV has several (required then).
     fill_from : ``"schwartz2008"`` — quantities of :data:`REQUIRED_QUANTITIES` missing in
         the CSV are taken from that data set (same class) and excluded from the gap;
         without it a missing quantity is an error naming it.
+    allow_no_sd : accept curves whose SD is 0 everywhere: tracked, but left out of the
+        located gap (listed in the DataSet's notes).
     """
     path = Path(path)
     df = data_mod.load_tidy(path)
-    classes = sorted(set(df["speed_class"]))
+    classes = sorted(set(df["speed_class"]), key=list(cv.SPEED_CLASSES).index)
     if speed_class is None:
         if len(classes) != 1:
-            raise data_mod.DataError(f"{path}: column 'speed_class' has {classes}; choose one (speed_class=...)")
+            raise data_mod.DataError(f"{path}: column 'speed_class' has several classes {classes}; choose one with "
+                                     "speed_class=... (CLI: --speed-class)")
         speed_class = classes[0]
     df = df[df["speed_class"] == speed_class]
     if df.empty:
-        raise data_mod.DataError(f"{path}: no rows for speed class {speed_class!r} (have {classes})")
-    return _from_frame(df, label=path.name, like=like, fill_from=fill_from, path=str(path))
+        raise data_mod.DataError(f"{path}: no rows for speed class {speed_class!r}; the file has {classes}")
+    no_sd = plausibility.check_tidy(df, path, allow_no_sd=allow_no_sd)
+    notes = ()
+    if no_sd:
+        qs = sorted({c.split(" ")[0] for c in no_sd})
+        notes = (f"tracked without SD (left out of the located gap): {', '.join(qs)}",)
+    return _from_frame(df, label=path.name, like=like, fill_from=fill_from, path=str(path), notes=notes)
 
 
-def _from_frame(df: pd.DataFrame, label: str, like=None, fill_from=None, path=None) -> DataSet:
+def _from_frame(df: pd.DataFrame, label: str, like=None, fill_from=None, path=None, notes=()) -> DataSet:
     sources = sorted(set(df["source"]))
     if len(sources) != 1:
         raise data_mod.DataError(f"{path}: column 'source' has several values {sources}; one data set per file")
@@ -184,7 +216,7 @@ def _from_frame(df: pd.DataFrame, label: str, like=None, fill_from=None, path=No
         shutil.rmtree(tmp, ignore_errors=True)
     if two:
         gait = _with_left(gait, left_rows)
-    notes = []
+    notes = list(notes)
     if filled:
         notes.append(f"{', '.join(filled)} taken from {fill_from} ({speed_class}) and excluded from the gap")
     return DataSet(gait=gait, label=label, base=base, n=n_subjects(base, speed_class), filled=filled, path=path,
