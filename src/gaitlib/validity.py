@@ -16,8 +16,10 @@ The checks (thresholds are the module constants below, with their sources)
                    rule). An acceptable-level stop met IPOPT's ``acceptable_*`` tolerances
                    over several iterations, not the requested ``tol``; it counts as
                    converged and its status is kept in the note.
-``swing_load``     (data tracking) the largest vertical force on a foot while the *data*
-                   say that foot swings ≤ :data:`SWING_LOAD_BW` × body weight (2 % BW,
+``swing_load``     (data tracking: the cost tracks GRFs, angles, coordinates or torques,
+                   so the run keeps the data's timing) the largest vertical force on a
+                   foot while the *data* say that foot swings ≤ :data:`SWING_LOAD_BW` ×
+                   body weight (2 % BW,
                    8.1 N for the 41.4 kg child). Right foot: swing from the data's foot-off
                    (fraction of the cycle, ``GaitData.events["foot_off"]``) to the end of
                    the cycle; left foot: the same window shifted by the data's left-leg
@@ -44,18 +46,24 @@ The checks (thresholds are the module constants below, with their sources)
                    ("Simulation with OpenSim – Best Practices" and "Reserves and
                    Residuals", simtk-confluence OpenSim pages) gives the absolute
                    adult-gait forms: peak residual forces < 10–20 N (RRA: 10–25 N, RMS
-                   5–15 N), peak residual moments < 75 N·m. For a 41.4 kg child
-                   (peak GRF ≈ 450 N) 5 % is ≈ 22 N, inside those ranges; the moment bound,
-                   ≈ 3.6 N·m, is far stricter than 75 N·m (a 2D model's single HAT moment).
+                   5–15 N), peak residual moments < 75 N·m. The peak external force is
+                   the solution's own (both feet): for the 41.4 kg child ≈ 450–750 N, so
+                   5 % is ≈ 22–37 N, inside those ranges; the moment bound, ≈ 4–6 N·m at
+                   a COM height of ≈ 0.84 m, is far stricter than 75 N·m. Our gait
+                   problems bound the residuals to 1 N, 1 N, 0.1 N·m (thesis Eq 4.8),
+                   so a converged gait passes by construction; trajectory optimisation
+                   on the data's kinematics (Ch 4 (a)) does not.
 ``strength``       joint torques within the child's strength: per joint and direction the
                    peak active torque of the muscle torque generator that produces it,
                    s^τ τ0 E (thesis Eq 5.8 at a = 1, t^A = 1 and the eccentric plateau
                    t^V = E; τ0 scaled to the body by Eq 5.21). MSK/NMSK: the solution's own
                    MTG parameters (the Ch 5 identified set in the book). SK: the Ch 5
-                   identified set too (:data:`SK_STRENGTH_PARAMS`) — we found no published
-                   pediatric strength table covering hip, knee and ankle flexion and
-                   extension (the isokinetic studies found cover knee or ankle only, as
-                   peak torque per age group) and so use the MTG envelope. Jump: the
+                   identified set too (:data:`SK_STRENGTH_PARAMS`): the pediatric strength
+                   studies we found (isokinetic knee, Pediatr Phys Ther 18:3–18, 2006;
+                   isokinetic ankle dorsiflexors, Scand J Rehabil Med 21:97–103, 1989;
+                   hand-held dynamometry at 6–8 years, Pediatr Phys Ther 20:128–136, 2008)
+                   miss the hip or give their values only in tables we could not read, so
+                   no per-joint N·m/kg limit is stated here. Jump: the
                    adult Gymnast set (the jump model is the adult of thesis Table 3.1,
                    73.8 kg) scaled by Eq 5.21 to the model's mass and standing height, × 2
                    (the legs are doubled). Metatarsal joint (no MTG): bounded by the
@@ -297,8 +305,9 @@ def check_frames(*, status: str, q: pd.DataFrame | None = None, torques: pd.Data
             fy = grf[f"grf_y_{s}"].to_numpy(float)[sel]
             peak = float(fy.max()) if fy.size else 0.0
             at = float(np.mod(tau[sel][np.argmax(fy)], 1.0)) if fy.size else float("nan")
-            parts.append(f"{s}: {peak:.1f} N at {100 * at:.0f} % (swing {100 * np.mod(lo, 1):.0f}–"
-                         f"{100 * np.mod(hi, 1):.0f} % of the cycle)")
+            mean = float(fy.mean()) if fy.size else 0.0
+            parts.append(f"{s}: peak {peak:.1f} N at {100 * at:.0f} %, mean {mean:.1f} N (swing "
+                         f"{100 * np.mod(lo, 1):.0f}–{100 * np.mod(hi, 1):.0f} % of the cycle)")
             worst = max(worst, peak)
         rows.append(_row("swing_load", worst, lim_load, "N", worst <= lim_load,
                          "; ".join(parts) + f"; data events: foot off {100 * fo:.0f} %, left shift "
@@ -315,12 +324,14 @@ def check_frames(*, status: str, q: pd.DataFrame | None = None, torques: pd.Data
         w = _weights(t, T)
         loaded = {s: grf[f"grf_y_{s}"].to_numpy(float) > lim_load for s in feet}
         both = float(np.sum(w[loaded["r"] & loaded["l"]]))
+        both10 = float(np.sum(w[(grf["grf_y_r"].to_numpy(float) > 0.1 * bw) & (grf["grf_y_l"].to_numpy(float) > 0.1 * bw)]))
         single = {s: float(np.sum(w[loaded[s]])) for s in feet}
         exp = (f"walking ≈ {100 * DOUBLE_SUPPORT_WALKING[0]:.0f}–{100 * DOUBLE_SUPPORT_WALKING[1]:.0f} %"
                + (f", data {100 * events['double_support']:.0f} %" if events and "double_support" in events else ""))
         rows.append(_row("double_support", 100 * both, 100 * DOUBLE_SUPPORT_MAX, "%", both <= DOUBLE_SUPPORT_MAX,
                          f"both feet > 2 % BW; {exp}; loaded: right {100 * single['r']:.0f} %, "
-                         f"left {100 * single['l']:.0f} % of the cycle", basis="of the cycle"))
+                         f"left {100 * single['l']:.0f} % of the cycle; both > 10 % BW: {100 * both10:.0f} %",
+                         basis="of the cycle"))
     else:
         rows.append(_na("double_support", notes.get("double_support", "not a gait")))
     # ---- residuals
@@ -410,8 +421,15 @@ def check_frames(*, status: str, q: pd.DataFrame | None = None, torques: pd.Data
 # --------------------------------------------------------------------------------------
 
 
+#: Cost terms that track data channels: a run with any of them follows the data's timing.
+DATA_TERMS = ("GRF", "Ang", "Q", "Trq")
+
+
 def _gait_kind(spec) -> str:
-    return "tracking" if "GRF" in spec.term_weights else "predictive"
+    """``"tracking"`` when the cost tracks any data channel (:data:`DATA_TERMS`: the data's
+    events then time the swing), else ``"predictive"`` (thesis FP: HAT, effort and
+    dynamics terms only)."""
+    return "tracking" if any(spec.term_weights.get(k, 0) for k in DATA_TERMS) else "predictive"
 
 
 def _tracked_data(spec, data=None):
@@ -526,7 +544,7 @@ def check(solution, *, kind: str | None = None, data=None, name: str = "") -> Ga
     ``trajectory`` and ``jump_height``) or a contact-identification result (has
     ``p_contact`` and ``key``; (b)/(c) are checked through their gait solution).
     ``kind``: ``"tracking"`` or ``"predictive"`` for a gait (default: tracking when the cost
-    tracks the GRFs, else predictive). ``data``: the :class:`gaitlib.data.GaitData` whose
+    tracks any data channel — GRFs, angles, coordinates or torques — else predictive). ``data``: the :class:`gaitlib.data.GaitData` whose
     events define the swing (default: the data the spec tracks)."""
     if hasattr(solution, "trajectory") and hasattr(solution, "jump_height"):
         return _check_jump(solution, name)
