@@ -97,6 +97,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 import pandas as pd
@@ -107,7 +108,8 @@ from .sweep import ACCEPTED_STATUSES
 
 __all__ = ["CONVERGED_STATUSES", "SWING_LOAD_BW", "SWING_MARGIN", "DOUBLE_SUPPORT_MAX", "DOUBLE_SUPPORT_WALKING",
            "RESIDUAL_FORCE_FRACTION", "RESIDUAL_MOMENT_FRACTION", "ROM_DEG", "ROM_TOL_DEG", "PERIODICITY_TOL",
-           "SK_STRENGTH_PARAMS", "CHECKS", "Gates", "strength_limits", "data_rom", "check", "check_frames"]
+           "SK_STRENGTH_PARAMS", "DATA_TERMS", "CHECKS", "Gates", "strength_limits", "data_rom", "check", "check_frames",
+           "label"]
 
 #: IPOPT statuses counted as converged (the sweep's rule, :data:`gaitlib.sweep.ACCEPTED_STATUSES`).
 CONVERGED_STATUSES = ACCEPTED_STATUSES
@@ -432,14 +434,18 @@ def _gait_kind(spec) -> str:
     return "tracking" if any(spec.term_weights.get(k, 0) for k in DATA_TERMS) else "predictive"
 
 
+@lru_cache(maxsize=16)
+def _gait_data(speed_class: str, source: str = "schwartz2008"):
+    from . import data as data_mod
+
+    return data_mod.load_gait_data(speed_class, source)
+
+
 def _tracked_data(spec, data=None):
     """(events, left shift, stride m, data ROM) of the data a gait spec tracks (``data``
     overrides the events' source: a :class:`gaitlib.data.GaitData`)."""
-    from . import data as data_mod
-
-    own = data_mod.load_gait_data(spec.speed_class, spec.source)
-    tracked = data if data is not None else (
-        data_mod.load_gait_data(spec.track_class, spec.source) if spec.track_class else own)
+    own = _gait_data(spec.speed_class, spec.source)
+    tracked = data if data is not None else (_gait_data(spec.track_class, spec.source) if spec.track_class else own)
     return dict(tracked.events), float(tracked.left_shift), float(own.speed * own.cycle_time), data_rom(tracked)
 
 
@@ -499,10 +505,9 @@ def _check_gait(sol, kind, data, name) -> Gates:
 
 
 def _check_contact_a(res, name) -> Gates:
-    from . import data as data_mod
-
-    g = data_mod.load_gait_data("Free")
     from . import transcription as tr
+
+    g = _gait_data("Free")
 
     return check_frames(status=res.stats["status"] if res.stats["success"] else f"{res.stats['status']} "
                         "(no converged local solve meets Eq 4.4)",
@@ -555,3 +560,9 @@ def check(solution, *, kind: str | None = None, data=None, name: str = "") -> Ga
     if hasattr(solution, "spec") and hasattr(solution, "grf"):
         return _check_gait(solution, kind, data, name)
     raise TypeError(f"check: cannot read a {type(solution).__name__} (need a gait, jump or contact-id solution)")
+
+
+def label(solution, **kw) -> str:
+    """:meth:`Gates.label` of :func:`check` (``"valid"``, ``"not converged (…)"``,
+    ``"invalid: …"``): the mark for a figure or table."""
+    return check(solution, **kw).label()
