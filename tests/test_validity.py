@@ -128,7 +128,8 @@ def test_angle_out_of_rom_fails():
     q["ankle_r"] = math.radians(-35.0)  # 35° plantarflexion: inside either reading's union
     assert gates(q=q).passed
     q["ankle_r"] = math.radians(-45.0)
-    assert gates(q=q).failed == ["rom"]
+    g = gates(q=q)
+    assert g.failed == ["rom"] and g.label() == "invalid: angle -45 deg < -40 deg (ankle_r, thesis Table 3.5)"
     # an angle the data's children show (mean + 1 SD) is inside their range
     q = f["q"].copy()
     q["knee_r"] = math.radians(2.0)

@@ -108,8 +108,8 @@ from .sweep import ACCEPTED_STATUSES
 
 __all__ = ["CONVERGED_STATUSES", "SWING_LOAD_BW", "SWING_MARGIN", "DOUBLE_SUPPORT_MAX", "DOUBLE_SUPPORT_WALKING",
            "RESIDUAL_FORCE_FRACTION", "RESIDUAL_MOMENT_FRACTION", "ROM_DEG", "ROM_TOL_DEG", "PERIODICITY_TOL",
-           "SK_STRENGTH_PARAMS", "DATA_TERMS", "CHECKS", "Gates", "strength_limits", "data_rom", "check", "check_frames",
-           "label"]
+           "SK_STRENGTH_PARAMS", "DATA_TERMS", "CHECKS", "Gates", "strength_limits", "data_rom", "check",
+           "check_frames", "label"]
 
 #: IPOPT statuses counted as converged (the sweep's rule, :data:`gaitlib.sweep.ACCEPTED_STATUSES`).
 CONVERGED_STATUSES = ACCEPTED_STATUSES
@@ -153,8 +153,9 @@ class Gates:
     """The validity checks of one solution.
 
     ``table``: one row per check of :data:`CHECKS` — ``check, value, threshold, unit,
-    passed, note`` (``passed`` True/False, or None where the check does not apply);
-    ``name``: what was checked (for reports)."""
+    passed, note, basis`` (``passed`` True/False, or None where the check does not apply;
+    ``basis`` what the threshold is, e.g. "2 % BW"); ``name``: what was checked (for
+    reports)."""
 
     table: pd.DataFrame
     name: str = ""
@@ -185,8 +186,9 @@ class Gates:
             if r.check == "converged":
                 parts.insert(0, f"not converged ({r.value})")
                 continue
-            parts.append(f"{CHECKS[r.check]} {_fmt(r.value)} {r.unit} > {_fmt(r.threshold)} {r.unit}".replace(" %", "%")
-                         + (f" ({r.basis})" if getattr(r, "basis", "") else ""))
+            op = "<" if float(r.value) < float(r.threshold) else ">"  # a lower bound (angles)
+            parts.append(f"{CHECKS[r.check]} {_fmt(r.value)} {r.unit} {op} {_fmt(r.threshold)} {r.unit}"
+                         .replace(" %", "%") + (f" ({r.basis})" if getattr(r, "basis", "") else ""))
         conv = [p for p in parts if p.startswith("not converged")]
         rest = [p for p in parts if not p.startswith("not converged")]
         return "; ".join(conv + (["invalid: " + "; ".join(rest)] if rest else []))
@@ -326,7 +328,8 @@ def check_frames(*, status: str, q: pd.DataFrame | None = None, torques: pd.Data
         w = _weights(t, T)
         loaded = {s: grf[f"grf_y_{s}"].to_numpy(float) > lim_load for s in feet}
         both = float(np.sum(w[loaded["r"] & loaded["l"]]))
-        both10 = float(np.sum(w[(grf["grf_y_r"].to_numpy(float) > 0.1 * bw) & (grf["grf_y_l"].to_numpy(float) > 0.1 * bw)]))
+        heavy = {s: grf[f"grf_y_{s}"].to_numpy(float) > 0.1 * bw for s in feet}
+        both10 = float(np.sum(w[heavy["r"] & heavy["l"]]))
         single = {s: float(np.sum(w[loaded[s]])) for s in feet}
         exp = (f"walking ≈ {100 * DOUBLE_SUPPORT_WALKING[0]:.0f}–{100 * DOUBLE_SUPPORT_WALKING[1]:.0f} %"
                + (f", data {100 * events['double_support']:.0f} %" if events and "double_support" in events else ""))
@@ -549,8 +552,9 @@ def check(solution, *, kind: str | None = None, data=None, name: str = "") -> Ga
     ``trajectory`` and ``jump_height``) or a contact-identification result (has
     ``p_contact`` and ``key``; (b)/(c) are checked through their gait solution).
     ``kind``: ``"tracking"`` or ``"predictive"`` for a gait (default: tracking when the cost
-    tracks any data channel — GRFs, angles, coordinates or torques — else predictive). ``data``: the :class:`gaitlib.data.GaitData` whose
-    events define the swing (default: the data the spec tracks)."""
+    tracks any data channel — GRFs, angles, coordinates or torques — else predictive).
+    ``data``: the :class:`gaitlib.data.GaitData` whose events define the swing (default:
+    the data the spec tracks). ``name``: carried into :attr:`Gates.name`."""
     if hasattr(solution, "trajectory") and hasattr(solution, "jump_height"):
         return _check_jump(solution, name)
     if hasattr(solution, "p_contact") and hasattr(solution, "key"):
