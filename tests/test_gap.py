@@ -522,3 +522,20 @@ def test_ranking_bars_draws_an_interval_that_excludes_the_point():
     segs = [c for c in fig.axes[0].collections if hasattr(c, "get_segments")]
     ends = sorted(tuple(np.round(s[:, 0], 2)) for c in segs for s in c.get_segments())
     assert ends == [(0.9, 2.19), (8.0, 12.0)]
+
+
+def test_data_signature_ignores_the_last_bits(real):
+    """Another CPU's BLAS kernel changes derived curves in the last bits: same signature;
+    a real change of the data (1e-6 of a curve's scale) changes it."""
+    import dataclasses
+
+    g = real.gait
+    base = gio.signature(g)
+    m = g.mean.to_numpy(float)
+    ulp = dataclasses.replace(g, mean=g.mean.copy(deep=True))
+    ulp.mean.iloc[:, :] = np.nextafter(m, np.inf)
+    assert gio.signature(ulp) == base
+    moved = dataclasses.replace(g, mean=g.mean.copy(deep=True))
+    col = moved.mean.columns[0]
+    moved.mean[col] = moved.mean[col] + 1e-6 * np.abs(moved.mean[col]).max()
+    assert gio.signature(moved) != base

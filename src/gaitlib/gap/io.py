@@ -120,15 +120,32 @@ def n_subjects(base: str, speed_class: str, data_dir=None) -> int:
     return int(sel["n"].iloc[0]) if len(sel) else 1
 
 
+#: Significant digits of a data set's numbers that its signature keeps (relative to each
+#: column's largest magnitude): the last bits of derived curves (the Fourier left leg) differ
+#: between CPUs and BLAS kernels, and a cache key must not.
+SIGNATURE_DIGITS = 9
+
+
+def _quantised(a) -> bytes:
+    """Columns of ``a`` on a power-of-ten grid :data:`SIGNATURE_DIGITS` digits below the
+    column's largest magnitude (int64 bytes; machine-independent)."""
+    a = np.atleast_2d(np.asarray(a, float).T).T
+    peak = np.nanmax(np.abs(np.where(np.isfinite(a), a, np.nan)), axis=0, initial=0.0)
+    step = 10.0 ** (np.floor(np.log10(np.where(peak > 0, peak, 1.0))) - SIGNATURE_DIGITS)
+    q = np.where(np.isfinite(a), np.round(np.nan_to_num(a) / step), -2**62)
+    return np.ascontiguousarray(q.astype(np.int64)).tobytes()
+
+
 def signature(gait) -> str:
-    """Hash of a GaitData's numbers (means, SDs, time, speed, events, left shift)."""
-    h = hashlib.sha256()
+    """Hash of a GaitData's numbers (means, SDs, time, speed, events, left shift), each
+    column to :data:`SIGNATURE_DIGITS` significant digits of its largest value."""
+    h = hashlib.sha256(b"signature/2")
     for frame in (gait.mean, gait.sd):
-        h.update(np.ascontiguousarray(frame.to_numpy(float)).tobytes())
+        h.update(_quantised(frame.to_numpy(float)))
         h.update(",".join(map(str, frame.columns)).encode())
-    h.update(np.asarray(gait.time, float).tobytes())
-    h.update(repr((round(float(gait.speed), 12), round(float(gait.cycle_time), 12), round(float(gait.left_shift), 12),
-                   sorted((k, round(float(v), 12)) for k, v in gait.events.items()))).encode())
+    h.update(_quantised(np.asarray(gait.time, float)))
+    h.update(repr((round(float(gait.speed), 9), round(float(gait.cycle_time), 9), round(float(gait.left_shift), 9),
+                   sorted((k, round(float(v), 9)) for k, v in gait.events.items()))).encode())
     return h.hexdigest()[:16]
 
 
