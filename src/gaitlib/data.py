@@ -527,7 +527,8 @@ def load_tidy(path: str | Path) -> pd.DataFrame:
         df[col] = num.astype(float)
     if (df["sd"] < 0).any():
         i = int(np.flatnonzero((df["sd"] < 0).to_numpy())[0])
-        raise DataError(f"{path}: column 'sd' row {i + 2}: negative SD {df['sd'].iloc[i]}")
+        raise DataError(f"{path}: column 'sd' row {i + 2} (quantity {df['quantity'].iloc[i]!r}): "
+                        f"negative SD {df['sd'].iloc[i]} (expected ≥ 0)")
     out_of_range = (df["percent_cycle"] < 0) | (df["percent_cycle"] > 100)
     if out_of_range.any():
         i = int(np.flatnonzero(out_of_range.to_numpy())[0])
@@ -772,7 +773,7 @@ def load_gait_data(speed_class: str = "Free", source: str = "schwartz2008",
                    body_mass: float = cv.BODY_MASS, body_height: float = cv.BODY_HEIGHT,
                    data_dir: str | Path | None = None, n_points: int | None = None,
                    fourier_order: int = 5, left_shift: float | None = None,
-                   include_emg: bool = True) -> GaitData:
+                   include_emg: bool = True, allow_no_sd: bool | None = None) -> GaitData:
     """The model's view of one data set and speed class (see :class:`GaitData`).
 
     Parameters
@@ -786,6 +787,12 @@ def load_gait_data(speed_class: str = "Free", source: str = "schwartz2008",
         data's own grid (51 points, 2 % steps).
     left_shift : fraction of the cycle between right and left legs; default the data's
         opposite-foot-contact event (≈ 0.5), i.e. the thesis's T_sh = t_DSP + t_SSP.
+    allow_no_sd : accept curves whose SD is 0 everywhere (:mod:`gaitlib.plausibility`);
+        default only for ``gaitutils``, whose EMG envelopes come without SD.
+
+    The class's rows pass :func:`gaitlib.plausibility.check_tidy` (physiological ranges,
+    complete curves) before anything is derived from them; a failure raises
+    :class:`DataError` naming file, quantity, row and the expected range.
     """
     data_dir = Path(data_dir) if data_dir is not None else DATA_DIR
     if source not in ("schwartz2008", "gaitutils"):
@@ -798,6 +805,10 @@ def load_gait_data(speed_class: str = "Free", source: str = "schwartz2008",
     if sel.empty:
         raise DataError(f"{curves_path}: no rows for speed class {speed_class!r} "
                         f"(available: {sorted(set(tidy['speed_class']))})")
+    from .plausibility import check_tidy  # imports this module: not at module level
+
+    # physiological ranges, complete curves, SD > 0 (gaitutils' EMG curves come without SD)
+    check_tidy(sel, curves_path, allow_no_sd=(source == "gaitutils") if allow_no_sd is None else allow_no_sd)
     notes = []
     if source == "schwartz2008":
         sp = speed_and_cycle_time(speed_class, body_height, data_dir / "schwartz2008_speed.csv")
@@ -850,7 +861,7 @@ def load_gait_data(speed_class: str = "Free", source: str = "schwartz2008",
         elif quantity.startswith("emg_") and include_emg:
             if set(g["side"]) >= {"R", "L"}:  # both legs measured: use them as they are
                 for side in ("R", "L"):
-                    gs = g[g["side"] == side]
+                    gs = g[g["side"] == side].sort_values("percent_cycle", kind="stable")
                     name = f"{quantity}_{side.lower()}"
                     fr = gs["percent_cycle"].to_numpy() / 100.0
                     mean_cols[name] = np.interp(frac, fr, gs["mean"].to_numpy())

@@ -228,7 +228,8 @@ def _from_frame(df: pd.DataFrame, label: str, like=None, fill_from=None, path=No
         df.to_csv(tmp / f"{base}_curves.csv", index=False)
         for f in _BASE_FILES[base]:
             shutil.copy(data_mod.DATA_DIR / f, tmp / f)
-        gait = data_mod.load_gait_data(speed_class, base, data_dir=tmp)
+        # the file's own checks ran above, with the caller's allow_no_sd
+        gait = data_mod.load_gait_data(speed_class, base, data_dir=tmp, allow_no_sd=True)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     if two:
