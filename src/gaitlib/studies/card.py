@@ -134,8 +134,9 @@ class Row:
     def record(self) -> dict:
         v = verdict(self.thesis, self.ours, unit=self.unit, sd=self.sd, holds=self.holds, valid=self.valid)
         cause = self.cause
-        if v == "invalid" and cause == "unknown":
-            cause = f"the solution fails its gates ({self.valid})"
+        if v == "invalid":
+            alone = verdict(self.thesis, self.ours, unit=self.unit, sd=self.sd, holds=self.holds)
+            cause = f"{'gates fail (valid column)' if cause == 'unknown' else cause}; the number alone: {alone}"
         if _missing(self.ours) and cause == "unknown":
             cause = "no stored solution"
         ours = float(self.ours) if _numeric(self.ours) else self.ours
@@ -226,6 +227,27 @@ class _NotStored(RuntimeError):
     pass
 
 
+@contextlib.contextmanager
+def _memo_data():
+    """Within: :func:`gaitlib.data.load_gait_data` returns one object per distinct call (it
+    re-reads and re-fits the tidy CSV on every call; the card asks for the same classes
+    dozens of times). The callers here never modify the returned data."""
+    orig = data_mod.load_gait_data
+    memo: dict = {}
+
+    def load(*a, **k):
+        key = (a, tuple(sorted(k.items())))
+        if key not in memo:
+            memo[key] = orig(*a, **k)
+        return memo[key]
+
+    data_mod.load_gait_data = load
+    try:
+        yield
+    finally:
+        data_mod.load_gait_data = orig
+
+
 def _rms_sd(gait, col: str, scale: float = 1.0) -> float:
     """RMS over the cycle of the data's SD of a channel (× ``scale``)."""
     return float(np.sqrt(np.mean(gait.sd[col].to_numpy(float) ** 2))) * scale
@@ -275,7 +297,7 @@ def _ch3() -> list[Row]:
     if len(sols) == len(jump.THESIS):
         rise = {n: s.jump_height["com_rise_flight"] for n, s in sols.items()}
         order = sorted(rise, key=rise.get)
-        v = "; ".join(f"{n}: {valid[n]}" for n in sols) if any(_blocked(x) for x in valid.values()) else "valid"
+        v = _joint(valid)
         rows.append(Row(3, "jump height order toeless < toe < ellipsoid (Sec 3.4.4)", "toeless < toe < ellipsoid",
                         " < ".join(order), "", f"COM rises {', '.join(f'{n} {100 * r:.0f} cm' for n, r in rise.items())} "
                         f"[{why}]", "jump (3 solutions)", v, holds=order == ["toeless", "toe", "ellipsoid"]))
@@ -333,7 +355,7 @@ def _ch4() -> list[Row]:
     if {"a", "b", "c"} <= set(res):
         fit = ci.grf_fit(res)["mean GRF RMSE (N)"]
         m = {k: float(fit[ci.APPROACHES[k]]) for k in res}
-        v = "; ".join(f"({k}) {valid[k]}" for k in res) if any(_blocked(x) for x in valid.values()) else "valid"
+        v = _joint({f"({k})": valid[k] for k in res})
         rows.append(Row(4, "GRF fit ranking (c) < (b) < (a) (Sec 4.4.2, Sec 4.5)", "(c) < (b) < (a)",
                         ", ".join(f"({k}) {v_:.1f} N" for k, v_ in m.items()), "",
                         f"mean GRF RMSE per approach [{where}]", "contact_id (a), (b), (c)", v,
@@ -461,9 +483,22 @@ def _mean(df: pd.DataFrame, kind: str | None = None, col: str = "nrmse") -> floa
     return float(d[col].mean()) if len(d) else np.nan
 
 
-def _joint(valids: list[str]) -> str:
-    bad = [v for v in valids if _blocked(v) or not v]
-    return "valid" if not bad else "; ".join(dict.fromkeys(v or "missing" for v in bad))
+def _joint(valids: dict) -> str:
+    """The validity text of a row computed from several solutions (name → gate text):
+    ``"valid"`` when none is blocked, else ``"invalid: …"`` / ``"not converged: …"`` naming
+    the blocked ones."""
+    bad = {k: v or "missing" for k, v in valids.items() if _blocked(v) or not v}
+    if not bad:
+        return "valid"
+    head = "invalid" if any("invalid" in v for v in bad.values()) else "not converged"
+    return f"{head}: " + "; ".join(f"{k} ({_short(v)})" for k, v in bad.items())
+
+
+def _short(label: str) -> str:
+    """The failed checks' names of a gate label (``"swing load, double support"``)."""
+    parts = re.split(r"; |: ", label.replace("invalid: ", ""))
+    names = [re.sub(r"\s*[-\d(].*$", "", p).strip() for p in parts]
+    return ", ".join(dict.fromkeys(n for n in names if n))
 
 
 def _ch6(bases: dict, runs: dict, valid: dict) -> list[Row]:
@@ -494,33 +529,33 @@ def _ch6(bases: dict, runs: dict, valid: dict) -> list[Row]:
         worse = "NMSK" if better == "MSK" else "MSK"
         rows.append(Row(6, f"{c}: {better} more accurate than {worse} (Sec 6.2.3)", f"{better} < {worse}", ours, "",
                         f"[{acc}]" if holds is not None else "unknown", f"Ch 6 {a}, {b}",
-                        _joint([valid.get(a, ""), valid.get(b, "")]), holds=holds))
+                        _joint({a: valid.get(a, ""), b: valid.get(b, "")}), holds=holds))
     # the fully predictive NMSK vs MSK: % lower RMSE (Sec 6.3)
     for kind, tv in pr.THESIS_FP_GAIN_PCT.items():
         a, b = "MSK FP", "NMSK FP"
         ours = (100 * (1 - _mean(sc[b], kind, "rmse") / _mean(sc[a], kind, "rmse"))) if a in sc and b in sc else np.nan
         rows.append(Row(6, f"FP: NMSK {kind} RMSE lower than MSK's by (Sec 6.3)", tv, ours, "%", "unknown",
-                        f"Ch 6 {a}, {b}", _joint([valid.get(a, ""), valid.get(b, "")])))
+                        f"Ch 6 {a}, {b}", _joint({a: valid.get(a, ""), b: valid.get(b, "")})))
     th = pr.THESIS_HOURS_TABLE_6_3
     a, b = runs.get("MSK FP"), runs.get("NMSK FP")
     rows.append(Row(6, "FP: NMSK compute time lower than MSK's by (Sec 6.2.4, Table 6.3)",
                     100 * (1 - th["NMSK"]["FP"] / th["MSK"]["FP"]),
                     100 * (1 - _hours(b.stats) / _hours(a.stats)) if a and b else np.nan, "%", "unknown",
-                    "Ch 6 MSK FP, NMSK FP", _joint([valid.get("MSK FP", ""), valid.get("NMSK FP", "")])))
+                    "Ch 6 MSK FP, NMSK FP", _joint({k: valid.get(k, "") for k in ("MSK FP", "NMSK FP")})))
     ms = [runs.get(f"MSK {c}") for c in pr.CH6_COSTS]
     ns = [runs.get(f"NMSK {c}") for c in pr.CH6_COSTS]
     ok = all(ms) and all(ns)
     rows.append(Row(6, "all 8 MSK runs' compute time ÷ all 8 NMSK runs' (Sec 6.3, Table 6.3)",
                     sum(th["MSK"].values()) / sum(th["NMSK"].values()),
                     sum(_hours(s.stats) for s in ms) / sum(_hours(s.stats) for s in ns) if ok else np.nan, "1",
-                    "unknown", "Ch 6, 16 runs", _joint([valid.get(k, "") for k in runs])))
+                    "unknown", "Ch 6, 16 runs", _joint({k: valid.get(k, "") for k in runs})))
     # excitations: SDT3 the most accurate NMSK run; FP vs the Ch 5 tracking (Secs 6.2.3–6.2.4)
     ex = {c: float(pr.excitation_score(runs[f"NMSK {c}"], free)["rmse"].mean())
           for c in pr.CH6_COSTS if runs.get(f"NMSK {c}") is not None}
     best = min(ex, key=ex.get) if ex else None
     rows.append(Row(6, "NMSK SDT3 predicts the most accurate excitations (Sec 6.2.3)", "SDT3",
                     f"{best} (mean RMSE {ex[best]:.3f}; SDT3 {ex.get('SDT3', np.nan):.3f})" if best else np.nan, "",
-                    "unknown", "Ch 6 NMSK, 8 runs", _joint([valid.get(f"NMSK {c}", "") for c in pr.CH6_COSTS]),
+                    "unknown", "Ch 6 NMSK, 8 runs", _joint({f"NMSK {c}": valid.get(f"NMSK {c}", "") for c in pr.CH6_COSTS}),
                     holds=(best == "SDT3") if best else None))
     n5 = bases.get("NMSK")
     ours = np.nan
@@ -529,7 +564,7 @@ def _ch6(bases: dict, runs: dict, valid: dict) -> list[Row]:
         ours = 100 * (1 - ex["FP"] / e5)
     rows.append(Row(6, "NMSK FP excitation RMSE lower than the Ch 5 data tracking's by (Sec 6.2.4)",
                     pr.THESIS_FP_EXCITATION_GAIN_PCT, ours, "%", "unknown", "Ch 6 NMSK FP, Ch 5 NMSK",
-                    _joint([valid.get("NMSK FP", ""), gate(n5, "NMSK") if n5 is not None else ""])))
+                    _joint({"NMSK FP": valid.get("NMSK FP", ""), "Ch 5 NMSK": gate(n5, "NMSK") if n5 is not None else ""})))
     return rows
 
 
@@ -555,7 +590,7 @@ def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict) -> list[
     rows.append(Row(7, "all 4 MSK runs' compute time ÷ all 4 NMSK runs' (Sec 7.3, Table 7.2)",
                     sum(th["MSK"].values()) / sum(th["NMSK"].values()),
                     sum(_hours(s.stats) for s in ms) / sum(_hours(s.stats) for s in ns) if ok else np.nan, "1",
-                    "unknown", "Ch 7, 8 runs", _joint([valid.get(k, "") for k in runs])))
+                    "unknown", "Ch 7, 8 runs", _joint({k: valid.get(k, "") for k in runs})))
     # NMSK torques more accurate than MSK's per class (Sec 7.2)
     acc = _anchor("ch07_speed", "Accuracy against each class's own (untracked) data — thesis Figs 7.1–7.4")
     for tc, tv in pr.THESIS_TORQUE_GAIN_PCT_CH7.items():
@@ -567,10 +602,10 @@ def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict) -> list[
             ours = 100 * (1 - _mean(pr.score(b, g), "torque") / _mean(pr.score(a, g), "torque"))
         rows.append(Row(7, f"{c} ({tc}): NMSK torque NRMSE lower than MSK's by (Sec 7.2)", tv, ours, "%",
                         f"[{acc}]" if np.isfinite(ours) else "unknown", f"Ch 7 MSK {c}, NMSK {c}",
-                        _joint([valid.get(f"MSK {c}", ""), valid.get(f"NMSK {c}", "")])))
+                        _joint({f"MSK {c}": valid.get(f"MSK {c}", ""), f"NMSK {c}": valid.get(f"NMSK {c}", "")})))
     # Fig 7.5: COT against speed; the natural-speed point is the like-for-like Ch 6 NMSK DT
     cot_page = _anchor("ch07_speed", "Cost of transport against speed (thesis Fig 7.5)")
-    pts, vals = {}, []
+    pts, vals = {}, {}
     n5 = bases.get("NMSK")
     for tc, speed, tv in pr.THESIS_COT_FIG_7_5:
         c = inv[tc]
@@ -583,7 +618,7 @@ def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict) -> list[
                      f"activation parameters) gives {n5.stats.get('COT', np.nan):.2f} [{cot_page}]")
         g = data_mod.load_gait_data(c)
         pts[c] = (g.speed, cot)
-        vals.append(v)
+        vals[f"NMSK {c}"] = v
         rows.append(Row(7, f"COT at {c} ({tc}, thesis {speed} m/s; ours {g.speed:.2f} m/s) (Fig 7.5)", tv, cot,
                         "J/kg/m", cause, s.name if s is not None else "", v))
     if all(np.isfinite(v[1]) for v in pts.values()) and len(pts) == 5:
@@ -605,6 +640,11 @@ def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict) -> list[
 # ======================================================================================
 def build(chapters=(3, 4, 5, 6, 7)) -> pd.DataFrame:
     """The report card (module docstring) from the stored solutions; never solves."""
+    with _memo_data():
+        return _build(tuple(chapters))
+
+
+def _build(chapters) -> pd.DataFrame:
     rows: list[Row] = []
     if 3 in chapters:
         rows += _ch3()
