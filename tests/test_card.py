@@ -115,3 +115,13 @@ def test_card_reads_the_stored_numbers(tmp_path, monkeypatch):
     nm = c[c["item"].str.startswith("NMSK RMSE")]
     assert len(nm) == 16 and nm["ours"].isna().all() and (nm["verdict"] == "not comparable").all()
     assert np.isfinite(row["thesis"])
+
+
+def test_card_never_solves(tmp_path, monkeypatch):
+    """Without stored solutions the rows are "not comparable" and nothing is solved or written."""
+    monkeypatch.setenv("GAITLIB_STORE", "")
+    monkeypatch.setenv("GAITLIB_SOLUTIONS", str(tmp_path / "cache"))
+    c = card.build(chapters=(3, 4))
+    assert len(c) >= 30 and (c["verdict"] == "not comparable").all()
+    assert (c["cause"] == "no stored solution").all()
+    assert not (tmp_path / "cache").exists() or not any((tmp_path / "cache").rglob("*.json"))

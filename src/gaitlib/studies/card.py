@@ -218,12 +218,13 @@ def _never_solve():
     def refuse(*a, **k):
         raise _NotStored("not stored")
 
-    saved = (tr.solve, ci.InverseDynamicsID.local_solve)
-    tr.solve, ci.InverseDynamicsID.local_solve = refuse, refuse
+    cls = ci.InverseDynamicsID
+    saved = (tr.solve, cls.local_solve, cls.__dict__["solver"])
+    tr.solve, cls.local_solve, cls.solver = refuse, refuse, property(refuse)
     try:
         yield
     finally:
-        tr.solve, ci.InverseDynamicsID.local_solve = saved
+        tr.solve, cls.local_solve, cls.solver = saved
 
 
 class _NotStored(RuntimeError):
