@@ -128,7 +128,8 @@ def test_angle_out_of_rom_fails():
     q["ankle_r"] = math.radians(-35.0)  # 35° plantarflexion: inside either reading's union
     assert gates(q=q).passed
     q["ankle_r"] = math.radians(-45.0)
-    assert gates(q=q).failed == ["rom"]
+    g = gates(q=q)
+    assert g.failed == ["rom"] and g.label() == "invalid: angle -45 deg < -40 deg (ankle_r, thesis Table 3.5)"
     # an angle the data's children show (mean + 1 SD) is inside their range
     q = f["q"].copy()
     q["knee_r"] = math.radians(2.0)
@@ -196,3 +197,25 @@ def test_check_reads_a_jump_like_solution():
     assert row(g, "strength")["threshold"] == pytest.approx(knee_peak)
     assert {r.check for r in g.table.itertuples() if r.passed is None} == {
         "swing_load", "double_support", "residual_force", "residual_moment", "periodicity"}
+
+
+def test_book_gates_table_from_given_solutions():
+    """The study's long table and matrix on hand-made solutions (no store needed): a jump
+    over strength and a run that returned no solution."""
+    from gaitlib.studies import validity as SV
+
+    idx = pd.Index(np.linspace(0, 1, 5), name="time")
+    traj = pd.DataFrame({"phase": "thrust", "ankle": 0.0, "knee": -0.5, "hip": 0.5, "tau_ankle": -10.0,
+                         "tau_knee": 900.0, "tau_hip": -10.0, "grf_x": 0.0, "grf_y": 700.0}, index=idx)
+    model = SimpleNamespace(joints=("ankle", "knee", "hip"), total_mass=72.0, incline=math.radians(28.8))
+    jump = SimpleNamespace(trajectory=traj, jump_height={}, model=model, status="Solve_Succeeded")
+    lost = SimpleNamespace(ok=False, status="error", value=None)
+    g = SV.book_gates(solutions={"jump": jump, "lost": lost})
+    assert set(g["solution"]) == {"jump", "lost"} and len(g) == 2 * len(V.CHECKS)
+    v = g.drop_duplicates("solution").set_index("solution")
+    assert not v.loc["jump", "valid"] and v.loc["lost", "label"] == "not converged (error)"
+    m = SV.gates_matrix(g)
+    assert m.loc["jump", "strength"].startswith("✗ 900") and m.loc["jump", "swing_load"] == "–"
+    s = SV.summary(g)
+    assert s.loc["strength", "failed"] == 1 and s.loc["converged", "failed"] == 1
+    assert V.label(jump).startswith("invalid: torque 900 N·m")

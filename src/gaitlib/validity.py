@@ -97,6 +97,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 import pandas as pd
@@ -107,7 +108,8 @@ from .sweep import ACCEPTED_STATUSES
 
 __all__ = ["CONVERGED_STATUSES", "SWING_LOAD_BW", "SWING_MARGIN", "DOUBLE_SUPPORT_MAX", "DOUBLE_SUPPORT_WALKING",
            "RESIDUAL_FORCE_FRACTION", "RESIDUAL_MOMENT_FRACTION", "ROM_DEG", "ROM_TOL_DEG", "PERIODICITY_TOL",
-           "SK_STRENGTH_PARAMS", "CHECKS", "Gates", "strength_limits", "data_rom", "check", "check_frames"]
+           "SK_STRENGTH_PARAMS", "DATA_TERMS", "CHECKS", "Gates", "strength_limits", "data_rom", "check",
+           "check_frames", "label"]
 
 #: IPOPT statuses counted as converged (the sweep's rule, :data:`gaitlib.sweep.ACCEPTED_STATUSES`).
 CONVERGED_STATUSES = ACCEPTED_STATUSES
@@ -151,8 +153,9 @@ class Gates:
     """The validity checks of one solution.
 
     ``table``: one row per check of :data:`CHECKS` — ``check, value, threshold, unit,
-    passed, note`` (``passed`` True/False, or None where the check does not apply);
-    ``name``: what was checked (for reports)."""
+    passed, note, basis`` (``passed`` True/False, or None where the check does not apply;
+    ``basis`` what the threshold is, e.g. "2 % BW"); ``name``: what was checked (for
+    reports)."""
 
     table: pd.DataFrame
     name: str = ""
@@ -183,8 +186,9 @@ class Gates:
             if r.check == "converged":
                 parts.insert(0, f"not converged ({r.value})")
                 continue
-            parts.append(f"{CHECKS[r.check]} {_fmt(r.value)} {r.unit} > {_fmt(r.threshold)} {r.unit}".replace(" %", "%")
-                         + (f" ({r.basis})" if getattr(r, "basis", "") else ""))
+            op = "<" if float(r.value) < float(r.threshold) else ">"  # a lower bound (angles)
+            parts.append(f"{CHECKS[r.check]} {_fmt(r.value)} {r.unit} {op} {_fmt(r.threshold)} {r.unit}"
+                         .replace(" %", "%") + (f" ({r.basis})" if getattr(r, "basis", "") else ""))
         conv = [p for p in parts if p.startswith("not converged")]
         rest = [p for p in parts if not p.startswith("not converged")]
         return "; ".join(conv + (["invalid: " + "; ".join(rest)] if rest else []))
@@ -324,7 +328,8 @@ def check_frames(*, status: str, q: pd.DataFrame | None = None, torques: pd.Data
         w = _weights(t, T)
         loaded = {s: grf[f"grf_y_{s}"].to_numpy(float) > lim_load for s in feet}
         both = float(np.sum(w[loaded["r"] & loaded["l"]]))
-        both10 = float(np.sum(w[(grf["grf_y_r"].to_numpy(float) > 0.1 * bw) & (grf["grf_y_l"].to_numpy(float) > 0.1 * bw)]))
+        heavy = {s: grf[f"grf_y_{s}"].to_numpy(float) > 0.1 * bw for s in feet}
+        both10 = float(np.sum(w[heavy["r"] & heavy["l"]]))
         single = {s: float(np.sum(w[loaded[s]])) for s in feet}
         exp = (f"walking ≈ {100 * DOUBLE_SUPPORT_WALKING[0]:.0f}–{100 * DOUBLE_SUPPORT_WALKING[1]:.0f} %"
                + (f", data {100 * events['double_support']:.0f} %" if events and "double_support" in events else ""))
@@ -432,14 +437,18 @@ def _gait_kind(spec) -> str:
     return "tracking" if any(spec.term_weights.get(k, 0) for k in DATA_TERMS) else "predictive"
 
 
+@lru_cache(maxsize=16)
+def _gait_data(speed_class: str, source: str = "schwartz2008"):
+    from . import data as data_mod
+
+    return data_mod.load_gait_data(speed_class, source)
+
+
 def _tracked_data(spec, data=None):
     """(events, left shift, stride m, data ROM) of the data a gait spec tracks (``data``
     overrides the events' source: a :class:`gaitlib.data.GaitData`)."""
-    from . import data as data_mod
-
-    own = data_mod.load_gait_data(spec.speed_class, spec.source)
-    tracked = data if data is not None else (
-        data_mod.load_gait_data(spec.track_class, spec.source) if spec.track_class else own)
+    own = _gait_data(spec.speed_class, spec.source)
+    tracked = data if data is not None else (_gait_data(spec.track_class, spec.source) if spec.track_class else own)
     return dict(tracked.events), float(tracked.left_shift), float(own.speed * own.cycle_time), data_rom(tracked)
 
 
@@ -499,10 +508,9 @@ def _check_gait(sol, kind, data, name) -> Gates:
 
 
 def _check_contact_a(res, name) -> Gates:
-    from . import data as data_mod
-
-    g = data_mod.load_gait_data("Free")
     from . import transcription as tr
+
+    g = _gait_data("Free")
 
     return check_frames(status=res.stats["status"] if res.stats["success"] else f"{res.stats['status']} "
                         "(no converged local solve meets Eq 4.4)",
@@ -544,8 +552,9 @@ def check(solution, *, kind: str | None = None, data=None, name: str = "") -> Ga
     ``trajectory`` and ``jump_height``) or a contact-identification result (has
     ``p_contact`` and ``key``; (b)/(c) are checked through their gait solution).
     ``kind``: ``"tracking"`` or ``"predictive"`` for a gait (default: tracking when the cost
-    tracks any data channel — GRFs, angles, coordinates or torques — else predictive). ``data``: the :class:`gaitlib.data.GaitData` whose
-    events define the swing (default: the data the spec tracks)."""
+    tracks any data channel — GRFs, angles, coordinates or torques — else predictive).
+    ``data``: the :class:`gaitlib.data.GaitData` whose events define the swing (default:
+    the data the spec tracks). ``name``: carried into :attr:`Gates.name`."""
     if hasattr(solution, "trajectory") and hasattr(solution, "jump_height"):
         return _check_jump(solution, name)
     if hasattr(solution, "p_contact") and hasattr(solution, "key"):
@@ -555,3 +564,9 @@ def check(solution, *, kind: str | None = None, data=None, name: str = "") -> Ga
     if hasattr(solution, "spec") and hasattr(solution, "grf"):
         return _check_gait(solution, kind, data, name)
     raise TypeError(f"check: cannot read a {type(solution).__name__} (need a gait, jump or contact-id solution)")
+
+
+def label(solution, **kw) -> str:
+    """:meth:`Gates.label` of :func:`check` (``"valid"``, ``"not converged (…)"``,
+    ``"invalid: …"``): the mark for a figure or table."""
+    return check(solution, **kw).label()
