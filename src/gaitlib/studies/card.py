@@ -205,8 +205,7 @@ def gate(sol, name: str = "") -> str:
         ok = bool(getattr(sol, "success", False))
         status = getattr(sol, "status", None) or getattr(sol, "stats", {}).get("status")
         return "not gated (converged)" if ok else f"not converged ({status})"
-    g = validity.check(sol, name=name)
-    return "valid" if g.passed else g.label()
+    return validity.label(sol, name=name)
 
 
 @contextlib.contextmanager
