@@ -142,8 +142,11 @@ class Row:
             cause = f"{'gates fail (valid column)' if cause == 'unknown' else cause}; the number alone: {alone}"
         if _missing(self.ours) and cause == "unknown":
             cause = "no stored solution"
-        ours = float(self.ours) if _numeric(self.ours) else self.ours
-        return {"chapter": self.chapter, "item": self.item, "thesis": self.thesis, "ours": ours, "unit": self.unit,
+        def g6(x):  # 6 significant digits for numbers (text kept)
+            return float(f"{float(x):.6g}") if _numeric(x) else x
+
+        return {"chapter": self.chapter, "item": self.item, "thesis": g6(self.thesis), "ours": g6(self.ours),
+                "unit": self.unit,
                 "verdict": v, "cause": cause, "solution": self.solution, "valid": self.valid}
 
 
