@@ -42,6 +42,7 @@ after a formulation's version changes.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -52,7 +53,7 @@ from functools import lru_cache
 from pathlib import Path
 
 __all__ = ["fingerprint", "key", "default_dir", "store_dir", "find", "lookup", "save", "verify", "scan",
-           "clear", "MANIFEST", "CacheWarning", "CorruptEntry"]
+           "clear", "only", "MANIFEST", "CacheWarning", "CorruptEntry", "NotCached"]
 
 _PKG = Path(__file__).resolve().parent
 
@@ -68,6 +69,33 @@ class CacheWarning(UserWarning):
 
 class CorruptEntry(Exception):
     """Raised by :func:`verify`: the entry's files do not match its manifest."""
+
+
+class NotCached(LookupError):
+    """Raised by :func:`find` inside :func:`only` when a solution is neither cached nor
+    stored: the caller would have to solve it."""
+
+
+#: ``GAITLIB_CACHE_ONLY=1``: :func:`find` raises :class:`NotCached` instead of returning None
+#: (set by :func:`only`; an environment variable, so sweep workers inherit it).
+ONLY_ENV = "GAITLIB_CACHE_ONLY"
+
+
+@contextlib.contextmanager
+def only(reason: str = "solving is disabled (cached solutions only)"):
+    """Within the block, a solution that is neither cached nor stored raises
+    :class:`NotCached` (naming its path) where it would otherwise be solved: every cached
+    solve of gaitlib looks its entry up with :func:`find` first. Worker processes started
+    inside the block (dask LocalCluster, subprocesses) inherit it."""
+    old = os.environ.get(ONLY_ENV)
+    os.environ[ONLY_ENV] = reason or "1"
+    try:
+        yield
+    finally:
+        if old is None:
+            os.environ.pop(ONLY_ENV, None)
+        else:
+            os.environ[ONLY_ENV] = old
 
 
 @lru_cache(maxsize=4096)
@@ -217,6 +245,8 @@ def find(where: Path, marker: str) -> Path | None:
                 found = cand
     if found is not None:
         _log_use(found)
+    elif os.environ.get(ONLY_ENV):
+        raise NotCached(f"{where}: not cached or stored ({os.environ[ONLY_ENV]})")
     return found
 
 

@@ -12,6 +12,8 @@ Commands
                      class on dask.distributed (gaitlib.sweep; a LocalCluster, or an existing
                      cluster with ``--scheduler tcp://host:port``; ``--serial`` without dask)
                      and write ``sweep.csv`` plus each run's outputs in ``DIR/<model>_<cost>_<speed>``.
+``card --out DIR``   the replication report card: ``card.csv``, one row per thesis headline
+                     number with ours, the verdict and the solution's validity (gaitlib.studies.card)
 ``gap --data CSV --out DIR``   sim-to-real gap diagnosis of a tidy data CSV: located gap,
                      ranking of candidate effects, shrink; ``diagnosis.json`` + figures (gaitlib.gap)
 ``gap-twin --effect NAME --magnitude X --seed N --out CSV``   a twin data set with a known
@@ -129,6 +131,25 @@ def _add_cache_parser(sub) -> None:
     c.set_defaults(func=_cmd_cache)
 
 
+def _cmd_card(args) -> int:
+    """``gaitlib card``: the replication report card from the stored solutions."""
+    from .studies import card
+
+    f = card.write(args.out)
+    import pandas as pd
+
+    c = pd.read_csv(f)
+    print(card.counts(c).to_string())
+    print(f"wrote {f} ({len(c)} rows)")
+    return 0
+
+
+def _add_card_parser(sub) -> None:
+    c = sub.add_parser("card", help="the replication report card (card.csv) from the stored solutions")
+    c.add_argument("--out", required=True, help="output directory (card.csv is written there)")
+    c.set_defaults(func=_cmd_card)
+
+
 def _add_sweep_parser(sub) -> None:
     w = sub.add_parser("sweep", help="solve cost functions x speed classes as one (distributed) sweep")
     w.add_argument("--model", default="MSK", choices=["SK", "MSK", "NMSK"])
@@ -180,6 +201,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.set_defaults(func=_cmd_run)
     _add_sweep_parser(sub)
     _add_cache_parser(sub)
+    _add_card_parser(sub)
     from .gap.cli import add_parsers as _add_gap_parsers  # gaitlib gap, gaitlib gap-twin (issue 7)
 
     _add_gap_parsers(sub)

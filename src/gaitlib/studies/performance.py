@@ -35,6 +35,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .. import cache
+
 __all__ = ["results_dir", "load", "load_optional", "fit_power_law", "scaling_table", "scaling_fits", "hessian_table",
            "linear_solver_table", "moco_table", "gait_table", "msk_profile_tables", "eval_floor_table", "kkt_scaling_tables", "measured_on", "ThesisTime", "THESIS_SILENT",
            "thesis_reference_times", "parse_duration", "time_row", "missing_row", "NOT_COMPUTED", "NO_CACHE",
@@ -525,37 +527,15 @@ def thesis_times_figure(res: dict | None = None):
     return fig
 
 
-class NotInCache(RuntimeError):
-    """Raised by a solve attempted inside :func:`no_solving`."""
+#: Raised by a solve attempted inside :func:`no_solving`.
+NotInCache = cache.NotCached
 
 
 @contextlib.contextmanager
 def no_solving(what: str = "solving is disabled (--cached-only)"):
-    """Within the block, any attempt to solve an optimisation raises :class:`NotInCache`
-    (before any symbolic work): :func:`gaitlib.transcription.solve`,
-    :class:`gaitlib.ocp.Transcription` and ``casadi.nlpsol`` (the last catches every other
-    solver, e.g. Ch 4's multistart search). Cached solutions still load, so the study
-    functions the book calls return whatever the cache holds and raise for the rest. Runs
-    of a :mod:`gaitlib.sweep` must be ``serial=True`` (worker processes are not patched).
-    Not thread-safe; restores everything on exit."""
-    import casadi as ca
-
-    from .. import ocp
-    from .. import transcription as tr
-
-    def refuse(*_a, **_k):
-        raise NotInCache(what)
-
-    saved = [(tr, "solve", tr.solve), (ca, "nlpsol", ca.nlpsol), (ocp.Transcription, "__init__",
-                                                                 ocp.Transcription.__init__)]
-    try:
-        tr.solve = refuse
-        ca.nlpsol = refuse
-        ocp.Transcription.__init__ = refuse
-        yield
-    finally:
-        for obj, name, val in saved:
-            setattr(obj, name, val)
+    """Within the block, a solve of anything not cached raises :class:`NotInCache`
+    (:func:`gaitlib.cache.only`); cached solutions still load."""
+    return cache.only(what)
 
 
 def machine_info() -> dict:

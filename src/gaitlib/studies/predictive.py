@@ -43,7 +43,8 @@ from .. import transcription as tr
 from . import gait as sg
 
 __all__ = ["CH6_COSTS", "CH7_CLASSES", "THESIS_CLASS", "THESIS_HOURS_TABLE_6_3", "THESIS_HOURS_TABLE_7_2",
-           "THESIS_COT_FIG_7_5", "BASELINE_COST", "GUESS_POLICY", "baseline", "default_params", "thesis_guess", "run_guess", "ch6_specs", "ch7_specs",
+           "THESIS_COT_FIG_7_5", "THESIS_FP_GAIN_PCT", "THESIS_FP_EXCITATION_GAIN_PCT",
+           "THESIS_TORQUE_GAIN_PCT_CH7", "BASELINE_COST", "GUESS_POLICY", "baseline", "default_params", "thesis_guess", "run_guess", "ch6_specs", "ch7_specs",
            "score", "excitation_score", "StudyResult", "cost_function_study", "speed_study", "cot_table",
            "times_table"]
 
@@ -60,6 +61,14 @@ THESIS_HOURS_TABLE_6_3 = {
 }
 #: Thesis Table 7.2, hours, by the thesis's class.
 THESIS_HOURS_TABLE_7_2 = {"MSK": {"XS": 18, "S": 12, "M": 10, "L": 12}, "NMSK": {"XS": 8, "S": 6, "M": 4, "L": 5}}
+#: Thesis Sec 6.3: the fully predictive (FP) NMSK gait's RMSEs lower than the MSK FP's by
+#: (angles, torques, GRFs), per cent.
+THESIS_FP_GAIN_PCT = {"angle": 20.0, "torque": 16.0, "grf": 8.0}
+#: Thesis Sec 6.2.4: mean excitation RMSE of the NMSK FP gait lower than that of the Ch 5
+#: data tracking (Eq 5.55) by, per cent.
+THESIS_FP_EXCITATION_GAIN_PCT = 12.0
+#: Thesis Secs 7.2–7.3: NMSK joint-torque NRMSE lower than the MSK's by, per cent, per class.
+THESIS_TORQUE_GAIN_PCT_CH7 = {"XS": 17.0, "S": 12.0, "M": 10.0, "L": 2.0}
 #: Thesis Sec 5.3.5 / 7.2 and Fig 7.5: (class, speed m/s, COT J kg⁻¹ m⁻¹).
 THESIS_COT_FIG_7_5 = (("XS", 0.90, 2.18), ("S", 1.09, 1.99), ("N", 1.26, 1.53), ("M", 1.29, 1.96), ("L", 1.58, 1.99))
 

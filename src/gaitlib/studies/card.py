@@ -1,0 +1,663 @@
+"""The replication report card: one row per headline number of the thesis, ours beside it.
+
+:func:`build` reads the stored solutions the book uses (never solves: a solution that is not
+stored gives a "not comparable" row) and returns a DataFrame with the columns :data:`COLUMNS`:
+
+``chapter``   thesis chapter (3–7)
+``item``      what is compared, with the thesis's table / figure / section
+``thesis``    the thesis's value (its labelled constant in the study modules) or claim
+``ours``      computed here from the stored solution (a number, or a text for a claim)
+``unit``      SI-ish display unit of both (deg, N*m, N, cm, J/kg/m, %, 1 …)
+``verdict``   :func:`verdict` (the rule below, stated once)
+``cause``     a one-line measured reason with the book page/section that measures it,
+              or ``"unknown"``
+``solution``  the stored solution (cache kind/key and what it is)
+``valid``     its physical validity gates (:func:`gaitlib.validity.check`): ``"valid"``,
+              ``"not converged (…)"`` and/or ``"invalid: …"``
+
+Verdict rule (:func:`verdict`)
+------------------------------
+1. ``not comparable`` — ours is missing (no stored solution, NaN) or the thesis gives no value.
+2. ``invalid`` — the solution failed a validity gate or did not converge: such a row never
+   counts as reproduced, whatever its number.
+3. A claim (ordering, sign, "converges"): ``qualitatively reproduced`` if it holds on ours,
+   else ``not reproduced``.
+4. A number: ``reproduced`` if |ours − thesis| ≤ max(:data:`REL_TOL` × |thesis|,
+   :data:`ABS_TOL` [unit]); else ``within data SD`` if the data give a standard deviation
+   for that quantity (tracking RMSEs: the RMS over the cycle of the data's between-subject
+   SD of the channel) and |ours − thesis| ≤ SD; else ``not reproduced``.
+
+Thesis values are on other data (Bovi 2011; ours Schwartz et al. 2008), so even a perfect
+replication need not reproduce a tracking error; the card says how far each number is, not
+why — the ``cause`` column does that where a page of the book has measured it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .. import cache
+from .. import conventions as cv
+from .. import data as data_mod
+from .. import ocp
+from .. import transcription as tr
+
+__all__ = ["COLUMNS", "VERDICTS", "REL_TOL", "ABS_TOL", "RULE", "verdict", "Row", "StoredGait", "stored_gait",
+           "gate", "build", "counts", "write", "PHYSIOLOGICAL_JUMP_RISE_M"]
+
+COLUMNS = ("chapter", "item", "thesis", "ours", "unit", "verdict", "cause", "solution", "valid")
+VERDICTS = ("reproduced", "within data SD", "qualitatively reproduced", "not reproduced", "not comparable",
+            "invalid")
+#: Relative tolerance of "reproduced": 10 % of the thesis's value.
+REL_TOL = 0.10
+#: Absolute tolerance of "reproduced" per unit (the resolution below which a difference is
+#: not meaningful for the quantity): joint angles 1° (marker-based sagittal kinematics),
+#: torques 1 N·m, forces 2 N, heights 2 cm, COT 0.1 J kg⁻¹ m⁻¹, percentages 5 points,
+#: masses 0.5 kg; dimensionless parameters, time ratios and hours: relative only.
+ABS_TOL = {"deg": 1.0, "N*m": 1.0, "N": 2.0, "cm": 2.0, "J/kg/m": 0.1, "%": 5.0, "kg": 0.5, "s": 0.001}
+#: The rule in one sentence (for the book page).
+RULE = ("reproduced: |ours − thesis| ≤ max(10 % of the thesis's value, the unit's resolution: "
+        + ", ".join(f"{v:g} {u}" for u, v in ABS_TOL.items())
+        + "); within data SD: |ours − thesis| ≤ the data's SD of the quantity (tracking RMSEs: RMS of the "
+          "channel's between-subject SD over the cycle); qualitatively reproduced: the thesis's claim "
+          "(ordering, sign, convergence) holds on ours; not reproduced: otherwise; not comparable: ours "
+          "missing or another quantity; invalid: the solution failed a validity gate or did not converge "
+          "(never counted as reproduced)")
+
+#: Flight COM rise of human standing vertical jumps, m: ≈ 0.2 m (untrained) to ≈ 0.7 m
+#: (trained adults) — e.g. Linthorne NP (2001) "Analysis of standing vertical jumps using a
+#: force platform", Am J Phys 69:1198–1204. The thesis-bounds jumps of Ch 3 are compared
+#: with it in the ``cause`` column (a physiological jump formulation is future work).
+PHYSIOLOGICAL_JUMP_RISE_M = (0.2, 0.7)
+
+_BOOK = "book/"
+#: A foot's load in the data's swing is given as the cause of a vertical-GRF miss when it
+#: makes at least this share (%) of the foot's squared error.
+SWING_SHARE = 20.0  # causes point at the book's pages: <page>#<section anchor>
+
+
+def verdict(thesis, ours, *, unit: str = "", sd: float | None = None, holds: bool | None = None,
+            valid: str = "valid") -> str:
+    """The card's verdict for one row (module docstring, "Verdict rule").
+
+    ``thesis``/``ours``: numbers (same ``unit``), or anything for a claim row, whose outcome
+    is ``holds`` (True/False; None: not evaluated). ``sd``: the data's SD of the quantity
+    (same unit) or None. ``valid``: the solution's gate text; ``"invalid…"`` or
+    ``"not converged…"`` make the row ``invalid``."""
+    if _missing(ours) or _missing(thesis) or (holds is None and not _numeric(thesis, ours)):
+        return "not comparable"
+    if _blocked(valid):
+        return "invalid"
+    if holds is not None:
+        return "qualitatively reproduced" if holds else "not reproduced"
+    d = abs(float(ours) - float(thesis))
+    if d <= max(REL_TOL * abs(float(thesis)), ABS_TOL.get(unit, 0.0)):
+        return "reproduced"
+    if sd is not None and np.isfinite(sd) and d <= float(sd):
+        return "within data SD"
+    return "not reproduced"
+
+
+def _missing(v) -> bool:
+    return v is None or (isinstance(v, (float, np.floating)) and not np.isfinite(v)) or (isinstance(v, str) and not v)
+
+
+def _numeric(*vs) -> bool:
+    return all(isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool) for v in vs)
+
+
+def _blocked(valid: str) -> bool:
+    v = str(valid)
+    return v.startswith("invalid") or v.startswith("not converged") or "; invalid" in v
+
+
+@dataclass
+class Row:
+    """One card row before its verdict (:func:`verdict` is applied by :meth:`record`)."""
+
+    chapter: int
+    item: str
+    thesis: object
+    ours: object
+    unit: str = ""
+    cause: str = "unknown"
+    solution: str = ""
+    valid: str = ""
+    sd: float | None = None
+    holds: bool | None = None
+
+    def record(self) -> dict:
+        v = verdict(self.thesis, self.ours, unit=self.unit, sd=self.sd, holds=self.holds, valid=self.valid)
+        cause = self.cause
+        if v == "invalid":
+            alone = verdict(self.thesis, self.ours, unit=self.unit, sd=self.sd, holds=self.holds)
+            cause = f"{'gates fail (valid column)' if cause == 'unknown' else cause}; the number alone: {alone}"
+        if _missing(self.ours) and cause == "unknown":
+            cause = "no stored solution"
+        def g6(x):  # 6 significant digits for numbers (text kept)
+            return float(f"{float(x):.6g}") if _numeric(x) else x
+
+        return {"chapter": self.chapter, "item": self.item, "thesis": g6(self.thesis), "ours": g6(self.ours),
+                "unit": self.unit,
+                "verdict": v, "cause": cause, "solution": self.solution, "valid": self.valid}
+
+
+def _anchor(page: str, heading: str) -> str:
+    """``book/<page>#<section id>`` of a heading (the ids the book's HTML gives its sections)."""
+    slug = re.sub(r"[^a-z0-9]+", "-", heading.lower().encode("ascii", "ignore").decode()).strip("-")
+    return f"{_BOOK}{page}#{slug}"
+
+
+# ======================================================================================
+# Stored solutions, read without rebuilding their NLP
+# ======================================================================================
+_FRAMES = ("q", "qd", "torques", "torques_active", "residuals", "grf", "ellipsoids", "activations", "excitations",
+           "muscle_activations", "metabolic")
+
+
+class StoredGait:
+    """A stored gait solution read from its entry (``spec.json``, ``summary.json``, the frames
+    and the raw ``ocp/`` solution) without rebuilding the NLP: the attributes of
+    :class:`gaitlib.transcription.GaitSolution` the card and the gates read (``spec``,
+    ``stats``, ``solution``, ``q``, ``torques``, ``grf``, ``rmse`` …; frames absent from the
+    entry are None). ``path``: the entry."""
+
+    def __init__(self, path: Path):
+        self.path = Path(path)
+        self.spec = tr.GaitSpec.from_dict(json.loads((self.path / "spec.json").read_text()))
+        summary = json.loads((self.path / "summary.json").read_text())
+        self.stats = summary["stats"]
+        self.solution = ocp.Solution.load(self.path / "ocp")
+        for name in _FRAMES:
+            f = self.path / f"{name}.csv"
+            setattr(self, name, pd.read_csv(f, index_col=0) if f.is_file() else None)
+        self.rmse = pd.read_csv(self.path / "rmse.csv")
+
+    @property
+    def success(self) -> bool:
+        return bool(self.stats["success"])
+
+    @property
+    def name(self) -> str:
+        s = self.spec
+        return f"{self.path.parent.name}/{self.path.name} ({s.model} {s.cost} {s.speed_class})"
+
+
+def stored_gait(where) -> StoredGait | None:
+    """The gait solution stored at a :func:`gaitlib.cache.lookup` directory (or the same entry
+    in the repository's store) as a :class:`StoredGait`; None if absent."""
+    found = cache.find(where, "spec.json")
+    return StoredGait(found) if found is not None else None
+
+
+def gate(sol, name: str = "") -> str:
+    """The validity text of a solution: ``"valid"``, or :meth:`gaitlib.validity.Gates.label`
+    (``"not converged (…)"``, ``"invalid: …"``). Without :mod:`gaitlib.validity`: the
+    convergence only (``"not gated (converged)"`` or ``"not converged (status)"``)."""
+    try:
+        from .. import validity
+    except ImportError:
+        ok = bool(getattr(sol, "success", False))
+        status = getattr(sol, "status", None) or getattr(sol, "stats", {}).get("status")
+        return "not gated (converged)" if ok else f"not converged ({status})"
+    return validity.label(sol, name=name)
+
+
+@contextlib.contextmanager
+def _memo_data():
+    """Within: :func:`gaitlib.data.load_gait_data` returns one object per distinct call (it
+    re-reads and re-fits the tidy CSV on every call; the card asks for the same classes
+    dozens of times). The callers here never modify the returned data."""
+    orig = data_mod.load_gait_data
+    memo: dict = {}
+
+    def load(*a, **k):
+        key = (a, tuple(sorted(k.items())))
+        if key not in memo:
+            memo[key] = orig(*a, **k)
+        return memo[key]
+
+    data_mod.load_gait_data = load
+    try:
+        yield
+    finally:
+        data_mod.load_gait_data = orig
+
+
+def _rms_sd(gait, col: str, scale: float = 1.0) -> float:
+    """RMS over the cycle of the data's SD of a channel (× ``scale``)."""
+    return float(np.sqrt(np.mean(gait.sd[col].to_numpy(float) ** 2))) * scale
+
+
+def _hours(st: dict) -> float:
+    return (float(st.get("solve_time_s", np.nan)) + float(st.get("build_time_s", np.nan))) / 3600
+
+
+# ======================================================================================
+# Chapter 3: jumps
+# ======================================================================================
+def _ch3() -> list[Row]:
+    from . import jump
+
+    rows, sols, valid = [], {}, {}
+    for n in jump.THESIS:
+        sp = jump.SPECS[n]
+        if cache.find(jump.cache_location(sp), "solution.json") is not None:
+            sols[n] = jump.solve(sp, use_cache=True)
+            valid[n] = gate(sols[n], n)
+    lo, hi = PHYSIOLOGICAL_JUMP_RISE_M
+    why = _anchor("ch03_jump", "What we found")
+    for n, th in jump.THESIS.items():
+        s = sols.get(n)
+        sol_name = f"jump/{cache.find(jump.cache_location(jump.SPECS[n]), 'solution.json').name} ({n})" if s else ""
+        lab = jump.LABELS[n]
+        if s is not None:
+            rise = s.jump_height["com_rise_flight"]
+            peak = max(s.trajectory[f"tau_{j}"].abs().max() for j in s.model.joints)
+            cause = (f"thesis-bounds formulation (Table 3.5 torques to 4000 N·m): COM rise in flight {100 * rise:.0f} cm, "
+                     f"{'outside' if not lo <= rise <= hi else 'inside'} the {100 * lo:.0f}–{100 * hi:.0f} cm of human "
+                     f"standing jumps, peak torque {peak:.0f} N·m — not a human jump; the physiological version is "
+                     f"future work [{why}]")
+            knee = float(s.trajectory["knee"].min() / cv.DEG)
+            mu = float(s.required_friction)
+        else:
+            rise = knee = mu = np.nan
+            cause = "unknown"
+        v = valid.get(n, "")
+        rows += [Row(3, f"{lab}: jump height (Sec 3.4.4; ours: COM rise in flight)", th["jump_height_cm"],
+                     100 * rise, "cm", cause, sol_name, v),
+                 Row(3, f"{lab}: required static friction μ_s (Sec 3.4.3, Fig 3.7)", th["mu_s"], mu, "1", cause,
+                     sol_name, v),
+                 Row(3, f"{lab}: most flexed knee (Sec 3.4.1, Fig 3.3)", th["knee_min_deg"], knee, "deg", cause,
+                     sol_name, v)]
+    if len(sols) == len(jump.THESIS):
+        rise = {n: s.jump_height["com_rise_flight"] for n, s in sols.items()}
+        order = sorted(rise, key=rise.get)
+        v = _joint(valid)
+        rows.append(Row(3, "jump height order toeless < toe < ellipsoid (Sec 3.4.4)", "toeless < toe < ellipsoid",
+                        " < ".join(order), "", f"COM rises {', '.join(f'{n} {100 * r:.0f} cm' for n, r in rise.items())} "
+                        f"[{why}]", "jump (3 solutions)", v, holds=order == ["toeless", "toe", "ellipsoid"]))
+        mu = {n: s.required_friction for n, s in sols.items()}
+        rows.append(Row(3, "ellipsoid contact needs less friction than either welded foot (Sec 3.4.3)",
+                        "μ_s ellipsoid < toeless, toe", ", ".join(f"{n} {m:.2f}" for n, m in mu.items()), "",
+                        "unknown", "jump (3 solutions)", v, holds=mu["ellipsoid"] < min(mu["toeless"], mu["toe"])))
+    return rows
+
+
+# ======================================================================================
+# Chapter 4: contact identification
+# ======================================================================================
+def _ch4() -> list[Row]:
+    from ..model import ChildModel
+    from . import contact_id as ci
+
+    res = {}
+    try:
+        with cache.only("the card reads stored solutions only"):
+            res["a"] = ci.trajectory_optimization()
+            res["b"] = ci.optimal_control()
+            res["c"] = ci.optimal_control_body(warm=res["b"])
+    except cache.NotCached:
+        pass
+    names, valid = {}, {}
+    for k, r in res.items():
+        if r.solution is not None:
+            names[k] = f"{r.solution.spec.model} {r.solution.spec.cost} ({ci.APPROACHES[k]})"
+        else:
+            names[k] = f"contact_id {ci.APPROACHES[k]}, {r.stats['n_local']} local solves"
+        valid[k] = gate(r, k)
+    table = ci.rmse_table(res) if res else pd.DataFrame(columns=["approach", "quantity", "side", "unit", "ours"])
+    gait = data_mod.load_gait_data("Free")
+    ph = ci.grf_error_by_phase(res) if res else None
+    where = _anchor("ch04_contact", "Why the GRF fits differ from the thesis's: where the error is")
+    rows = []
+    for k, th in ci.THESIS_RMSE.items():
+        if k == "c_wide":
+            continue
+        for (qty, side), tv in th.items():
+            m = table[(table["approach"] == k) & (table["quantity"] == qty) & (table["side"] == side)]
+            ours = float(m["ours"].iloc[0]) if len(m) else np.nan
+            unit = "N*m" if qty.startswith("tau") or qty == "R_z" else "N"
+            col = qty if qty.startswith("R_") else f"{qty}_{side}"
+            sd = _rms_sd(gait, col) if col in gait.sd.columns else None
+            cause = "unknown"
+            foot = {"r": "right", "l": "left"}.get(side)
+            p = ph.loc[(ci.APPROACHES[k], foot)] if ph is not None and k in res and foot else None
+            if qty == "grf_y" and p is not None and p["share of squared error in swing (%)"] >= SWING_SHARE:
+                cause = (f"the {foot} foot carries {p['mean simulated force in swing (N)']:.0f} N in the data's swing: "
+                         f"{p['share of squared error in swing (%)']:.0f} % of its squared error [{where}]")
+            item = f"({k}) RMSE {qty}{' ' + side.upper() if side else ''} ({ci.THESIS_RMSE_SOURCE[k]})"
+            rows.append(Row(4, item, tv, ours, unit, cause, names.get(k, ""), valid.get(k, ""), sd=sd))
+    if {"a", "b", "c"} <= set(res):
+        fit = ci.grf_fit(res)["mean GRF RMSE (N)"]
+        m = {k: float(fit[ci.APPROACHES[k]]) for k in res}
+        v = _joint({f"({k})": valid[k] for k in res})
+        sw = ph.loc[ci.APPROACHES["c"]]["mean simulated force in swing (N)"]
+        rows.append(Row(4, "GRF fit ranking (c) < (b) < (a) (Sec 4.4.2, Sec 4.5)", "(c) < (b) < (a)",
+                        ", ".join(f"({k}) {v_:.1f} N" for k, v_ in m.items()) + " mean GRF RMSE", "",
+                        f"(c)'s feet carry {sw['right']:.0f} N (right) and {sw['left']:.0f} N (left) in the data's "
+                        f"swing [{where}]", "contact_id (a), (b), (c)", v,
+                        holds=m["c"] < m["b"] < m["a"]))
+        masses = [i for i, n in enumerate(ci.P_BODY_NAMES) if n.startswith("mass_")]
+        th_mass = _total_mass(ChildModel().p_body_identified(), masses, ci.P_BODY_NAMES)
+        rows.append(Row(4, "(c) total identified mass (Sec 4.4.2; Table 4.15 tuned, both legs)", round(th_mass, 2),
+                        _total_mass(res["c"].p_body, masses, ci.P_BODY_NAMES), "kg", "unknown", names["c"],
+                        valid["c"]))
+    return rows
+
+
+def _total_mass(p, idx, names) -> float:
+    """Whole-body mass (kg) from the body parameters: HAT once, leg segments twice."""
+    return float(sum(p[i] * (1 if "hat" in names[i].lower() else 2) for i in idx))
+
+
+# ======================================================================================
+# Chapter 5: MTG identification, MSK and NMSK tracking, COT
+# ======================================================================================
+def _ch5(bases: dict) -> list[Row]:
+    from .. import mtg
+    from . import gait as sg
+    from . import msk
+    from . import mtg_id
+
+    rows = []
+    # Table 5.2 / Sec 5.1.2: the stored identified MTG set and its provenance
+    f = mtg_id.PARAMS_FILE
+    if f.is_file():
+        doc = json.loads(f.read_text())
+        prov, params = doc["provenance"], doc["params"]
+        v = "not gated (converged)" if prov["success"] else f"not converged ({prov['status']})"
+        name = f"data/identified/{f.name} (MTG identification)"
+        for j, tv in mtg_id.THESIS_RMSE_DEG.items():
+            rows.append(Row(5, f"MTG identification: {j} angle RMSE (Sec 5.1.2)", tv, prov["rmse_deg"].get(j, np.nan),
+                            "deg", "unknown", name, v))
+        for g in mtg.GENERATORS:
+            for k in ("s_tau", "s_V"):
+                rows.append(Row(5, f"MTG {g}: {k} (Table 5.2)", float(getattr(mtg.THESIS_PARAMS[g], k)),
+                                float(params[g][k]), "1", "unknown", name, v))
+    gait = sg.tracking_data(data_mod.load_gait_data("Free"))
+    # Tables 5.4 and 5.11: tracking RMSEs
+    for model, table in (("MSK", "Table 5.4"), ("NMSK", "Table 5.11")):
+        s = bases.get(model)
+        valid = gate(s, model) if s is not None else ""
+        r = s.rmse.set_index(["kind", "channel"])["rmse"] if s is not None else None
+        for (kind, part, side), tv in sg.THESIS_RMSE[model].items():
+            ch = f"grf_{part}_{side}" if kind == "grf" else f"{part}_{side}"
+            col = {"angle": ch, "torque": f"tau_{ch}", "grf": ch}[kind]
+            unit = {"angle": "deg", "torque": "N*m", "grf": "N"}[kind]
+            sd = _rms_sd(gait, col, 1 / cv.DEG if kind == "angle" else 1.0)
+            ours = float(r.get((kind, ch), np.nan)) if r is not None else np.nan
+            rows.append(Row(5, f"{model} RMSE {kind} {part} {side.upper()} ({table})", tv, ours, unit,
+                            "unknown", s.name if s is not None else "", valid, sd=sd))
+    # Table 5.10 and COT: the NMSK solution
+    s = bases.get("NMSK")
+    valid = gate(s, "NMSK") if s is not None else ""
+    ap = s.stats.get("activation_parameters", {}) if s is not None else {}
+    from .. import activation
+
+    for k, tv in msk.THESIS_TABLE_5_10["identified"].items():
+        ours = ap.get(k, np.nan)
+        cause = "unknown"
+        lo, hi = activation.ACTIVATION_BOUNDS[k]
+        if np.isfinite(ours) and min(abs(ours - lo), abs(ours - hi)) <= 1e-3 * (hi - lo):
+            cause = (f"at its bound {lo if abs(ours - lo) < abs(ours - hi) else hi:g} (bounds {lo:g}–{hi:g}) "
+                     f"[{_anchor('ch05_msk', 'Table 5.10: activation parameters')}]")
+        rows.append(Row(5, f"NMSK identified {k} (Table 5.10)", tv, ours, "s" if k == "tau_act" else "1", cause,
+                        s.name if s is not None else "", valid))
+    cot = s.stats.get("COT", np.nan) if s is not None else np.nan
+    cause = "unknown"
+    if s is not None and s.muscle_activations is not None:
+        br = msk.cot_breakdown(s).iloc[:, 0]
+        cause = (f"shortening heat {br['shortening']:.2f} of {br['total']:.2f} J/kg/m (Eq 5.47 as printed) "
+                 f"[{_anchor('ch05_msk', 'Cost of transport (Eq 5.57)')}]")
+    rows.append(Row(5, "NMSK cost of transport, natural speed (Sec 5.3.5, Eq 5.57)", msk.THESIS_COT, cot, "J/kg/m",
+                    cause, s.name if s is not None else "", valid))
+    return rows
+
+
+def _ch5_bases() -> dict:
+    """The Ch 5 MSK and NMSK solutions (Eq 5.33, Eq 5.55) as :class:`StoredGait`."""
+    from . import gait as sg
+    from . import msk
+
+    out = {}
+    b = stored_gait(sg.cache_dir(msk.ch5_spec("MSK")))
+    if b is not None:
+        out["MSK"] = b
+        nb = stored_gait(sg.cache_dir(msk.ch5_spec("NMSK"), guess=b.solution))
+        if nb is not None:
+            out["NMSK"] = nb
+    return out
+
+
+# ======================================================================================
+# Chapters 6 and 7: cost functions and speeds
+# ======================================================================================
+def _runs(bases: dict, which: str) -> dict:
+    """name → StoredGait (or None) of the Ch 6 (``which="ch6"``) or Ch 7 runs, found as
+    :func:`gaitlib.studies.predictive.cost_function_study` / ``speed_study`` store them."""
+    from . import gait as sg
+    from . import predictive as pr
+
+    out = {}
+    for m, base in bases.items():
+        if which == "ch6":
+            specs = pr.ch6_specs(m, base, pr.CH6_COSTS, **pr.default_params())
+            guesses = {k: pr.run_guess(base, pr.GUESS_POLICY[m]) for k in specs}
+        else:
+            specs = pr.ch7_specs(m, base, pr.CH7_CLASSES, **pr.default_params())
+            guesses = {}
+            for k, s in specs.items():
+                g = data_mod.load_gait_data(s.speed_class, s.source)
+                guesses[k] = pr.run_guess(base, pr.GUESS_POLICY[m], cycle_time=g.cycle_time,
+                                          stride=g.speed * g.cycle_time)
+        for k, s in specs.items():
+            out[k] = stored_gait(sg.cache_dir(s, guess=guesses[k]))
+    return out
+
+
+def _mean(df: pd.DataFrame, kind: str | None = None, col: str = "nrmse") -> float:
+    d = df if kind is None else df[df["kind"] == kind]
+    return float(d[col].mean()) if len(d) else np.nan
+
+
+def _joint(valids: dict) -> str:
+    """The validity text of a row computed from several solutions (name → gate text):
+    ``"valid"`` when none is blocked, else ``"invalid: …"`` / ``"not converged: …"`` naming
+    the blocked ones."""
+    bad = {k: v or "missing" for k, v in valids.items() if _blocked(v) or not v}
+    if not bad:
+        return "valid"
+    head = "invalid" if any("invalid" in v for v in bad.values()) else "not converged"
+    return f"{head}: " + "; ".join(f"{k} ({_short(v)})" for k, v in bad.items())
+
+
+def _short(label: str) -> str:
+    """The failed checks' names of a gate label (``"swing load, double support"``)."""
+    parts = re.split(r"; |: ", label.replace("invalid: ", ""))
+    names = [re.sub(r"\s*[-\d(].*$", "", p).strip() for p in parts]
+    return ", ".join(dict.fromkeys(n for n in names if n))
+
+
+def _ch6(bases: dict, runs: dict, valid: dict) -> list[Row]:
+    from . import predictive as pr
+
+    rows = []
+    status = _anchor("ch06_costfun", "Did every run converge? Solver statistics and Table 6.3")
+    for model, hours in pr.THESIS_HOURS_TABLE_6_3.items():
+        for c, h in hours.items():
+            s = runs.get(f"{model} {c}")
+            ours = f"{s.stats['status']}, {s.stats['iterations']} it, {_hours(s.stats):.2f} h" if s else np.nan
+            cause = "unknown" if s is None or s.success else \
+                f"{s.stats['status']} after {s.stats['iterations']} iterations [{status}]"
+            rows.append(Row(6, f"{model} {c} converges (Table 6.3: {h} h)", f"converged, {h} h", ours, "", cause,
+                            s.name if s else "", valid.get(f"{model} {c}", ""), holds=bool(s and s.success)))
+    free = data_mod.load_gait_data("Free")
+    sc = {k: pr.score(s, free) for k, s in runs.items() if s is not None}
+    # which model tracks better, per cost function (Sec 6.2.3; mean NRMSE of angles, torques, GRFs)
+    for c, better in (("SDT2", "MSK"), ("SP3", "MSK"), ("SDT1", "NMSK"), ("SP2", "NMSK"), ("FP", "NMSK")):
+        a, b = f"MSK {c}", f"NMSK {c}"
+        if a in sc and b in sc:
+            ma, mb = _mean(sc[a]), _mean(sc[b])
+            holds = (ma < mb) if better == "MSK" else (mb < ma)
+            ours = f"mean NRMSE MSK {ma:.3f}, NMSK {mb:.3f}"
+        else:
+            holds, ours = None, np.nan
+        worse = "NMSK" if better == "MSK" else "MSK"
+        rows.append(Row(6, f"{c}: {better} more accurate than {worse} (Sec 6.2.3)", f"{better} < {worse}", ours, "",
+                        "unknown", f"Ch 6 {a}, {b}",
+                        _joint({a: valid.get(a, ""), b: valid.get(b, "")}), holds=holds))
+    # the fully predictive NMSK vs MSK: % lower RMSE (Sec 6.3)
+    for kind, tv in pr.THESIS_FP_GAIN_PCT.items():
+        a, b = "MSK FP", "NMSK FP"
+        ours = (100 * (1 - _mean(sc[b], kind, "rmse") / _mean(sc[a], kind, "rmse"))) if a in sc and b in sc else np.nan
+        rows.append(Row(6, f"FP: NMSK {kind} RMSE lower than MSK's by (Sec 6.3)", tv, ours, "%", "unknown",
+                        f"Ch 6 {a}, {b}", _joint({a: valid.get(a, ""), b: valid.get(b, "")})))
+    th = pr.THESIS_HOURS_TABLE_6_3
+    a, b = runs.get("MSK FP"), runs.get("NMSK FP")
+    rows.append(Row(6, "FP: NMSK compute time lower than MSK's by (Sec 6.2.4, Table 6.3)",
+                    100 * (1 - th["NMSK"]["FP"] / th["MSK"]["FP"]),
+                    100 * (1 - _hours(b.stats) / _hours(a.stats)) if a and b else np.nan, "%", "unknown",
+                    "Ch 6 MSK FP, NMSK FP", _joint({k: valid.get(k, "") for k in ("MSK FP", "NMSK FP")})))
+    ms = [runs.get(f"MSK {c}") for c in pr.CH6_COSTS]
+    ns = [runs.get(f"NMSK {c}") for c in pr.CH6_COSTS]
+    ok = all(ms) and all(ns)
+    rows.append(Row(6, "all 8 MSK runs' compute time ÷ all 8 NMSK runs' (Sec 6.3, Table 6.3)",
+                    sum(th["MSK"].values()) / sum(th["NMSK"].values()),
+                    sum(_hours(s.stats) for s in ms) / sum(_hours(s.stats) for s in ns) if ok else np.nan, "1",
+                    "unknown", "Ch 6, 16 runs", _joint({k: valid.get(k, "") for k in runs})))
+    # excitations: SDT3 the most accurate NMSK run; FP vs the Ch 5 tracking (Secs 6.2.3–6.2.4)
+    ex = {c: float(pr.excitation_score(runs[f"NMSK {c}"], free)["rmse"].mean())
+          for c in pr.CH6_COSTS if runs.get(f"NMSK {c}") is not None}
+    best = min(ex, key=ex.get) if ex else None
+    rows.append(Row(6, "NMSK SDT3 predicts the most accurate excitations (Sec 6.2.3)", "SDT3",
+                    f"{best} (mean RMSE {ex[best]:.3f}; SDT3 {ex.get('SDT3', np.nan):.3f})" if best else np.nan, "",
+                    "unknown", "Ch 6 NMSK, 8 runs", _joint({f"NMSK {c}": valid.get(f"NMSK {c}", "") for c in pr.CH6_COSTS}),
+                    holds=(best == "SDT3") if best else None))
+    n5 = bases.get("NMSK")
+    ours = np.nan
+    if n5 is not None and "FP" in ex:
+        e5 = float(pr.excitation_score(n5, free)["rmse"].mean())
+        ours = 100 * (1 - ex["FP"] / e5)
+    rows.append(Row(6, "NMSK FP excitation RMSE lower than the Ch 5 data tracking's by (Sec 6.2.4)",
+                    pr.THESIS_FP_EXCITATION_GAIN_PCT, ours, "%", "unknown", "Ch 6 NMSK FP, Ch 5 NMSK",
+                    _joint({"NMSK FP": valid.get("NMSK FP", ""), "Ch 5 NMSK": gate(n5, "NMSK") if n5 is not None else ""})))
+    return rows
+
+
+def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict) -> list[Row]:
+    from . import predictive as pr
+
+    rows = []
+    inv = {v: k for k, v in pr.THESIS_CLASS.items()}
+    status = _anchor("ch07_speed", "Compute times (thesis Table 7.2)")
+    for model, hours in pr.THESIS_HOURS_TABLE_7_2.items():
+        for tc, h in hours.items():
+            k = f"{model} {inv[tc]}"
+            s = runs.get(k)
+            ours = f"{s.stats['status']}, {s.stats['iterations']} it, {_hours(s.stats):.2f} h" if s else np.nan
+            cause = "unknown" if s is None or s.success else \
+                f"{s.stats['status']} after {s.stats['iterations']} iterations [{status}]"
+            rows.append(Row(7, f"{model} {inv[tc]} ({tc}) converges (Table 7.2: {h} h)", f"converged, {h} h", ours, "",
+                            cause, s.name if s else "", valid.get(k, ""), holds=bool(s and s.success)))
+    th = pr.THESIS_HOURS_TABLE_7_2
+    ms = [runs.get(f"MSK {c}") for c in pr.CH7_CLASSES]
+    ns = [runs.get(f"NMSK {c}") for c in pr.CH7_CLASSES]
+    ok = all(ms) and all(ns)
+    rows.append(Row(7, "all 4 MSK runs' compute time ÷ all 4 NMSK runs' (Sec 7.3, Table 7.2)",
+                    sum(th["MSK"].values()) / sum(th["NMSK"].values()),
+                    sum(_hours(s.stats) for s in ms) / sum(_hours(s.stats) for s in ns) if ok else np.nan, "1",
+                    "unknown", "Ch 7, 8 runs", _joint({k: valid.get(k, "") for k in runs})))
+    # NMSK torques more accurate than MSK's per class (Sec 7.2)
+    for tc, tv in pr.THESIS_TORQUE_GAIN_PCT_CH7.items():
+        c = inv[tc]
+        a, b = runs.get(f"MSK {c}"), runs.get(f"NMSK {c}")
+        ours = np.nan
+        if a is not None and b is not None:
+            g = data_mod.load_gait_data(c, a.spec.source)
+            ours = 100 * (1 - _mean(pr.score(b, g), "torque") / _mean(pr.score(a, g), "torque"))
+        rows.append(Row(7, f"{c} ({tc}): NMSK torque NRMSE lower than MSK's by (Sec 7.2)", tv, ours, "%",
+                        "unknown", f"Ch 7 MSK {c}, NMSK {c}",
+                        _joint({f"MSK {c}": valid.get(f"MSK {c}", ""), f"NMSK {c}": valid.get(f"NMSK {c}", "")})))
+    # Fig 7.5: COT against speed; the natural-speed point is the like-for-like Ch 6 NMSK DT
+    cot_page = _anchor("ch07_speed", "Cost of transport against speed (thesis Fig 7.5)")
+    pts, vals = {}, {}
+    n5 = bases.get("NMSK")
+    for tc, speed, tv in pr.THESIS_COT_FIG_7_5:
+        c = inv[tc]
+        s = ch6.get("NMSK DT") if c == "Free" else runs.get(f"NMSK {c}")
+        v = valid6.get("NMSK DT", "") if c == "Free" else valid.get(f"NMSK {c}", "")
+        cot = float(s.stats.get("COT", np.nan)) if s is not None else np.nan
+        cause = "unknown"
+        if c == "Free" and n5 is not None:
+            cause = (f"ours: Ch 6 NMSK DT (the cost of the other points); the Ch 5 NMSK (Eq 5.55, its own "
+                     f"activation parameters) gives {n5.stats.get('COT', np.nan):.2f} [{cot_page}]")
+        g = data_mod.load_gait_data(c)
+        pts[c] = (g.speed, cot)
+        vals[f"NMSK {c}"] = v
+        rows.append(Row(7, f"COT at {c} ({tc}, thesis {speed} m/s; ours {g.speed:.2f} m/s) (Fig 7.5)", tv, cot,
+                        "J/kg/m", cause, s.name if s is not None else "", v))
+    if all(np.isfinite(v[1]) for v in pts.values()) and len(pts) == 5:
+        order = sorted(pts, key=lambda k: pts[k][0])
+        cots = [pts[k][1] for k in order]
+        i = int(np.argmin(cots))
+        holds = order[i] == "Free" and 0 < i < len(cots) - 1
+        ours = ", ".join(f"{k} {pts[k][1]:.2f}" for k in order) + f" (minimum at {order[i]})"
+    else:
+        holds, ours = None, np.nan
+    rows.append(Row(7, "COT against speed is U-shaped with its minimum at the natural speed (Sec 7.2, Fig 7.5)",
+                    "U, minimum at natural speed", ours, "", "unknown",
+                    "Ch 6 NMSK DT, Ch 7 NMSK", _joint(vals), holds=holds))
+    return rows
+
+
+# ======================================================================================
+# The card
+# ======================================================================================
+def build(chapters=(3, 4, 5, 6, 7)) -> pd.DataFrame:
+    """The report card (module docstring) from the stored solutions; never solves
+    (:func:`gaitlib.cache.only`: a missing solution is a "not comparable" row)."""
+    with _memo_data(), cache.only("the card reads stored solutions only"):
+        return _build(tuple(chapters))
+
+
+def _build(chapters) -> pd.DataFrame:
+    rows: list[Row] = []
+    if 3 in chapters:
+        rows += _ch3()
+    if 4 in chapters:
+        rows += _ch4()
+    bases = _ch5_bases() if {5, 6, 7} & set(chapters) else {}
+    if 5 in chapters:
+        rows += _ch5(bases)
+    ch6 = _runs(bases, "ch6") if {6, 7} & set(chapters) else {}
+    valid6 = {k: gate(s, k) for k, s in ch6.items() if s is not None}
+    if 6 in chapters:
+        rows += _ch6(bases, ch6, valid6)
+    if 7 in chapters:
+        ch7 = _runs(bases, "ch7")
+        valid7 = {k: gate(s, k) for k, s in ch7.items() if s is not None}
+        rows += _ch7(bases, ch7, valid7, ch6, valid6)
+    return pd.DataFrame([r.record() for r in rows], columns=list(COLUMNS))
+
+
+def counts(card: pd.DataFrame) -> pd.Series:
+    """Number of rows per verdict (every verdict listed, zeros included)."""
+    return card["verdict"].value_counts().reindex(list(VERDICTS), fill_value=0)
+
+
+def write(out) -> Path:
+    """Write ``card.csv`` into the directory ``out`` (created)."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    f = out / "card.csv"
+    build().to_csv(f, index=False, float_format="%.6g")
+    return f

@@ -1,0 +1,127 @@
+"""The replication report card: the verdict rule on hand-made cases, the card's shape from the
+stored solutions, and that ``ours`` is read from the solutions (never typed)."""
+
+import math
+import shutil
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from gaitlib import cache
+from gaitlib.cli import main
+from gaitlib.studies import card
+from gaitlib.studies import gait as sg
+from gaitlib.studies import msk
+
+
+# --------------------------------------------------------------------------------------
+# The verdict rule
+# --------------------------------------------------------------------------------------
+@pytest.mark.parametrize("thesis, ours, unit, sd, expected", [
+    (10.0, 10.9, "1", None, "reproduced"),          # 9 % off
+    (100.0, 111.0, "1", None, "not reproduced"),    # 11 % off, no absolute tolerance for "1"
+    (0.6, 1.5, "deg", None, "reproduced"),          # 0.9° ≤ 1° resolution although 150 % off
+    (0.6, 3.0, "deg", 4.0, "within data SD"),       # 2.4° > 1°, ≤ SD 4°
+    (0.6, 3.0, "deg", 2.0, "not reproduced"),       # 2.4° > SD 2°
+    (26.49, 65.3, "N", 40.0, "within data SD"),
+    (1.53, 5.12, "J/kg/m", None, "not reproduced"),
+    (-150.0, -149.99, "deg", None, "reproduced"),   # sign kept: |d| = 0.01
+    (0.0, 0.9, "N", None, "reproduced"),            # a zero thesis value: the unit's resolution
+    (0.0, 2.1, "N", None, "not reproduced"),
+])
+def test_verdict_numbers(thesis, ours, unit, sd, expected):
+    assert card.verdict(thesis, ours, unit=unit, sd=sd) == expected
+
+
+def test_verdict_missing_and_claims():
+    assert card.verdict(1.53, float("nan")) == "not comparable"
+    assert card.verdict(1.53, None) == "not comparable"
+    assert card.verdict(None, 1.0) == "not comparable"
+    assert card.verdict("a < b", "b < a") == "not comparable"  # text without an evaluated claim
+    assert card.verdict("a < b", "a 1 < b 2", holds=True) == "qualitatively reproduced"
+    assert card.verdict("a < b", "b 1 < a 2", holds=False) == "not reproduced"
+
+
+def test_invalid_never_reproduced():
+    """A solution that failed a gate or did not converge gives "invalid", even for an exact number
+    or a claim that holds; the number-alone verdict stays in the cause."""
+    for valid in ("invalid: swing load 55 N > 8.12 N (2 % BW)", "not converged (Maximum_Iterations_Exceeded)",
+                  "not converged (Maximum_Iterations_Exceeded); invalid: double support 90% > 40%"):
+        assert card.verdict(1.53, 1.53, unit="J/kg/m", valid=valid) == "invalid"
+        assert card.verdict("U", "U", holds=True, valid=valid) == "invalid"
+    rec = card.Row(5, "x", 1.53, 1.53, "J/kg/m", valid="invalid: swing load 55 N > 8.12 N").record()
+    assert rec["verdict"] == "invalid" and "the number alone: reproduced" in rec["cause"]
+    assert card.verdict(1.53, 1.53, valid="valid") == "reproduced"
+    assert card.verdict(1.53, 1.53, valid="not gated (converged)") == "reproduced"
+
+
+def test_joint_validity():
+    assert card._joint({"a": "valid", "b": "valid"}) == "valid"
+    j = card._joint({"a": "valid", "b": "not converged (Maximum_Iterations_Exceeded); invalid: swing load 9 N > 8 N"})
+    assert j.startswith("invalid") and "b (not converged, swing load)" in j
+    assert card._joint({"a": "not converged (X)"}).startswith("not converged")
+    assert card._joint({"a": ""}).startswith("not converged")  # a missing solution blocks too
+
+
+# --------------------------------------------------------------------------------------
+# The card from the stored solutions (one CLI run)
+# --------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def cli_card(tmp_path_factory):
+    out = tmp_path_factory.mktemp("card")
+    assert main(["card", "--out", str(out)]) == 0
+    return pd.read_csv(out / "card.csv")
+
+
+def test_cli_writes_card(cli_card):
+    c = cli_card
+    assert tuple(c.columns) == card.COLUMNS
+    assert len(c) >= 40
+    assert set(c["verdict"]) <= set(card.VERDICTS)
+    assert set(c["chapter"]) == {3, 4, 5, 6, 7}
+    assert c["thesis"].notna().all() and c["item"].is_unique
+    # a blocked solution never yields "reproduced"
+    blocked = c["valid"].fillna("").str.contains("invalid|not converged")
+    assert not (blocked & c["verdict"].isin(["reproduced", "within data SD", "qualitatively reproduced"])).any()
+    # the thesis-bounds jumps say why they are not a human jump
+    jumps = c[(c["chapter"] == 3) & c["item"].str.contains("jump height \\(")]
+    assert len(jumps) == 3 and jumps["cause"].str.contains("human standing jumps").all()
+    assert (card.counts(c).sum() == len(c))
+
+
+def test_card_reads_the_stored_numbers(tmp_path, monkeypatch):
+    """Change a stored number in a copy of the Ch 5 MSK entry: the card's row follows it."""
+    where = sg.cache_dir(msk.ch5_spec("MSK"))
+    found = cache.find(where, "spec.json")
+    if found is None:
+        pytest.skip("the Ch 5 MSK solution is not stored")
+    store = tmp_path / "store"
+    entry = store / found.parent.name / found.name
+    shutil.copytree(found, entry)
+    rm = pd.read_csv(entry / "rmse.csv")
+    i = rm.index[(rm["kind"] == "angle") & (rm["channel"] == "hip_r")][0]
+    rm.loc[i, "rmse"] = 0.65  # thesis Table 5.4: 0.6°
+    rm.to_csv(entry / "rmse.csv", index=False)
+    if hasattr(cache, "write_manifest"):  # stores that verify their entries
+        cache.write_manifest(entry)
+    monkeypatch.setenv("GAITLIB_STORE", str(store))
+    monkeypatch.setenv("GAITLIB_SOLUTIONS", str(tmp_path / "empty"))
+    c = card.build(chapters=(5,))
+    row = c[c["item"] == "MSK RMSE angle hip R (Table 5.4)"].iloc[0]
+    assert math.isclose(row["ours"], 0.65)
+    assert row["solution"].startswith(f"{found.parent.name}/{found.name}")
+    # the NMSK solution is not in this store: its rows are not comparable, never typed in
+    nm = c[c["item"].str.startswith("NMSK RMSE")]
+    assert len(nm) == 16 and nm["ours"].isna().all() and (nm["verdict"] == "not comparable").all()
+    assert np.isfinite(row["thesis"])
+
+
+def test_card_never_solves(tmp_path, monkeypatch):
+    """Without stored solutions the rows are "not comparable" and nothing is solved or written."""
+    monkeypatch.setenv("GAITLIB_STORE", "")
+    monkeypatch.setenv("GAITLIB_SOLUTIONS", str(tmp_path / "cache"))
+    c = card.build(chapters=(3, 4))
+    assert len(c) >= 30 and (c["verdict"] == "not comparable").all()
+    assert (c["cause"] == "no stored solution").all()
+    assert not (tmp_path / "cache").exists() or not any((tmp_path / "cache").rglob("*.json"))
