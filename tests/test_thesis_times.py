@@ -10,6 +10,8 @@ import casadi
 import numpy as np
 import pytest
 
+from gaitlib import cache
+
 from gaitlib import ocp
 from gaitlib import transcription as tr
 from gaitlib.studies import contact_id, msk, predictive
@@ -126,19 +128,15 @@ def test_stored_table_is_consistent():
 
 
 def test_no_solving_refuses_and_restores(tmp_path, monkeypatch):
+    """Inside no_solving a study that would solve raises before any symbolic work (no entry
+    written), and patches nothing: afterwards the same call solves."""
     from gaitlib.studies import gait
 
     monkeypatch.setenv("GAITLIB_STORE", "")
-    solve, nlpsol, init = tr.solve, casadi.nlpsol, ocp.Transcription.__init__
     with perf.no_solving("cached only"):
         with pytest.raises(perf.NotInCache, match="cached only"):
             gait.natural_gait("SK", root=tmp_path, n_intervals=2, degree=2)  # empty cache: would solve
-        x = casadi.SX.sym("x")
-        with pytest.raises(perf.NotInCache):
-            casadi.nlpsol("s", "ipopt", {"x": x, "f": x**2})
-    assert tr.solve is solve and casadi.nlpsol is nlpsol and ocp.Transcription.__init__ is init
     assert not any(tmp_path.rglob("spec.json"))  # nothing stored
-    # restored: a tiny NLP solves again
-    x = casadi.SX.sym("x")
-    s = casadi.nlpsol("s", "ipopt", {"x": x, "f": (x - 1) ** 2}, {"print_time": False, "ipopt.print_level": 0})
-    assert float(s(x0=0)["x"]) == pytest.approx(1.0) and np.isfinite(float(s.stats()["iter_count"]))
+    assert perf.NotInCache is cache.NotCached
+    sol = gait.natural_gait("SK", root=tmp_path, n_intervals=2, degree=2, max_iter=3)
+    assert sol.stats["iterations"] <= 3 and any(tmp_path.rglob("spec.json"))

@@ -229,10 +229,12 @@ def _valid(path: Path, marker: str) -> bool:
         return False
 
 
-def find(where: Path, marker: str) -> Path | None:
+def find(where: Path, marker: str, *, to_solve: bool = True) -> Path | None:
     """``where`` (a :func:`lookup` result) if it holds a verified entry with ``marker``;
     else the same entry in :func:`store_dir` if present and verified there; else None.
-    A corrupt entry is reported (:class:`CacheWarning`) and skipped, never served."""
+    A corrupt entry is reported (:class:`CacheWarning`) and skipped, never served.
+    ``to_solve``: the caller solves when nothing is found (inside :func:`only` a miss then
+    raises :class:`NotCached`); False for a caller that only reads what is there."""
     where = Path(where)
     found = None
     if where.exists() and _valid(where, marker):
@@ -245,7 +247,7 @@ def find(where: Path, marker: str) -> Path | None:
                 found = cand
     if found is not None:
         _log_use(found)
-    elif os.environ.get(ONLY_ENV):
+    elif to_solve and os.environ.get(ONLY_ENV):
         raise NotCached(f"{where}: not cached or stored ({os.environ[ONLY_ENV]})")
     return found
 

@@ -194,7 +194,7 @@ class StoredGait:
 def stored_gait(where) -> StoredGait | None:
     """The gait solution stored at a :func:`gaitlib.cache.lookup` directory (or the same entry
     in the repository's store) as a :class:`StoredGait`; None if absent."""
-    found = cache.find(where, "spec.json")
+    found = cache.find(where, "spec.json", to_solve=False)
     return StoredGait(found) if found is not None else None
 
 
@@ -250,14 +250,14 @@ def _ch3() -> list[Row]:
     rows, sols, valid = [], {}, {}
     for n in jump.THESIS:
         sp = jump.SPECS[n]
-        if cache.find(jump.cache_location(sp), "solution.json") is not None:
+        if cache.find(jump.cache_location(sp), "solution.json", to_solve=False) is not None:
             sols[n] = jump.solve(sp, use_cache=True)
             valid[n] = gate(sols[n], n)
     lo, hi = PHYSIOLOGICAL_JUMP_RISE_M
     why = _anchor("ch03_jump", "What we found")
     for n, th in jump.THESIS.items():
         s = sols.get(n)
-        sol_name = f"jump/{cache.find(jump.cache_location(jump.SPECS[n]), 'solution.json').name} ({n})" if s else ""
+        sol_name = f"jump/{cache.find(jump.cache_location(jump.SPECS[n]), 'solution.json', to_solve=False).name} ({n})" if s else ""
         lab = jump.LABELS[n]
         if s is not None:
             rise = s.jump_height["com_rise_flight"]

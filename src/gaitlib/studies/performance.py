@@ -289,7 +289,6 @@ def measured_on(res: dict) -> str:
 # Thesis times (issue 8, item 1): every optimisation the book runs beside the thesis's time
 # ======================================================================================
 from dataclasses import dataclass  # noqa: E402
-import contextlib  # noqa: E402
 import math  # noqa: E402
 import re  # noqa: E402
 
@@ -531,7 +530,6 @@ def thesis_times_figure(res: dict | None = None):
 NotInCache = cache.NotCached
 
 
-@contextlib.contextmanager
 def no_solving(what: str = "solving is disabled (--cached-only)"):
     """Within the block, a solve of anything not cached raises :class:`NotInCache`
     (:func:`gaitlib.cache.only`); cached solutions still load."""
