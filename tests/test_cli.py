@@ -243,6 +243,18 @@ def test_write_twin_raises_on_a_failed_solve(monkeypatch, tmp_path):
     assert not any(tmp_path.iterdir())
 
 
+def test_a_twin_without_a_converged_baseline_counts_as_a_miss():
+    from gaitlib.gap.twin import TwinValidation
+
+    truth = {"friction@1#1": {"effects": (("friction", -0.3),), "seed": 1, "level": 1}}
+    tv = TwinValidation.build({}, truth, {"friction": (-0.15, -0.3, -0.45)}, {}, settings={
+        "effects": ["friction"], "baseline_failed": {"friction@1#1": {"cold": FAILED}}})
+    assert tv.rows[["twin", "top", "correct"]].values.tolist() == [["friction@1#1", "baseline failed", False]]
+    acc = tv.accuracy()
+    assert acc.loc["middle", "twins"] == 1 and acc.loc["middle", "top-1 accuracy (%)"] == 0.0
+    assert tv.confusion.loc["friction", "baseline failed"] == 1
+
+
 def group(arg):
     """A sweep item returning a group of solutions (as gaitlib.gap.solve.solve_many's)."""
     return {f"k{i}": Fake(s) for i, s in enumerate(arg)}

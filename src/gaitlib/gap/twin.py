@@ -186,7 +186,8 @@ def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), 
     seed), diagnose each with the baseline model only, and score the diagnosis.
 
     Returns a :class:`TwinValidation`; a twin none of whose baseline starts converged is not
-    diagnosed and is listed in ``settings["baseline_failed"]`` (start → status). Cost: (#twins + #seeds) twin solves, the baseline
+    diagnosed: its row says ``top = "baseline failed"`` (a miss) and
+    ``settings["baseline_failed"]`` lists its starts' statuses. Cost: (#twins + #seeds) twin solves, the baseline
     fits per twin (:data:`gaitlib.gap.diagnose.BASELINE_STARTS`: up to 8 solves), one
     re-solve per candidate per twin (and, for a candidate that fails or ends above the
     baseline, one per other baseline start), all through
@@ -361,6 +362,13 @@ class TwinValidation:
                 "true_start": (d.fits[inj].solution.stats.get("retry_start", "best")
                                if inj in d.fits and d.fits[inj].solution is not None else None),
             })
+        for key in (settings or {}).get("baseline_failed", {}):  # no baseline: a miss, never dropped
+            t = truth[key]
+            rows.append({"twin": key, "injected": t["effects"][0][0] if t["effects"] else "none",
+                         "magnitude": t["effects"][0][1] if t["effects"] else 0.0, "level": t["level"],
+                         "seed": t["seed"], "top": "baseline failed", "verdict": "baseline failed", "correct": False,
+                         "shrink_injected_top": np.nan, "shrink_injected_true": np.nan,
+                         "shrink_vs_noise_top": np.nan})
         return cls(pd.DataFrame(rows), diags, gen_stats, settings)
 
     @property
