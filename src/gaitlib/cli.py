@@ -154,7 +154,12 @@ class Output:
             parent.mkdir(parents=True, exist_ok=True)
             self.tmp = Path(tempfile.mkdtemp(prefix=f".{f.name}.partial-", dir=parent))
         except OSError as e:
-            raise CLIError(f"{option} {f}: cannot write in {parent} ({e.strerror or e})") from None
+            if not f.is_dir():
+                raise CLIError(f"{option} {f}: cannot write in {parent} ({e.strerror or e})") from None
+            try:  # a writable folder in a read-only one: stage inside it
+                self.tmp = Path(tempfile.mkdtemp(prefix=".partial-", dir=f))
+            except OSError as e2:
+                raise CLIError(f"{option} {f}: cannot write in it ({e2.strerror or e2})") from None
         os.chmod(self.tmp, 0o777 & ~_umask())
 
     def __enter__(self) -> "Output":
@@ -171,7 +176,8 @@ class Output:
     def _commit(self):
         f = self.folder
         new = sorted(p.name for p in self.tmp.iterdir())
-        if self.files is None and (not f.exists() or not any(f.iterdir())):
+        inside = self.tmp.parent == f
+        if not inside and (not f.exists() or (self.files is None and not any(f.iterdir()))):
             os.replace(self.tmp, f)
             return
         f.mkdir(exist_ok=True)
