@@ -187,10 +187,10 @@ def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), 
 
     Returns a :class:`TwinValidation`; a twin none of whose baseline starts converged is not
     diagnosed: its row says ``top = "baseline failed"`` (a miss) and
-    ``settings["baseline_failed"]`` lists its starts' statuses. Cost: (#twins + #seeds) twin solves, the baseline
-    fits per twin (:data:`gaitlib.gap.diagnose.BASELINE_STARTS`: up to 8 solves), one
-    re-solve per candidate per twin (and, for a candidate that fails or ends above the
-    baseline, one per other baseline start), all through
+    ``settings["baseline_failed"]`` lists its starts' statuses. Cost: (#twins + #seeds)
+    twin solves, the baseline fits per twin (:data:`gaitlib.gap.diagnose.BASELINE_STARTS`:
+    up to 8 solves), one re-solve per candidate per twin (and, for a candidate that fails
+    or ends above the baseline, one per other baseline start), all through
     :func:`gaitlib.sweep.sweep` (one item per spec, built once and re-solved on every twin
     by swapping the NLP's data).
     """
