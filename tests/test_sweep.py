@@ -168,7 +168,8 @@ def test_existing_cluster_gives_bitwise_the_serial_results(serial, dask_cluster,
                                                      rel=1e-12)
     assert (out / "SK_DT_Slow" / "summary.json").exists()
     rc = cli.main(["sweep", "--model", "SK", "--costs", "DT", "--speeds", "Free", "--intervals", "8", "--degree", "3",
-                   "--max-iter", "3", "--scheduler", address, "--cache", str(root), "--no-figures", "--out", str(out)])
+                   "--max-iter", "3", "--scheduler", address, "--cache", str(root), "--no-figures", "--out", str(out),
+                   "--overwrite"])
     table = pd.read_csv(out / "sweep.csv")
     assert rc == 2 and list(table["status"]) == ["Maximum_Iterations_Exceeded"] and not table["ok"].any()
     # an exception on a remote worker is reported too; the cluster stays up for the next call

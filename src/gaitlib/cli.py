@@ -20,13 +20,200 @@ Commands
                      injected effect, in the tidy format
 ``cache verify [--remove] [--root DIR]``   check every cached solution against its checksums;
                      ``--remove`` deletes the corrupt or incomplete ones (they are re-solved on use)
+
+Exit status: 0 when every solve the reported result rests on converged (IPOPT
+``Solve_Succeeded`` or ``Solved_To_Acceptable_Level``); 2 otherwise — a run that did not
+converge (its outputs are written, with its status), a sweep with a failed run, a gap
+diagnosis with a candidate that did not converge — and on every error or refusal (one line
+``gaitlib <command>: <message>`` on stderr; ``--debug`` shows the traceback): bad options
+(checked before any solve), an output that exists (``--overwrite``) or cannot be written,
+a gap baseline none of whose starts converged (``baseline failed: <statuses>``), a twin
+whose generating solve did not converge (nothing written).
+
+Outputs: ``--out`` and the solutions cache are checked for writability before any solve.
+Results are written to a temporary folder next to ``--out`` (``.<name>.partial-*``) and
+moved into place at the end, so an interrupted command leaves no half-written result. An
+existing non-empty ``--out`` is refused unless ``--overwrite``, which replaces only the
+files the command owns: ``run`` — the files its new ``summary.json`` lists and those the
+old one listed; ``sweep`` — ``sweep.csv`` and the run folders of the new and the old
+``sweep.csv``; ``gap`` — ``diagnosis.json``, ``located.csv``, ``ranking.csv``,
+``shrink_*.csv`` and its figures; ``gap-twin`` — the CSV and its ``.truth.json``. Other
+files in the folder are kept.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import math
+import os
+import shutil
 import sys
+import tempfile
+from pathlib import Path
 
+#: Exit status of errors, refusals and results that rest on a solve that did not converge.
+EXIT_FAILED = 2
+
+
+class CLIError(Exception):
+    """A user-facing error: printed as one line ``gaitlib <command>: <message>``, exit 2."""
+
+
+# -- option types (checked at parse time, before anything is read or solved) ----------
+
+def int_at_least(lo: int):
+    """argparse type: an integer ≥ ``lo``."""
+
+    def parse(text: str) -> int:
+        try:
+            v = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer >= {lo}, got {text!r}") from None
+        if v < lo:
+            raise argparse.ArgumentTypeError(f"expected an integer >= {lo}, got {v}")
+        return v
+
+    parse.__name__ = f"integer >= {lo}"
+    return parse
+
+
+def finite_float(text: str) -> float:
+    """argparse type: a finite number."""
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not math.isfinite(v):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+    return v
+
+
+class _Parser(argparse.ArgumentParser):
+    """An ArgumentParser whose errors are one line (``gaitlib <command>: <message>``)."""
+
+    def error(self, message):  # noqa: D102 — argparse's hook
+        self.exit(EXIT_FAILED, f"{self.prog}: {message} (see {self.prog} --help)\n")
+
+
+# -- outputs ------------------------------------------------------------------------
+
+def check_cache(root, use_cache: bool) -> str | None:
+    """The solutions cache folder (``root`` or :func:`gaitlib.cache.default_dir`), created
+    and checked for writability when it will be written (``use_cache``); ``CLIError`` if
+    it cannot be. Returns ``root`` as given (None: the default)."""
+    if not use_cache:
+        return root
+    from . import cache
+
+    folder = Path(root) if root is not None else cache.default_dir()
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        fd, probe = tempfile.mkstemp(prefix=".write-test-", dir=folder)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as e:
+        raise CLIError(f"the solutions cache {folder} is not writable ({e.strerror or e}); "
+                       "pass --cache DIR or --no-cache") from None
+    return root
+
+
+def _umask() -> int:
+    m = os.umask(0)
+    os.umask(m)
+    return m
+
+
+class Output:
+    """A command's outputs, written to a fresh folder next to their destination and moved
+    into place when the command succeeds (``with Output(...) as o: ... write into o.tmp``).
+
+    Created (before any solve) it checks the destination: ``folder`` is refused if it exists
+    and is not empty (``files=None``: the command writes the whole folder) or if any of
+    ``files`` exists in it, unless ``overwrite``; the temporary folder is made next to it
+    (which proves it writable). On success the entries of ``folder`` the command owns —
+    those it writes now and ``owned`` (e.g. the files a previous run listed) — are removed
+    and the new ones moved in, the names in ``last`` (the files that say "done", e.g.
+    ``summary.json``) last; an absent or empty ``folder`` is replaced in one rename. On an
+    exception nothing is moved and the temporary folder is removed."""
+
+    def __init__(self, folder, *, overwrite: bool = False, owned=(), files=None, last=(), option: str = "--out",
+                 what: str = "the files this command writes"):
+        self.folder = Path(folder)
+        self.owned, self.files, self.last = set(owned), None if files is None else tuple(files), tuple(last)
+        f = self.folder
+        if f.exists() and not f.is_dir():
+            raise CLIError(f"{option} {f}: exists and is not a folder")
+        if f.is_dir():
+            clash = [n for n in self.files if (f / n).exists()] if self.files is not None else \
+                sorted(p.name for p in f.iterdir())
+            if clash and not overwrite:
+                target = f / clash[0] if self.files is not None else f
+                raise CLIError(f"{option} {target} exists{'' if self.files is not None else ' and is not empty'}: "
+                               f"pass --overwrite to replace {what}, or choose another path")
+            if not os.access(f, os.W_OK | os.X_OK):
+                raise CLIError(f"{option} {f}: the folder is not writable")
+        parent = f.absolute().parent
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+            self.tmp = Path(tempfile.mkdtemp(prefix=f".{f.name}.partial-", dir=parent))
+        except OSError as e:
+            if not f.is_dir():
+                raise CLIError(f"{option} {f}: cannot write in {parent} ({e.strerror or e})") from None
+            try:  # a writable folder in a read-only one: stage inside it
+                self.tmp = Path(tempfile.mkdtemp(prefix=".partial-", dir=f))
+            except OSError as e2:
+                raise CLIError(f"{option} {f}: cannot write in it ({e2.strerror or e2})") from None
+        os.chmod(self.tmp, 0o777 & ~_umask())
+
+    def __enter__(self) -> "Output":
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        try:
+            if exc_type is None:
+                self._commit()
+        finally:
+            shutil.rmtree(self.tmp, ignore_errors=True)
+        return False
+
+    def _commit(self):
+        f = self.folder
+        new = sorted(p.name for p in self.tmp.iterdir())
+        inside = self.tmp.parent == f
+        if not inside and (not f.exists() or (self.files is None and not any(f.iterdir()))):
+            os.replace(self.tmp, f)
+            return
+        f.mkdir(exist_ok=True)
+        for name in sorted(set(new) | self.owned):
+            old = f / name
+            if old.is_dir() and not old.is_symlink():
+                shutil.rmtree(old)
+            elif old.exists() or old.is_symlink():
+                old.unlink()
+        for name in sorted(new, key=lambda n: (n in self.last, self.last.index(n) if n in self.last else 0)):
+            os.replace(self.tmp / name, f / name)
+
+
+def _add_output_options(p, cache: bool = True):
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace the files this command owns in an existing --out (others are kept)")
+    if cache:
+        p.add_argument("--cache", default=None, help="solutions cache (default: $GAITLIB_SOLUTIONS or "
+                                                     "~/.cache/gaitlib/solutions)")
+        p.add_argument("--no-cache", action="store_true", help="solve even if cached solutions exist")
+
+
+def _listed_files(summary: Path) -> set:
+    """The ``files`` a previous run's ``summary.json`` lists (none if unreadable)."""
+    try:
+        files = json.loads(summary.read_text()).get("files", [])
+        return {str(n) for n in files if isinstance(n, str) and "/" not in n and n not in ("", ".", "..")}
+    except (OSError, ValueError, AttributeError):
+        return set()
+
+
+# -- commands -----------------------------------------------------------------------
 
 def _cmd_data(args) -> int:
     from . import data
@@ -38,72 +225,97 @@ def _cmd_data(args) -> int:
 
 
 def _cmd_run(args) -> int:
-    import json
+    import warnings
 
-    if args.study != "gait":
-        raise SystemExit(f"unknown study {args.study!r}; known: gait")
+    from .ocp import SolveFailedWarning
     from .studies import gait
 
     kw = dict(n_intervals=args.intervals, degree=args.degree, scheme=args.scheme, max_iter=args.max_iter)
     if args.free_contact is not None:
         kw["free_contact"] = args.free_contact
     spec = gait.natural_gait_spec(args.model, args.cost, args.speed, **kw)
-    print(f"gaitlib run gait: {spec.model} {spec.cost} {spec.speed_class}, {spec.n_intervals} x {spec.degree} "
-          f"{spec.scheme}, key {spec.key()}", flush=True)
-    sol = gait.solve_cached(spec, use_cache=not args.no_cache, progress=not args.quiet)
-    if sol.stats.get("from_cache") and not sol.success:
-        print(f"note: a cached failed solve ({sol.stats['status']}), loaded from {sol.stats.get('cache_path')}; "
-              f"--no-cache solves it again", file=sys.stderr)
-    out = gait.write_outputs(sol, args.out, figures=not args.no_figures)
+    root = check_cache(args.cache, not args.no_cache)
+    out = Path(args.out)
+    with Output(out, overwrite=args.overwrite, owned=_listed_files(out / "summary.json") | {"summary.json"},
+                last=("summary.json",), what="the files the previous run listed in summary.json") as o:
+        print(f"gaitlib run gait: {spec.model} {spec.cost} {spec.speed_class}, {spec.n_intervals} x {spec.degree} "
+              f"{spec.scheme}, key {spec.key()}", flush=True)
+        with warnings.catch_warnings():  # a failed solve is reported below, with its status
+            warnings.simplefilter("ignore", SolveFailedWarning)
+            sol = gait.solve_cached(spec, use_cache=not args.no_cache, root=root, progress=not args.quiet)
+        if sol.stats.get("from_cache") and not sol.success:
+            print(f"note: a cached failed solve ({sol.stats['status']}), loaded from "
+                  f"{sol.stats.get('cache_path')}; --no-cache solves it again", file=sys.stderr)
+        gait.write_outputs(sol, o.tmp, figures=not args.no_figures)
     st = sol.stats
     print(json.dumps({k: st[k] for k in ("status", "iterations", "solve_time_s", "time_per_iteration_s",
                                          "objective", "max_violation")}, indent=1))
     print(f"wrote {out}")
-    return 0 if sol.success else 2
+    if not sol.success:
+        print(f"gaitlib run: the solve did not converge ({st['status']}, {st['iterations']} iterations); "
+              f"its outputs carry that status", file=sys.stderr)
+        return EXIT_FAILED
+    return 0
+
+
+def _split(text: str) -> list:
+    return [c.strip() for c in text.split(",") if c.strip()]
 
 
 def _cmd_sweep(args) -> int:
     """``gaitlib sweep``: cost functions × speed classes of one model as one sweep."""
-    import math
-
     import pandas as pd
 
     from . import sweep as sw
     from . import transcription as tr
     from .studies import gait
 
-    costs = [c.strip() for c in args.costs.split(",") if c.strip()]
-    speeds = [s.strip() for s in args.speeds.split(",") if s.strip()]
+    costs, speeds = _split(args.costs), _split(args.speeds)
     if not costs or not speeds:
-        raise SystemExit("--costs and --speeds need at least one comma-separated name each")
+        raise CLIError("--costs and --speeds need at least one comma-separated name each")
     kw = dict(n_intervals=args.intervals, degree=args.degree, max_iter=args.max_iter)
-    try:
-        specs = {f"{args.model}_{c}_{s}": tr.GaitSpec(model=args.model, cost=c, speed_class=s, **kw)
-                 for c in costs for s in speeds}
-    except ValueError as e:
-        raise SystemExit(f"gaitlib sweep: {e}") from None
-    recs = sw.solve_specs(specs, use_cache=not args.no_cache, cache_root=args.cache, scheduler=args.scheduler,
-                          n_workers=args.workers, serial=args.serial, progress=True)
-    from pathlib import Path
-
+    specs = {f"{args.model}_{c}_{s}": tr.GaitSpec(model=args.model, cost=c, speed_class=s, **kw)
+             for c in costs for s in speeds}
+    root = check_cache(args.cache, not args.no_cache)
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    rows = []
-    for name, r in recs.items():
-        st = r.value.stats if r.value is not None else {}
-        rows.append({"name": name, "status": r.status, "ok": r.ok, "iterations": st.get("iterations"),
-                     "wall": r.wall_s, "solve_time_s": st.get("solve_time_s"),
-                     "time_per_iteration_s": st.get("time_per_iteration_s"), "objective": st.get("objective", math.nan),
-                     "from_cache": st.get("from_cache"), "worker": r.worker,
-                     "error": (r.error or "").strip().splitlines()[-1] if r.error else ""})
-        if r.value is not None:
-            gait.write_outputs(r.value, out / name, figures=not args.no_figures)
-        elif r.error:
-            (out / name).mkdir(parents=True, exist_ok=True)
-            (out / name / "error.txt").write_text(r.error)
-    pd.DataFrame(rows).to_csv(out / "sweep.csv", index=False)
-    print(f"wrote {out / 'sweep.csv'} ({sum(r.ok for r in recs.values())}/{len(recs)} ok)")
-    return 0 if all(r.ok for r in recs.values()) else 2
+    old = set()
+    try:
+        old = {str(n) for n in pd.read_csv(out / "sweep.csv")["name"] if "/" not in str(n)}
+    except (OSError, ValueError, KeyError, pd.errors.ParserError):
+        pass
+    with Output(out, overwrite=args.overwrite, owned=old | {"sweep.csv"}, last=("sweep.csv",),
+                what="sweep.csv and the run folders it lists") as o:
+        recs = sw.solve_specs(specs, use_cache=not args.no_cache, cache_root=root, scheduler=args.scheduler,
+                              n_workers=args.workers, serial=args.serial, progress=True)
+        rows = []
+        for name, r in recs.items():
+            st = r.value.stats if r.value is not None else {}
+            rows.append({"name": name, "status": r.status, "ok": r.ok, "iterations": st.get("iterations"),
+                         "wall": r.wall_s, "solve_time_s": st.get("solve_time_s"),
+                         "time_per_iteration_s": st.get("time_per_iteration_s"),
+                         "objective": st.get("objective", math.nan), "from_cache": st.get("from_cache"),
+                         "worker": r.worker, "error": (r.error or "").strip().splitlines()[-1] if r.error else ""})
+            if r.value is not None:
+                gait.write_outputs(r.value, o.tmp / name, figures=not args.no_figures)
+            elif r.error:
+                (o.tmp / name).mkdir(parents=True, exist_ok=True)
+                (o.tmp / name / "error.txt").write_text(r.error)
+        pd.DataFrame(rows).to_csv(o.tmp / "sweep.csv", index=False)
+    n_ok = sum(r.ok for r in recs.values())
+    print(f"wrote {out / 'sweep.csv'} ({n_ok}/{len(recs)} ok)")
+    if n_ok < len(recs):
+        bad = ", ".join(f"{n} {r.status}" for n, r in recs.items() if not r.ok)
+        print(f"gaitlib sweep: {len(recs) - n_ok} of {len(recs)} runs did not converge: {bad}", file=sys.stderr)
+        return EXIT_FAILED
+    return 0
+
+
+def _int_options(p, mesh, max_iter: int = 1000):
+    p.add_argument("--intervals", type=int_at_least(1), default=mesh[0],
+                   help=f"mesh intervals (default {mesh[0]}; thesis: 20)")
+    p.add_argument("--degree", type=int_at_least(1), default=mesh[1],
+                   help=f"collocation points per interval (default {mesh[1]}; thesis: 5)")
+    p.add_argument("--max-iter", type=int_at_least(1), default=max_iter, help="IPOPT iteration limit")
 
 
 def _cmd_cache(args) -> int:
@@ -155,62 +367,87 @@ def _add_sweep_parser(sub) -> None:
     w.add_argument("--model", default="MSK", choices=["SK", "MSK", "NMSK"])
     w.add_argument("--costs", required=True, help="comma-separated cost functions, e.g. DT,SDT1,SP1")
     w.add_argument("--speeds", default="Free", help="comma-separated speed classes, e.g. VerySlow,Slow,Free")
-    w.add_argument("--intervals", type=int, default=20, help="mesh intervals (thesis: 20)")
-    w.add_argument("--degree", type=int, default=5, help="collocation points per interval (thesis: 5)")
-    w.add_argument("--max-iter", type=int, default=1000)
+    _int_options(w, (20, 5))
     w.add_argument("--scheduler", default=None,
                    help="address (tcp://host:port) or scheduler file of an existing dask cluster "
                         "(default: a LocalCluster over the machine's cores)")
-    w.add_argument("--workers", type=int, default=None, help="LocalCluster worker processes (default: cores)")
+    w.add_argument("--workers", type=int_at_least(1), default=None,
+                   help="LocalCluster worker processes (default: cores)")
     w.add_argument("--serial", action="store_true", help="run in this process without dask")
-    w.add_argument("--cache", default=None, help="solutions cache (default: $GAITLIB_SOLUTIONS or "
-                                                 "~/.cache/gaitlib/solutions), passed to every worker")
-    w.add_argument("--no-cache", action="store_true", help="solve even if cached solutions exist")
     w.add_argument("--no-figures", action="store_true")
     w.add_argument("--out", required=True, help="output directory")
+    _add_output_options(w)
     w.set_defaults(func=_cmd_sweep)
 
 
+def _add_debug(p, top: bool = False):
+    p.add_argument("--debug", action="store_true", default=False if top else argparse.SUPPRESS,
+                   help="show the traceback of an error")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="gaitlib", description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
-    sub = p.add_subparsers(dest="command", required=True)
+    from . import __version__
+
+    p = _Parser(prog="gaitlib", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--version", action="version", version=f"gaitlib {__version__}")
+    _add_debug(p, top=True)
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
     d = sub.add_parser("data", help="fetch the public data archives and write tidy CSVs")
     d.add_argument("--out", default="data", help="output directory (default: data)")
     d.add_argument("--cache", default=None, help="archive cache (default: $GAITLIB_CACHE or ~/.cache/gaitlib)")
     d.set_defaults(func=_cmd_data)
 
     r = sub.add_parser("run", help="run a study (gait) and write frames, figures and summary.json")
-    r.add_argument("study", help="study name: gait")
+    r.add_argument("study", choices=["gait"], help="study name: gait")
     r.add_argument("--out", required=True, help="output directory")
     r.add_argument("--model", default="MSK", choices=["SK", "MSK", "NMSK"])
     r.add_argument("--cost", default=None, help="cost function (default: Eq4.11 for SK, Eq5.33 for MSK, "
                                                  "Eq5.55 for NMSK; also DT, SDT1..3, SP1..3, FP)")
     r.add_argument("--speed", default="Free", help="speed class (VerySlow, Slow, Free, Fast, VeryFast)")
-    r.add_argument("--intervals", type=int, default=20, help="mesh intervals (thesis: 20)")
-    r.add_argument("--degree", type=int, default=5, help="collocation points per interval (thesis: 5)")
+    _int_options(r, (20, 5))
     r.add_argument("--scheme", default="lgr", choices=["lgr", "trapezoidal", "hermite-simpson"])
-    r.add_argument("--max-iter", type=int, default=1000)
     fc = r.add_mutually_exclusive_group()
     fc.add_argument("--free-contact", dest="free_contact", action="store_true", default=None,
                     help="identify the 39 contact parameters (Ch 4; default: fixed, thesis Tables 4.17/4.18)")
     fc.add_argument("--fixed-contact", dest="free_contact", action="store_false")
-    r.add_argument("--no-cache", action="store_true", help="solve even if a cached solution exists")
     r.add_argument("--no-figures", action="store_true")
     r.add_argument("--quiet", action="store_true", help="no IPOPT progress log")
+    _add_output_options(r)
     r.set_defaults(func=_cmd_run)
     _add_sweep_parser(sub)
     _add_cache_parser(sub)
     _add_card_parser(sub)
-    from .gap.cli import add_parsers as _add_gap_parsers  # gaitlib gap, gaitlib gap-twin (issue 7)
+    from .gap.cli import add_parsers as _add_gap_parsers  # gaitlib gap, gaitlib gap-twin
 
     _add_gap_parsers(sub)
+    for sp in sub.choices.values():
+        _add_debug(sp)
     return p
+
+
+def _expected() -> tuple:
+    """Exception types whose message is the whole story (no "--debug" hint)."""
+    from .gap.diagnose import BaselineFailed
+    from .ocp import SolveFailedError
+
+    return (CLIError, ValueError, OSError, BaselineFailed, SolveFailedError)
 
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    return args.func(args)
+    if args.debug:
+        return args.func(args)
+    try:
+        return args.func(args)
+    except KeyboardInterrupt:
+        print(f"gaitlib {args.command}: interrupted", file=sys.stderr)
+        return 130
+    except Exception as e:  # noqa: BLE001 — one line for the user; --debug re-raises
+        msg = " ".join(str(e).split()) or type(e).__name__
+        if not isinstance(e, _expected()):
+            msg = f"{type(e).__name__}: {msg} (--debug shows the traceback)"
+        print(f"gaitlib {args.command}: {msg}", file=sys.stderr)
+        return EXIT_FAILED
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -26,8 +26,9 @@ Every run is wrapped on the worker: an exception becomes a record with ``ok=Fals
 IPOPT return status when the function returns a solution (an object with
 ``stats["status"]``, e.g. :class:`~gaitlib.transcription.GaitSolution`, or with a
 ``status`` string, e.g. :class:`~gaitlib.ocp.Solution`); ``ok`` is then True only for
-``Solve_Succeeded`` and ``Solved_To_Acceptable_Level``. Any other return value gives
-``status="done"``, ``ok=True``.
+``Solve_Succeeded`` and ``Solved_To_Acceptable_Level``. A mapping of solutions (a group
+of solves) has their statuses (one if shared, else their counts), ``ok`` only if every
+one is accepted. Any other return value gives ``status="done"``, ``ok=True``.
 
 Results are identical to a serial run: each run is the same deterministic computation in
 a fresh single-threaded process (tests/test_sweep.py compares solutions bitwise).
@@ -65,7 +66,8 @@ class RunRecord:
     name : the item's name.
     ok : True if the run returned without exception and, for a solution, IPOPT's status is
         in :data:`ACCEPTED_STATUSES`.
-    status : IPOPT's ``return_status`` for a solution, ``"done"`` for other return values,
+    status : IPOPT's ``return_status`` for a solution (for a mapping of solutions their
+        statuses, see the module docstring), ``"done"`` for other return values,
         ``"error"`` when the function raised (or its worker died).
     value : the function's return value (``None`` on error).
     error : the traceback text on error, else ``None``.
@@ -82,14 +84,31 @@ class RunRecord:
     worker: str
 
 
-def _status_of(value) -> tuple[bool, str]:
+def _solution_status(value) -> str | None:
     stats = getattr(value, "stats", None)
     status = stats.get("status") if isinstance(stats, Mapping) else None
     if status is None and isinstance(getattr(value, "status", None), str):
         status = value.status
-    if status is None:
-        return True, "done"
-    return str(status) in ACCEPTED_STATUSES, str(status)
+    return None if status is None else str(status)
+
+
+def _status_of(value) -> tuple[bool, str]:
+    """(ok, status) of a run's return value: a solution's IPOPT status; for a mapping of
+    solutions (e.g. :func:`gaitlib.gap.solve.solve_many`'s groups) the status they share, or
+    their counts (``"2 Solve_Succeeded, 1 Maximum_Iterations_Exceeded"``), ok only if all
+    are accepted; anything else ``"done"``."""
+    status = _solution_status(value)
+    if status is not None:
+        return status in ACCEPTED_STATUSES, status
+    if isinstance(value, Mapping) and value:
+        sts = [_solution_status(v) for v in value.values()]
+        if all(s is not None for s in sts):
+            counts: dict[str, int] = {}
+            for s in sts:
+                counts[s] = counts.get(s, 0) + 1
+            text = sts[0] if len(counts) == 1 else ", ".join(f"{n} {s}" for s, n in counts.items())
+            return all(s in ACCEPTED_STATUSES for s in sts), text
+    return True, "done"
 
 
 def _where() -> str:

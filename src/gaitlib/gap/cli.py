@@ -1,8 +1,11 @@
-"""Command-line subcommands ``gaitlib gap`` and ``gaitlib gap-twin`` (:mod:`gaitlib.cli`)."""
+"""Command-line subcommands ``gaitlib gap`` and ``gaitlib gap-twin`` (:mod:`gaitlib.cli`;
+exit status and outputs as described there)."""
 
 from __future__ import annotations
 
 import json
+import sys
+from pathlib import Path
 
 
 def _base(args, speed_class: str) -> dict:
@@ -10,66 +13,129 @@ def _base(args, speed_class: str) -> dict:
                 degree=args.degree, max_iter=args.max_iter)
 
 
+def _spec(base: dict):
+    """The baseline spec (its options checked before any solve)."""
+    from .. import transcription as tr
+
+    return tr.GaitSpec(**base)
+
+
+def effect_names(text: str | None) -> list | None:
+    """``--effects`` as a list of known effect names (None: all); ``CLIError`` naming the
+    known ones otherwise."""
+    from ..cli import CLIError
+    from .effects import EFFECTS
+
+    if text is None:
+        return None
+    names = [e.strip() for e in text.split(",") if e.strip()]
+    unknown = [n for n in names if n not in EFFECTS]
+    if unknown or not names:
+        what = f"unknown effect(s) {', '.join(unknown)}" if unknown else "no effect named"
+        raise CLIError(f"--effects: {what}; known: {', '.join(EFFECTS)}")
+    return list(dict.fromkeys(names))
+
+
+GAP_FILES = ("diagnosis.json", "located.csv", "ranking.csv", "gap_heatmap.png", "ranking.png", "shrink.png")
+
+
 def cmd_gap(args) -> int:
     """``gaitlib gap --data CSV --out DIR``: diagnose the gap; writes diagnosis.json + figures.
     Data that fail the reader's checks (:func:`gaitlib.gap.io.read_data`,
     :mod:`gaitlib.plausibility`): one line on stderr, exit 2, nothing built or written."""
-    import sys
-
-    from .. import data as data_mod
+    from .. import cli
     from . import diagnose as D
     from . import io as gio
 
-    try:  # the data gates run here, before any problem is built
-        ds = gio.read_data(args.data, like=args.like, speed_class=args.speed_class, fill_from=args.fill_from,
-                           allow_no_sd=args.allow_no_sd)
-    except data_mod.DataError as e:
-        print(f"gaitlib gap: {e}", file=sys.stderr)
-        return 2
-    effects = [e.strip() for e in args.effects.split(",")] if args.effects else None
-    print(f"gaitlib gap: {ds.label} ({ds.base}, {ds.gait.speed_class}, n = {ds.n}); baseline {args.model} "
-          f"{args.cost} {args.intervals} x {args.degree}, objective {args.objective}", flush=True)
-    d = D.diagnose(ds, base=_base(args, ds.gait.speed_class), effects=effects, objective=args.objective,
-                   resamples=args.resamples, seed=args.seed, root=args.cache, use_cache=not args.no_cache,
-                   serial=args.serial, n_workers=args.workers, scheduler=args.scheduler, progress=True)
-    out = d.save(args.out, figures=not args.no_figures)
+    effects = effect_names(args.effects)
+    # the data gates (gaitlib.plausibility) run here, before any problem is built
+    ds = gio.read_data(args.data, like=args.like, speed_class=args.speed_class, fill_from=args.fill_from,
+                       allow_no_sd=args.allow_no_sd)
+    base = _base(args, ds.gait.speed_class)
+    _spec(base)
+    root = cli.check_cache(args.cache, not args.no_cache)
+    out = Path(args.out)
+    owned = set(GAP_FILES) | ({p.name for p in out.glob("shrink_*.csv")} if out.is_dir() else set())
+    with cli.Output(out, overwrite=args.overwrite, owned=owned, last=("diagnosis.json",),
+                    what="the diagnosis's files (diagnosis.json, located.csv, ranking.csv, shrink_*.csv, "
+                         "figures)") as o:
+        print(f"gaitlib gap: {ds.label} ({ds.base}, {ds.gait.speed_class}, n = {ds.n}); baseline {args.model} "
+              f"{args.cost} {args.intervals} x {args.degree}, objective {args.objective}", flush=True)
+        d = D.diagnose(ds, base=base, effects=effects, objective=args.objective, resamples=args.resamples,
+                       seed=args.seed, root=root, use_cache=not args.no_cache, serial=args.serial,
+                       n_workers=args.workers, scheduler=args.scheduler, progress=True)
+        d.save(o.tmp, figures=not args.no_figures)
     cols = ["rank", "effect", "n_params", "status", "pct_closed", "dAIC", "dBIC"]
     print(d.ranking[cols].to_string(index=False, float_format=lambda v: f"{v:.2f}"))
     print(json.dumps({"top_effect": d.top_effect, "verdict": d.verdict, "rss_baseline": d.located.rss,
-                      "n_eff": d.located.n_eff}, indent=1))
+                      "n_eff": d.located.n_eff, "baseline_status": d.baseline.stats["status"]}, indent=1))
     print(f"wrote {out / 'diagnosis.json'}")
+    failed = [(f.effect, f.status) for f in d.fits.values() if not f.ok]
+    if failed:
+        print(f"gaitlib gap: {len(failed)} of {len(d.fits)} candidates did not converge "
+              f"({', '.join(f'{n} {s}' for n, s in failed)}): the ranking does not test them", file=sys.stderr)
+        return cli.EXIT_FAILED
     return 0
+
+
+def twin_effects(args) -> tuple:
+    """``--effect/--magnitude`` (and ``--effect2/--magnitude2``) as ((name, magnitude), …),
+    checked against the effect registry and its bounds (:func:`gaitlib.gap.effects.validate`)
+    before any solve; ``CLIError`` otherwise."""
+    from ..cli import CLIError
+    from .effects import EFFECTS, validate
+
+    pairs = []
+    for opt, eff, mag in (("", args.effect, args.magnitude), ("2", args.effect2, args.magnitude2)):
+        if eff is None or eff == "none":
+            if mag is not None:
+                raise CLIError(f"--magnitude{opt} given without an effect (--effect{opt} {eff or 'none'})")
+            continue
+        if eff not in EFFECTS:
+            raise CLIError(f"--effect{opt}: unknown effect {eff!r}; known: {', '.join(EFFECTS)} (or none)")
+        p = EFFECTS[eff].magnitude
+        if mag is None:
+            unit = "" if p.unit in ("", "1") else f" {p.unit}"
+            raise CLIError(f"--effect{opt} {eff} needs --magnitude{opt} ({p.name} in [{p.lower:g}, {p.upper:g}]"
+                           f"{unit}; {p.null:g} is no effect)")
+        pairs.append((eff, mag))
+    try:
+        return validate(tuple(pairs), args.model)
+    except ValueError as e:
+        raise CLIError(str(e)) from None
 
 
 def cmd_gap_twin(args) -> int:
     """``gaitlib gap-twin --effect NAME --magnitude X --seed N --out CSV``."""
+    from .. import cli
     from .twin import write_twin
 
-    effects = [(args.effect, args.magnitude)] if args.effect != "none" else []
-    if args.effect2:
-        if args.magnitude2 is None:
-            raise SystemExit("--effect2 needs --magnitude2")
-        effects.append((args.effect2, args.magnitude2))
-    try:
-        path = write_twin(args.out, tuple(effects), args.seed, base=_base(args, args.speed),
-                          root=args.cache, use_cache=not args.no_cache, noise=not args.no_noise)
-    except ValueError as e:
-        raise SystemExit(f"gaitlib gap-twin: {e}") from None
-    print(f"wrote {path} (truth: {path.with_suffix('.truth.json')})")
+    effects = twin_effects(args)
+    base = _base(args, args.speed)
+    _spec(base)
+    root = cli.check_cache(args.cache, not args.no_cache)
+    out = Path(args.out)
+    truth = out.with_suffix(".truth.json")
+    with cli.Output(out.parent if str(out.parent) else Path("."), overwrite=args.overwrite,
+                    files=(out.name, truth.name), last=(truth.name,),
+                    what=f"{out.name} and {truth.name}") as o:
+        write_twin(o.tmp / out.name, effects, args.seed, base=base, root=root, use_cache=not args.no_cache,
+                   noise=not args.no_noise)
+    print(f"wrote {out} (truth: {truth})")
     return 0
 
 
 def _common(p, mesh=(10, 3)):
+    from ..cli import _add_output_options, _int_options
+
     p.add_argument("--model", default="SK", choices=["SK", "MSK", "NMSK"], help="baseline model (default SK)")
     p.add_argument("--cost", default="DT", help="baseline cost function (default DT)")
-    p.add_argument("--intervals", type=int, default=mesh[0], help=f"mesh intervals (default {mesh[0]})")
-    p.add_argument("--degree", type=int, default=mesh[1], help=f"LGR points per interval (default {mesh[1]})")
-    p.add_argument("--max-iter", type=int, default=1000)
-    p.add_argument("--cache", default=None, help="solutions cache (default $GAITLIB_SOLUTIONS or ~/.cache/gaitlib/solutions)")
-    p.add_argument("--no-cache", action="store_true")
+    _int_options(p, mesh)
+    _add_output_options(p)
 
 
 def add_parsers(sub) -> None:
+    from ..cli import finite_float, int_at_least
     from .effects import EFFECTS
 
     g = sub.add_parser("gap", help="sim-to-real gap diagnosis of a tidy data CSV (diagnosis.json + figures)")
@@ -86,10 +152,11 @@ def add_parsers(sub) -> None:
     g.add_argument("--effects", default=None, help=f"comma-separated candidates (default all applicable: "
                                                    f"{','.join(EFFECTS)})")
     g.add_argument("--objective", default="fit", choices=["fit", "cost"])
-    g.add_argument("--resamples", type=int, default=200, help="data resamples for the %% closed interval")
-    g.add_argument("--seed", type=int, default=0)
+    g.add_argument("--resamples", type=int_at_least(0), default=200,
+                   help="data resamples for the %% closed interval (0: no interval)")
+    g.add_argument("--seed", type=int_at_least(0), default=0)
     g.add_argument("--serial", action="store_true", help="solve in this process without dask")
-    g.add_argument("--workers", type=int, default=None, help="LocalCluster workers (default: cores)")
+    g.add_argument("--workers", type=int_at_least(1), default=None, help="LocalCluster workers (default: cores)")
     g.add_argument("--scheduler", default=None, help="existing dask scheduler address")
     g.add_argument("--no-figures", action="store_true")
     _common(g)
@@ -97,12 +164,13 @@ def add_parsers(sub) -> None:
 
     t = sub.add_parser("gap-twin", help="write a twin data set (baseline model + an injected effect + noise)")
     t.add_argument("--effect", required=True, help=f"effect name ({', '.join(EFFECTS)}) or 'none'")
-    t.add_argument("--magnitude", type=float, default=0.0, help="the effect's magnitude (its first parameter)")
+    t.add_argument("--magnitude", type=finite_float, default=None,
+                   help="the effect's magnitude (its first parameter, within its bounds); required with --effect")
     t.add_argument("--effect2", default=None)
-    t.add_argument("--magnitude2", type=float, default=None)
-    t.add_argument("--seed", type=int, default=0, help="noise seed")
+    t.add_argument("--magnitude2", type=finite_float, default=None)
+    t.add_argument("--seed", type=int_at_least(0), default=0, help="noise seed")
     t.add_argument("--speed", default="Free", help="speed class of the real data the twin is made from")
     t.add_argument("--no-noise", action="store_true")
-    t.add_argument("--out", required=True, help="output CSV")
+    t.add_argument("--out", required=True, help="output CSV (its truth goes to <stem>.truth.json beside it)")
     _common(t)
     t.set_defaults(func=cmd_gap_twin)

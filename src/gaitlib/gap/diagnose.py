@@ -9,7 +9,8 @@ GaitData) and a baseline model, and
    continuations from the spec's own cost function, from a coarse mesh and from the fit
    with the GRFs weighted up), keeps the converged fit with the lowest objective, and
    locates its gap
-   (:func:`gaitlib.gap.locate.locate`);
+   (:func:`gaitlib.gap.locate.locate`); if no start converged it stops
+   (:class:`BaselineFailed`): a gap located on a non-converged fit is not a result;
 2. re-solves with every applicable candidate effect (:data:`gaitlib.gap.effects.EFFECTS`),
    warm-started from the baseline fit, through :func:`gaitlib.sweep.sweep`:
    ``identify="nlp"`` effects with their parameters free in the NLP; ``"profile"`` effects
@@ -63,7 +64,7 @@ from .solve import solve_many
 __all__ = ["BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "Fit", "Diagnosis", "diagnose", "assemble",
            "candidates", "base_spec", "as_dataset", "baseline_fits", "pick_best", "BASELINE_STARTS",
            "COARSE_MESH", "GRF_SD_FACTOR", "RETRY_MARGIN", "grf_weighted", "candidate_fits", "needs_retry",
-           "alternates_of"]
+           "alternates_of", "lowest_objective", "BaselineFailed"]
 
 #: ΔBIC a top effect must reach (≤) to be named.
 BIC_THRESHOLD = -10.0
@@ -134,13 +135,28 @@ def _status(sol) -> tuple[str, bool]:
 
 
 def pick_best(sols: list):
-    """The converged solution with the lowest objective (else the lowest objective)."""
+    """The converged solution with the lowest objective; None if none converged (a
+    non-converged solve is never kept as a baseline)."""
+    conv = [s for s in sols if s is not None and _status(s)[1]]
+    return min(conv, key=lambda s: s.stats["objective"]) if conv else None
+
+
+def lowest_objective(sols: list):
+    """The solution with the lowest objective, converged or not (None if there is none): a
+    candidate none of whose starts converged is reported by this fit, with its status and
+    ``ok=False`` (never eligible for the verdict)."""
     sols = [s for s in sols if s is not None]
-    if not sols:
-        return None
-    conv = [s for s in sols if _status(s)[1]]
-    pool = conv or sols
-    return min(pool, key=lambda s: s.stats["objective"])
+    return min(sols, key=lambda s: s.stats["objective"]) if sols else None
+
+
+class BaselineFailed(RuntimeError):
+    """No start of the baseline fit converged: there is no baseline to locate a gap on.
+    ``statuses``: start → IPOPT status of every start that returned a solution."""
+
+    def __init__(self, statuses: dict):
+        self.statuses = dict(statuses)
+        text = ", ".join(f"{k} {v}" for k, v in self.statuses.items()) or "no start returned a solution"
+        super().__init__(f"baseline failed: {text}")
 
 
 # ======================================================================================
@@ -388,9 +404,9 @@ def baseline_fits(spec0, datasets: dict, warm=None, *, objective="fit", root=Non
     """Baseline fits of several data sets (key → DataSet) from each of ``starts``
     (:data:`BASELINE_STARTS`; ``warm`` only with a ``warm`` solution, ``coarse`` only on a
     mesh finer than :data:`COARSE_MESH`, ``grf`` only for the ``"fit"`` objective); the
-    converged fit with the lowest objective is kept. Returns key → GaitSolution
-    (``detail``: key → {start: GaitSolution}, the kept one under ``"best"``); each kept
-    solution's ``stats["start"]`` names its start."""
+    converged fit with the lowest objective is kept. Returns key → GaitSolution, None where
+    no start converged (``detail``: key → {start: GaitSolution}, the kept one under
+    ``"best"``); each kept solution's ``stats["start"]`` names its start."""
     unknown = set(starts) - set(BASELINE_STARTS)
     if unknown:
         raise ValueError(f"unknown baseline start(s) {sorted(unknown)}; expected some of {BASELINE_STARTS}")
@@ -471,8 +487,10 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
     (key → {start: solution}: the baseline's fits from its other starts, see
     :func:`baseline_fits` ``detail``) enables the retry: an NLP-identified candidate whose
     fit :func:`needs_retry` is re-solved warm-started from each of them, and the converged
-    fit with the lowest objective (:func:`pick_best`) is kept; its ``stats["retry_start"]``
-    names the start it came from (``"best"``: the first solve)."""
+    fit with the lowest objective (:func:`pick_best`) is kept — if none converged, the one
+    with the lowest objective (:func:`lowest_objective`), reported with its status and never
+    eligible; its ``stats["retry_start"]`` names the start it came from (``"best"``: the
+    first solve)."""
     groups = {}
     for n in names:
         e = fx.EFFECTS[n]
@@ -515,7 +533,7 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
                 tried = {"best": res.get(f"{k}|{n}")}
                 tried.update({st: res.get(f"{k}|{n}|{st}") for st in (alternates or {}).get(k) or {}
                               if res.get(f"{k}|{n}|{st}") is not None})
-                sol = pick_best(list(tried.values()))
+                sol = pick_best(list(tried.values())) or lowest_objective(list(tried.values()))
                 if sol is not None and len(tried) > 1:
                     sol.stats["retry_start"] = next(st for st, s in tried.items() if s is sol)
                 fits[n] = _nlp_fit(n, sol, ds, error=n in recs and bool(recs[n].error))
@@ -598,6 +616,9 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
     resamples, seed : data resampling for the % closed intervals.
     root, use_cache : the solutions cache.
     **sweep_kw : ``scheduler``, ``n_workers``, ``serial``, ``progress`` of :func:`gaitlib.sweep.sweep`.
+
+    Raises :class:`BaselineFailed` (with every start's IPOPT status) when no start of the
+    baseline fit converged.
     """
     ds = as_dataset(data, like, fill_from)
     spec0 = base_spec(base)
@@ -606,7 +627,7 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
                       **sweep_kw)
     base_sol = b["data"]["best"]
     if base_sol is None:
-        raise RuntimeError("the baseline fit failed (no solution returned); see the sweep's error report")
+        raise BaselineFailed({st: s.stats["status"] for st, s in b["data"].items() if st != "best" and s is not None})
     fits = candidate_fits(spec0, {"data": ds}, {"data": base_sol}, names, objective=objective, root=root,
                           use_cache=use_cache, alternates=alternates_of(b), **sweep_kw)["data"]
     settings = {"objective": objective, "candidates": names, "warm": warm is not None}

@@ -153,8 +153,16 @@ def make_twin(effects, seed: int = 0, *, base: dict | None = None, real: gio.Dat
 
 
 def write_twin(path, effects, seed: int = 0, **kw) -> Path:
-    """Write a twin's tidy CSV to ``path`` and its truth to ``<path stem>.truth.json``."""
+    """Write a twin's tidy CSV to ``path`` and its truth to ``<path stem>.truth.json``.
+    Raises :class:`gaitlib.ocp.SolveFailedError` (nothing written) when the generating solve
+    did not converge: its curves are not the model's gait."""
+    from ..ocp import SolveFailedError
+    from ..sweep import ACCEPTED_STATUSES
+
     frame, truth = make_twin(effects, seed, **kw)
+    if truth["status"] not in ACCEPTED_STATUSES:
+        raise SolveFailedError(f"the twin's generating solve did not converge ({truth['status']}, "
+                               f"{truth['iterations']} iterations): no twin written")
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     frame.to_csv(path, index=False, float_format="%.8g")
@@ -177,10 +185,12 @@ def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), 
     """Generate twins (each effect × magnitude × seed, plus the effect-free twin of each
     seed), diagnose each with the baseline model only, and score the diagnosis.
 
-    Returns a :class:`TwinValidation`. Cost: (#twins + #seeds) twin solves, the baseline
-    fits per twin (:data:`gaitlib.gap.diagnose.BASELINE_STARTS`: up to 8 solves), one
-    re-solve per candidate per twin (and, for a candidate that fails or ends above the
-    baseline, one per other baseline start), all through
+    Returns a :class:`TwinValidation`; a twin none of whose baseline starts converged is not
+    diagnosed: its row says ``top = "baseline failed"`` (a miss) and
+    ``settings["baseline_failed"]`` lists its starts' statuses. Cost: (#twins + #seeds)
+    twin solves, the baseline fits per twin (:data:`gaitlib.gap.diagnose.BASELINE_STARTS`:
+    up to 8 solves), one re-solve per candidate per twin (and, for a candidate that fails
+    or ends above the baseline, one per other baseline start), all through
     :func:`gaitlib.sweep.sweep` (one item per spec, built once and re-solved on every twin
     by swapping the NLP's data).
     """
@@ -230,11 +240,16 @@ def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), 
     detail = D.baseline_fits(spec0, datasets, warm, objective=objective, root=root, use_cache=use_cache, detail=True,
                              **sweep_kw)
     bases = {k: v["best"] for k, v in detail.items()}
+    # twins none of whose baseline starts converged have no baseline: no diagnosis, listed
+    # in settings["baseline_failed"] with every start's status
+    base_failed = {k: {st: s.stats["status"] for st, s in v.items() if st != "best" and s is not None}
+                   for k, v in detail.items() if v["best"] is None}
+    fitted = {k: ds for k, ds in datasets.items() if bases[k] is not None}
     # 3. candidates: every twin effect, re-solved on every twin (a failed or worse-than-
     #    baseline fit again from the baseline's other starts)
     names, _ = D.candidates(spec0, next(iter(datasets.values())).gait, effects)
-    fits = D.candidate_fits(spec0, datasets, bases, names, objective=objective, root=root, use_cache=use_cache,
-                            alternates=D.alternates_of(detail), **sweep_kw)
+    fits = D.candidate_fits(spec0, fitted, bases, names, objective=objective, root=root, use_cache=use_cache,
+                            alternates=D.alternates_of({k: detail[k] for k in fitted}), **sweep_kw) if fitted else {}
     # 4. the reference of the shrink: the true model (injected effect fixed at its injected
     #    magnitude) fitted by the same method (warm-started from the baseline fit), and the
     #    generating solution's own RSS (noise only)
@@ -259,7 +274,7 @@ def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), 
     return TwinValidation.build(diags, truth, mags, gen_stats, refs=refs, settings={
         "base": spec0.to_dict(), "objective": objective, "gen_objective": gen_objective, "seeds": list(seeds),
         "effects": list(effects), "magnitudes": {e: list(v) for e, v in mags.items()}, "real": real.label,
-        "n_subjects": real.n, "noise_length": NOISE_LENGTH})
+        "n_subjects": real.n, "noise_length": NOISE_LENGTH, "baseline_failed": base_failed})
 
 
 def TWIN_EFFECTS_DEFAULT():
@@ -347,6 +362,13 @@ class TwinValidation:
                 "true_start": (d.fits[inj].solution.stats.get("retry_start", "best")
                                if inj in d.fits and d.fits[inj].solution is not None else None),
             })
+        for key in (settings or {}).get("baseline_failed", {}):  # no baseline: a miss, never dropped
+            t = truth[key]
+            rows.append({"twin": key, "injected": t["effects"][0][0] if t["effects"] else "none",
+                         "magnitude": t["effects"][0][1] if t["effects"] else 0.0, "level": t["level"],
+                         "seed": t["seed"], "top": "baseline failed", "verdict": "baseline failed", "correct": False,
+                         "shrink_injected_top": np.nan, "shrink_injected_true": np.nan,
+                         "shrink_vs_noise_top": np.nan})
         return cls(pd.DataFrame(rows), diags, gen_stats, settings)
 
     @property
