@@ -498,8 +498,9 @@ def test_stored_gap_solutions_are_reachable(real):
     from gaitlib.gap.solve import _where
 
     store = cache.store_dir()
-    if store is None or not (store / "gap").is_dir():
-        pytest.skip("no solution store")
+    if store is None or "ch08_gap.ipynb:" not in ((store / "README.md").read_text()
+                                                  if (store / "README.md").is_file() else ""):
+        pytest.skip("the store does not hold the gap chapter's solutions (solutions/README.md)")
     spec = twin.twin_spec(())  # the effect-free twin's generating solve (Ch 8), on the real data
     where = _where(spec, real.gait, None, None, objective="cost")
     assert (store / "gap" / where.name).is_dir(), (

@@ -89,8 +89,9 @@ def main(argv) -> int:
         shutil.rmtree(STORE)
     shutil.move(str(new), STORE)
     (STORE / "README.md").write_text(
-        "Solutions the book loads instead of re-solving, keyed by spec + code + data hash\n"
-        "(gaitlib.cache). Written by tools/store_solutions.py; never edit by hand.\n\n"
+        "Solutions the book loads instead of re-solving, keyed by spec + formulation version + data\n"
+        "(gaitlib.cache). Written by tools/store_solutions.py; never edit by hand. The notebooks listed\n"
+        "run from the store (their time from it); `make test` skips a notebook not listed (book/conftest.py).\n\n"
         + "\n".join(f"- {k}: {v:.0f} s" for k, v in times.items()) + "\n")
     print(f"store: {len(used)} entries used by this run; times (s): {times}")
     shutil.rmtree(tmp, ignore_errors=True)
