@@ -527,13 +527,8 @@ def _ch6(bases: dict, runs: dict, valid: dict) -> list[Row]:
                     100 * (1 - th["NMSK"]["FP"] / th["MSK"]["FP"]),
                     100 * (1 - _hours(b.stats) / _hours(a.stats)) if a and b else np.nan, "%", "unknown",
                     "Ch 6 MSK FP, NMSK FP", _joint({k: valid.get(k, "") for k in ("MSK FP", "NMSK FP")})))
-    ms = [runs.get(f"MSK {c}") for c in pr.CH6_COSTS]
-    ns = [runs.get(f"NMSK {c}") for c in pr.CH6_COSTS]
-    ok = all(ms) and all(ns)
-    rows.append(Row(6, "all 8 MSK runs' compute time ÷ all 8 NMSK runs' (Sec 6.3, Table 6.3)",
-                    sum(th["MSK"].values()) / sum(th["NMSK"].values()),
-                    sum(_hours(s.stats) for s in ms) / sum(_hours(s.stats) for s in ns) if ok else np.nan, "1",
-                    "unknown", "Ch 6, 16 runs", _joint({k: valid.get(k, "") for k in runs})))
+    rows.append(_time_ratio_row(6, "all 8 MSK runs' compute time ÷ all 8 NMSK runs' (Sec 6.3, Table 6.3)", th, runs,
+                                pr.CH6_COSTS, "Ch 6, 16 runs", valid))
     # excitations: SDT3 the most accurate NMSK run; FP vs the Ch 5 tracking (Secs 6.2.3–6.2.4)
     ex = {c: float(pr.excitation_score(runs[f"NMSK {c}"], free)["rmse"].mean())
           for c in pr.CH6_COSTS if runs.get(f"NMSK {c}") is not None}
@@ -553,6 +548,15 @@ def _ch6(bases: dict, runs: dict, valid: dict) -> list[Row]:
     return rows
 
 
+def _time_ratio_row(chapter: int, item: str, th: dict, runs: dict, names, solution: str, valid: dict) -> Row:
+    """The MSK ÷ NMSK ratio of summed compute times: the thesis's table ``th`` vs our runs."""
+    ms = [runs.get(f"MSK {c}") for c in names]
+    ns = [runs.get(f"NMSK {c}") for c in names]
+    ours = sum(_hours(s.stats) for s in ms) / sum(_hours(s.stats) for s in ns) if all(ms) and all(ns) else np.nan
+    return Row(chapter, item, sum(th["MSK"].values()) / sum(th["NMSK"].values()), ours, "1", "unknown", solution,
+               _joint({k: valid.get(k, "") for k in runs}))
+
+
 def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict) -> list[Row]:
     from . import predictive as pr
 
@@ -569,13 +573,8 @@ def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict) -> list[
             rows.append(Row(7, f"{model} {inv[tc]} ({tc}) converges (Table 7.2: {h} h)", f"converged, {h} h", ours, "",
                             cause, s.name if s else "", valid.get(k, ""), holds=bool(s and s.success)))
     th = pr.THESIS_HOURS_TABLE_7_2
-    ms = [runs.get(f"MSK {c}") for c in pr.CH7_CLASSES]
-    ns = [runs.get(f"NMSK {c}") for c in pr.CH7_CLASSES]
-    ok = all(ms) and all(ns)
-    rows.append(Row(7, "all 4 MSK runs' compute time ÷ all 4 NMSK runs' (Sec 7.3, Table 7.2)",
-                    sum(th["MSK"].values()) / sum(th["NMSK"].values()),
-                    sum(_hours(s.stats) for s in ms) / sum(_hours(s.stats) for s in ns) if ok else np.nan, "1",
-                    "unknown", "Ch 7, 8 runs", _joint({k: valid.get(k, "") for k in runs})))
+    rows.append(_time_ratio_row(7, "all 4 MSK runs' compute time ÷ all 4 NMSK runs' (Sec 7.3, Table 7.2)", th, runs,
+                                pr.CH7_CLASSES, "Ch 7, 8 runs", valid))
     # NMSK torques more accurate than MSK's per class (Sec 7.2)
     for tc, tv in pr.THESIS_TORQUE_GAIN_PCT_CH7.items():
         c = inv[tc]
