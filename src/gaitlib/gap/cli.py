@@ -15,15 +15,21 @@ def cmd_gap(args) -> int:
     from . import diagnose as D
     from . import io as gio
 
-    ds = gio.read_data(args.data, like=args.like, fill_from=args.fill_from)
+    from ..data import DataError
+
+    try:
+        ds = gio.read_data(args.data, like=args.like, fill_from=args.fill_from, n_subjects=args.n_subjects)
+    except DataError as e:
+        raise SystemExit(f"gaitlib gap: {e}") from None
     effects = [e.strip() for e in args.effects.split(",")] if args.effects else None
-    print(f"gaitlib gap: {ds.label} ({ds.base}, {ds.gait.speed_class}, n = {ds.n}); baseline {args.model} "
+    print(f"gaitlib gap: {ds.label} ({ds.base}, {ds.gait.speed_class}, n = {ds.n} from {ds.n_source}); "
+          f"baseline {args.model} "
           f"{args.cost} {args.intervals} x {args.degree}, objective {args.objective}", flush=True)
     d = D.diagnose(ds, base=_base(args, ds.gait.speed_class), effects=effects, objective=args.objective,
                    resamples=args.resamples, seed=args.seed, root=args.cache, use_cache=not args.no_cache,
                    serial=args.serial, n_workers=args.workers, scheduler=args.scheduler, progress=True)
     out = d.save(args.out, figures=not args.no_figures)
-    cols = ["rank", "effect", "n_params", "status", "pct_closed", "dAIC", "dBIC"]
+    cols = ["rank", "effect", "n_params", "start", "nests_baseline", "status", "pct_closed", "dAIC", "dBIC"]
     print(d.ranking[cols].to_string(index=False, float_format=lambda v: f"{v:.2f}"))
     print(json.dumps({"top_effect": d.top_effect, "verdict": d.verdict, "rss_baseline": d.located.rss,
                       "n_eff": d.located.n_eff}, indent=1))
@@ -65,8 +71,11 @@ def add_parsers(sub) -> None:
     g = sub.add_parser("gap", help="sim-to-real gap diagnosis of a tidy data CSV (diagnosis.json + figures)")
     g.add_argument("--data", required=True, help="tidy CSV (gaitlib.data format)")
     g.add_argument("--out", required=True, help="output directory")
-    g.add_argument("--like", default=None, help="base data set for speed, cycle time and events "
+    g.add_argument("--like", default=None, help="base data set for speed, cycle time and events only "
                                                 "(schwartz2008|gaitutils; default: the CSV's source)")
+    g.add_argument("--n-subjects", type=int, default=None,
+                   help="subjects behind the CSV's means (SD/sqrt(n) is their standard error); required unless "
+                        "the CSV has an n_subjects column or its source is schwartz2008/gaitutils")
     g.add_argument("--fill-from", default=None, help="take quantities the problem needs but the CSV lacks from "
                                                      "this data set (e.g. schwartz2008); excluded from the gap")
     g.add_argument("--effects", default=None, help=f"comma-separated candidates (default all applicable: "
