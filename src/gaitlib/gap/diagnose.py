@@ -16,10 +16,19 @@ GaitData) and a baseline model, and
    (signature in EMG only) on a grid of fixed magnitudes, keeping the one with the smallest
    gap; an NLP candidate that does not converge, or ends above the baseline's objective
    although it contains the baseline model (a worse local optimum), is re-solved from each
-   of the baseline's other starts and the best converged fit kept; comparison-only effects
-   (``resolve=False``) by a bounded scalar search of the gap on the baseline's solution;
+   of the baseline's other starts, then (if still so) from the *null start* — the baseline
+   fit itself with the effect at its null value, a point with exactly the baseline's
+   objective (:mod:`gaitlib.gap.nullstart`) — and the best converged fit kept; if it still
+   ends above the baseline, it is a *failed search*; comparison-only effects
+   (``resolve=False``) by a bounded scalar search of the gap on the baseline's solution
+   (the null value kept when the search does no better);
 3. ranks the effects by a criterion that pays for parameters and says "unexplained" when
-   none is good enough;
+   none is good enough. Failed searches are not ranked (no % closed), nor is a candidate
+   that nests the baseline (:func:`nesting`) but whose located gap ends above the
+   baseline's; a ranked nested candidate therefore never shows a negative % closed beyond
+   the tolerance :data:`RETRY_MARGIN` — only a non-nesting one (the profiled effects) can.
+   Each candidate's row names the start of its kept fit and whether it nests the baseline;
+   ``diagnosis.json`` counts them (:meth:`Diagnosis.summary`);
 4. for the top effects: the gap before/after per channel and phase, % closed, and an
    interval from resampling the data within SD/√n.
 
@@ -64,7 +73,7 @@ from .solve import solve_many
 __all__ = ["BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "Fit", "Diagnosis", "diagnose", "assemble",
            "candidates", "base_spec", "as_dataset", "baseline_fits", "pick_best", "BASELINE_STARTS",
            "COARSE_MESH", "GRF_SD_FACTOR", "RETRY_MARGIN", "grf_weighted", "candidate_fits", "needs_retry",
-           "alternates_of"]
+           "alternates_of", "nesting", "ABOVE_LOCATED", "FIT_STARTS"]
 
 #: ΔBIC a top effect must reach (≤) to be named.
 BIC_THRESHOLD = -10.0
@@ -418,6 +427,11 @@ BASELINE_STARTS = ("cold", "warm", "dt", "coarse", "grf")
 COARSE_MESH = (10, 3)
 #: Factor on the GRF channels' SDs in the first stage of the ``grf`` start.
 GRF_SD_FACTOR = 0.1
+#: Where a candidate's kept fit started (``Fit.start``): ``"baseline"`` the kept baseline fit
+#: (the first solve; profiled effects); one of :data:`BASELINE_STARTS` the baseline's fit
+#: from that start (the retry); ``"null"`` the null start (:mod:`gaitlib.gap.nullstart`);
+#: ``"baseline (no re-solve)"`` comparison-only effects.
+FIT_STARTS = ("baseline", *BASELINE_STARTS, "null", "baseline (no re-solve)")
 #: A nested candidate (its null parameters are the baseline model) whose fit ends with an
 #: objective above the baseline fit's by more than this relative margin has stopped in a
 #: worse local optimum; :func:`candidate_fits` then re-solves it from the baseline's other
