@@ -141,6 +141,14 @@ def test_nested_fit_with_a_located_gap_above_the_baseline_is_not_ranked(tmp_path
     assert not bool(r.loc["co_contraction", "nests_baseline"])
     s = d.summary()
     assert s["located_above_baseline_effects"] == ["hat_com"] and "co_contraction" in s["not_nesting"]
+    # the ranking figure shows only ranked effects and marks the non-nesting one
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from gaitlib.gap import figures as F
+
+    labels = [t.get_text() for t in F.ranking_bars(d.ranking).axes[0].get_yticklabels()]
+    assert labels == ["co_contraction (k=1, not nesting)"]
 
 
 # -------------------------------------------------------------------------- subjects
