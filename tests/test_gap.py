@@ -400,15 +400,19 @@ def test_diagnose_names_the_injected_effect_on_a_twin(tmp_path):
 def test_cli_gap_on_a_hand_written_csv(tmp_path):
     """``gaitlib gap --data CSV --out DIR`` from a fresh process on a tidy CSV written line by
     line (another lab's name, only the quantities the problem needs, every 10 % of the
-    cycle; ``--like schwartz2008`` for speed, cycle time and events): diagnosis.json has
-    the located gap, the ranking (effect, parameters added, identified values, RSS before/
-    after, % closed, ΔAIC/ΔBIC), the shrink with its interval, and a top effect that is
+    cycle; ``--like schwartz2008`` for speed, cycle time and events, ``--n-subjects`` for its
+    own n): diagnosis.json has the data's n and its source, the located gap, the ranking
+    (effect, parameters added, identified values, start of the kept fit, whether it nests the
+    baseline, RSS before/after, % closed — never negative for a ranked nested candidate —,
+    ΔAIC/ΔBIC), the summary's counts, the shrink with its interval, and a top effect that is
     either the best eligible candidate or "unexplained"."""
     import json
     import os
     import shutil
     import subprocess
     import sys
+
+    from gaitlib.gap import diagnose as D
 
     df = data_mod.load_tidy(data_mod.DATA_DIR / "schwartz2008_curves.csv")
     df = df[(df.speed_class == "Free") & df.quantity.isin(gio.REQUIRED_QUANTITIES) & (df.percent_cycle % 10 == 0)]
@@ -421,7 +425,7 @@ def test_cli_gap_on_a_hand_written_csv(tmp_path):
     assert exe, "the gaitlib console script is not installed"
     out = tmp_path / "out"
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
-    cmd = [exe, "gap", "--data", str(csv), "--out", str(out), "--like", "schwartz2008",
+    cmd = [exe, "gap", "--data", str(csv), "--out", str(out), "--like", "schwartz2008", "--n-subjects", "24",
            "--effects", "friction,hat_com,segment_inertia", "--intervals", "6", "--degree", "3",
            "--resamples", "40", "--serial", "--cache", str(tmp_path / "cache")]
     # a guard against a hang, not a speed claim: ≈ 50 s here alone, > 240 s on 2 busy cores
@@ -430,7 +434,8 @@ def test_cli_gap_on_a_hand_written_csv(tmp_path):
     j = json.loads((out / "diagnosis.json").read_text())
     for f in ("gap_heatmap.png", "ranking.png", "located.csv", "ranking.csv"):
         assert (out / f).is_file(), f
-    assert j["data"]["base_source"] == "schwartz2008" and j["data"]["n_subjects"] == 82
+    assert j["data"]["base_source"] == "schwartz2008"
+    assert j["data"]["n_subjects"] == 24 and j["data"]["n_subjects_source"] == "option"
     # located: 16 channels (angles, torques, GRFs; both legs) × 6 phases
     loc = j["located"]
     assert loc["summary"]["cells"] == 16 * 6 and len(loc["channels"]) == 16
@@ -443,9 +448,16 @@ def test_cli_gap_on_a_hand_written_csv(tmp_path):
         e = fx.EFFECTS[name]
         assert r["n_params"] == e.n_params and set(r["parameters"]) == {q.name for q in e.params}
         assert r["rss_before"] == pytest.approx(loc["summary"]["rss"])
+        assert r["start"] in ("baseline", "null") + D.BASELINE_STARTS and r["nests_baseline"]
+        if r["rank"] is None:  # a failed search or a located gap above the baseline's: no % closed
+            assert r["search"] != "ok" and r["pct_closed"] is None and r["dBIC"] is None
+            continue
         assert r["pct_closed"] == pytest.approx(100 * (1 - r["rss_after"] / r["rss_before"]))
+        assert r["pct_closed"] >= -100 * j["summary"]["retry_margin"]  # every candidate here nests the baseline
         n_eff = j["criterion"]["n_eff"]
         assert r["dBIC"] == pytest.approx(n_eff * np.log(r["rss_after"] / r["rss_before"]) + e.n_params * np.log(n_eff))
+    s = j["summary"]
+    assert s["candidates"] == 3 and s["ranked"] + s["failed_search"] + s["located_above_baseline"] == 3
     # shrink of the top effects: before/after per channel and phase, % closed and its interval
     assert j["shrink"]
     for name, s in j["shrink"].items():

@@ -50,7 +50,7 @@ def cmd_gap(args) -> int:
     effects = effect_names(args.effects)
     # the data gates (gaitlib.plausibility) run here, before any problem is built
     ds = gio.read_data(args.data, like=args.like, speed_class=args.speed_class, fill_from=args.fill_from,
-                       allow_no_sd=args.allow_no_sd)
+                       allow_no_sd=args.allow_no_sd, n_subjects=args.n_subjects)
     base = _base(args, ds.gait.speed_class)
     _spec(base)
     root = cli.check_cache(args.cache, not args.no_cache)
@@ -59,13 +59,14 @@ def cmd_gap(args) -> int:
     with cli.Output(out, overwrite=args.overwrite, owned=owned, last=("diagnosis.json",),
                     what="the diagnosis's files (diagnosis.json, located.csv, ranking.csv, shrink_*.csv, "
                          "figures)") as o:
-        print(f"gaitlib gap: {ds.label} ({ds.base}, {ds.gait.speed_class}, n = {ds.n}); baseline {args.model} "
-              f"{args.cost} {args.intervals} x {args.degree}, objective {args.objective}", flush=True)
+        print(f"gaitlib gap: {ds.label} ({ds.base}, {ds.gait.speed_class}, n = {ds.n} from {ds.n_source}); "
+              f"baseline {args.model} {args.cost} {args.intervals} x {args.degree}, objective {args.objective}",
+              flush=True)
         d = D.diagnose(ds, base=base, effects=effects, objective=args.objective, resamples=args.resamples,
                        seed=args.seed, root=root, use_cache=not args.no_cache, serial=args.serial,
                        n_workers=args.workers, scheduler=args.scheduler, progress=True)
         d.save(o.tmp, figures=not args.no_figures)
-    cols = ["rank", "effect", "n_params", "status", "pct_closed", "dAIC", "dBIC"]
+    cols = ["rank", "effect", "n_params", "start", "nests_baseline", "status", "pct_closed", "dAIC", "dBIC"]
     print(d.ranking[cols].to_string(index=False, float_format=lambda v: f"{v:.2f}"))
     print(json.dumps({"top_effect": d.top_effect, "verdict": d.verdict, "rss_baseline": d.located.rss,
                       "n_eff": d.located.n_eff, "baseline_status": d.baseline.stats["status"]}, indent=1))
@@ -141,8 +142,11 @@ def add_parsers(sub) -> None:
     g = sub.add_parser("gap", help="sim-to-real gap diagnosis of a tidy data CSV (diagnosis.json + figures)")
     g.add_argument("--data", required=True, help="tidy CSV (gaitlib.data format)")
     g.add_argument("--out", required=True, help="output directory")
-    g.add_argument("--like", default=None, help="base data set for speed, cycle time and events "
+    g.add_argument("--like", default=None, help="base data set for speed, cycle time and events only "
                                                 "(schwartz2008|gaitutils; default: the CSV's source)")
+    g.add_argument("--n-subjects", type=int_at_least(1), default=None,
+                   help="subjects behind the CSV's means (SD/sqrt(n) is their standard error); required unless "
+                        "the CSV has an n_subjects column or its source is schwartz2008/gaitutils")
     g.add_argument("--fill-from", default=None, help="take quantities the problem needs but the CSV lacks from "
                                                      "this data set (e.g. schwartz2008); excluded from the gap")
     g.add_argument("--speed-class", default=None, help="the speed class to diagnose if the CSV has several "

@@ -17,10 +17,19 @@ GaitData) and a baseline model, and
    (signature in EMG only) on a grid of fixed magnitudes, keeping the one with the smallest
    gap; an NLP candidate that does not converge, or ends above the baseline's objective
    although it contains the baseline model (a worse local optimum), is re-solved from each
-   of the baseline's other starts and the best converged fit kept; comparison-only effects
-   (``resolve=False``) by a bounded scalar search of the gap on the baseline's solution;
+   of the baseline's other starts, then (if still so) from the *null start* — the baseline
+   fit itself with the effect at its null value, a point with exactly the baseline's
+   objective (:mod:`gaitlib.gap.nullstart`) — and the best converged fit kept; if it still
+   ends above the baseline, it is a *failed search*; comparison-only effects
+   (``resolve=False``) by a bounded scalar search of the gap on the baseline's solution
+   (the null value kept when the search does no better);
 3. ranks the effects by a criterion that pays for parameters and says "unexplained" when
-   none is good enough;
+   none is good enough. Failed searches are not ranked (no % closed), nor is a candidate
+   that nests the baseline (:func:`nesting`) but whose located gap ends above the
+   baseline's; a ranked nested candidate therefore never shows a negative % closed beyond
+   the tolerance :data:`RETRY_MARGIN` — only a non-nesting one (the profiled effects) can.
+   Each candidate's row names the start of its kept fit and whether it nests the baseline;
+   ``diagnosis.json`` counts them (:meth:`Diagnosis.summary`);
 4. for the top effects: the gap before/after per channel and phase, % closed, and an
    interval from resampling the data within SD/√n.
 
@@ -59,12 +68,13 @@ from ..ocp import _json_default  # the same JSON encoding as saved solutions
 from . import effects as fx
 from . import io as gio
 from . import locate as L
+from .nullstart import null_start_many
 from .solve import solve_many
 
 __all__ = ["BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "Fit", "Diagnosis", "diagnose", "assemble",
            "candidates", "base_spec", "as_dataset", "baseline_fits", "pick_best", "BASELINE_STARTS",
            "COARSE_MESH", "GRF_SD_FACTOR", "RETRY_MARGIN", "grf_weighted", "candidate_fits", "needs_retry",
-           "alternates_of", "lowest_objective", "BaselineFailed"]
+           "alternates_of", "lowest_objective", "BaselineFailed", "nesting", "ABOVE_LOCATED", "FIT_STARTS"]
 
 #: ΔBIC a top effect must reach (≤) to be named.
 BIC_THRESHOLD = -10.0
@@ -84,14 +94,16 @@ def base_spec(base=None) -> tr.GaitSpec:
     return tr.GaitSpec(**dict(DEFAULT_BASE if base is None else base))
 
 
-def as_dataset(data, like=None, fill_from=None) -> gio.DataSet:
+def as_dataset(data, like=None, fill_from=None, n_subjects=None) -> gio.DataSet:
     if isinstance(data, gio.DataSet):
         return data
     if isinstance(data, (str, Path)):
-        return gio.read_data(data, like=like, fill_from=fill_from)
+        return gio.read_data(data, like=like, fill_from=fill_from, n_subjects=n_subjects)
     if hasattr(data, "mean") and hasattr(data, "sd"):
-        return gio.DataSet(gait=data, label=f"{data.source} {data.speed_class}", base=data.source,
-                           n=gio.n_subjects(data.source, data.speed_class))
+        frame = pd.DataFrame({"source": [data.source]})
+        n, n_source = gio.subject_count(frame, data.speed_class, n_subjects, f"GaitData {data.source}")
+        return gio.DataSet(gait=data, label=f"{data.source} {data.speed_class}", base=data.source, n=n,
+                           n_source=n_source)
     raise TypeError(f"data must be a CSV path, DataSet or GaitData, got {type(data).__name__}")
 
 
@@ -125,6 +137,8 @@ class Fit:
     status: str
     ok: bool
     profile: list = field(default_factory=list)  # [(magnitude, rss, status)]
+    start: str = "baseline"  # where the kept fit started (:data:`FIT_STARTS`)
+    search: str = "ok"  # "ok" or "failed search" (:func:`candidate_fits`)
 
 
 def _status(sol) -> tuple[str, bool]:
@@ -223,7 +237,8 @@ class Diagnosis:
 
         out = {
             "data": {"label": self.data.label, "base_source": self.data.base, "speed_class": self.data.gait.speed_class,
-                     "n_subjects": self.data.n, "signature": self.data.signature, "filled": list(self.data.filled),
+                     "n_subjects": self.data.n, "n_subjects_source": self.data.n_source,
+                     "signature": self.data.signature, "filled": list(self.data.filled),
                      "path": self.data.path, "notes": list(self.data.notes) + list(self.data.gait.notes)},
             "baseline": {"spec": self.spec.to_dict(), "objective": self.objective,
                          "stats": _stats(self.baseline)},
@@ -239,14 +254,34 @@ class Diagnosis:
             "shrink": {k: {"table": rec(v), "pct_closed": float(self.ranking.set_index("effect").loc[k, "pct_closed"]),
                            "interval_95": self.intervals.get(k)} for k, v in self.shrink.items()},
             "skipped": self.skipped,
+            "summary": self.summary(),
             "effects": {n: {"title": e.title, "n_params": e.n_params, "identify": e.identify,
-                            "params": [p.__dict__ for p in e.params]} for n, e in fx.EFFECTS.items()},
+                            "params": [p.__dict__ for p in e.params], "nests_baseline": nesting(n)[0],
+                            "nesting": nesting(n)[1]} for n, e in fx.EFFECTS.items()},
             "settings": self.settings,
         }
         if self.solution_located is not None:
             out["solution_located"] = {"summary": self.solution_located.summary(),
                                        "table": rec(self.solution_located.table)}
         return out
+
+    def summary(self) -> dict:
+        """Counts of the candidates: tried, ranked, failed searches (named), nested ones with
+        a located gap above the baseline's, re-solved from the null start, not nesting."""
+        r = self.ranking
+        if r.empty:
+            r = pd.DataFrame(columns=["rank", "effect", "search", "start"])
+
+        def sel(mask):
+            return [str(e) for e in r.loc[mask, "effect"]]
+
+        failed, above = sel(r["search"] == "failed search"), sel(r["search"] == ABOVE_LOCATED)
+        return {"candidates": len(r), "ranked": int(r["rank"].notna().sum()),
+                "failed_search": len(failed), "failed_search_effects": failed,
+                "located_above_baseline": len(above), "located_above_baseline_effects": above,
+                "null_start": sel(r["start"] == "null"),
+                "not_nesting": {n: nesting(n)[1] for n in r["effect"] if not nesting(n)[0]},
+                "retry_margin": RETRY_MARGIN}
 
     def save(self, out, figures: bool = True) -> Path:
         """Write ``diagnosis.json``, ``located.csv``, ``ranking.csv``, ``shrink_<effect>.csv``
@@ -281,30 +316,69 @@ def _stats(sol) -> dict:
     return {k: sol.stats.get(k) for k in keys if k in sol.stats}
 
 
+#: ``search`` of a nested candidate whose fit is no failed search (its objective is not above
+#: the baseline's) but whose located gap (RSS) is above the baseline's by more than
+#: :data:`RETRY_MARGIN` (relative): the fit moved misfit from the located channels to what
+#: the objective counts besides them (regularisation; channels filled from another data
+#: set). Not ranked: the candidate model contains the baseline, so this is not its best
+#: member by the ranking's criterion.
+ABOVE_LOCATED = "located gap above the baseline's"
+
+
+def nesting(name: str) -> tuple[bool, str]:
+    """(whether the candidate's kept fit can always reproduce the baseline, why)."""
+    e = fx.EFFECTS[name]
+    if not e.resolve:
+        return True, "comparison on the baseline solution; the null value is kept unless a value does better"
+    if _nested(e):
+        return True, "its null parameter values are the baseline model (an NLP start with the baseline's objective)"
+    if e.identify == "profile":
+        return False, "fitted on a grid of fixed magnitudes without the null value"
+    return False, "its null value lies outside its parameters' bounds"
+
+
 def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", resamples: int = 200, seed: int = 0,
              top: int = 3, skipped=None, settings=None, solution=None) -> Diagnosis:
-    """Rank fitted candidates against the baseline fit and build the :class:`Diagnosis`."""
+    """Rank fitted candidates against the baseline fit and build the :class:`Diagnosis`.
+
+    Ranked (``rank`` 1, 2, …, by ΔBIC): candidates with a located fit whose ``search`` is
+    ``"ok"``. Not ranked (``rank`` missing; no % closed, ΔAIC, ΔBIC): no fit, a failed
+    search (:func:`candidate_fits`), or a nested candidate whose located gap ends above the
+    baseline's (:data:`ABOVE_LOCATED`). So a ranked candidate that nests the baseline
+    (``nests_baseline``, :func:`nesting`) closes ≥ −100 :data:`RETRY_MARGIN` % of the RSS;
+    only a non-nesting one can show a negative % closed."""
     loc0 = L.locate(base_sol, ds)
     n_eff = loc0.n_eff
     rows = []
     for name, f in fits.items():
         e = fx.EFFECTS[name]
+        nests, _ = nesting(name)
+        row = {"effect": name, "title": e.title, "n_params": f.n_params, "identify": f.identify,
+               "parameters": f.thetas.get(name, {}), "status": f.status, "ok": f.ok, "start": f.start,
+               "nests_baseline": nests, "search": f.search, "rss_before": loc0.rss, "rss_after": np.nan,
+               "pct_closed": np.nan, "dAIC": np.nan, "dBIC": np.nan}
+        if f.located is not None:
+            row["rss_after"] = rk = f.located.rss
+            if nests and f.search == "ok" and rk > loc0.rss * (1.0 + RETRY_MARGIN):
+                row["search"] = ABOVE_LOCATED
         if f.located is None:
-            rows.append({"effect": name, "title": e.title, "n_params": f.n_params, "identify": f.identify,
-                         "parameters": f.thetas.get(name, {}), "status": f.status, "ok": False,
-                         "rss_before": loc0.rss, "rss_after": np.nan, "pct_closed": np.nan, "dAIC": np.nan,
-                         "dBIC": np.nan})
-            continue
-        rk = f.located.rss
-        daic, dbic = _criteria(loc0.rss, rk, f.n_params, n_eff)
-        rows.append({"effect": name, "title": e.title, "n_params": f.n_params, "identify": f.identify,
-                     "parameters": f.thetas.get(name, {}), "status": f.status, "ok": f.ok,
-                     "rss_before": loc0.rss, "rss_after": rk, "pct_closed": 100.0 * (1.0 - rk / loc0.rss),
-                     "dAIC": daic, "dBIC": dbic})
+            row["ok"] = False
+        elif row["search"] != "ok":
+            row["ok"] = False
+            row["status"] = f"{row['search']} ({f.status})"
+        else:
+            row["dAIC"], row["dBIC"] = _criteria(loc0.rss, rk, f.n_params, n_eff)
+            row["pct_closed"] = 100.0 * (1.0 - rk / loc0.rss)
+        rows.append(row)
     ranking = pd.DataFrame(rows)
     if not ranking.empty:
-        ranking = ranking.sort_values("dBIC", na_position="last").reset_index(drop=True)
-        ranking.insert(0, "rank", np.arange(1, len(ranking) + 1))
+        ranked = ranking["search"].eq("ok") & np.isfinite(ranking["dBIC"].astype(float))
+        ranking = ranking.assign(_r=~ranked).sort_values(["_r", "dBIC"], na_position="last", kind="stable")
+        ranking = ranking.drop(columns="_r").reset_index(drop=True)
+        rank = pd.array([pd.NA] * len(ranking), dtype="Int64")
+        m = int(ranked.sum())
+        rank[:m] = np.arange(1, m + 1)
+        ranking.insert(0, "rank", rank)
     elig = ranking[(ranking["ok"]) & (ranking["dBIC"] <= BIC_THRESHOLD)] if not ranking.empty else ranking
     if len(elig):
         top_effect = str(elig.iloc[0]["effect"])
@@ -369,6 +443,11 @@ BASELINE_STARTS = ("cold", "warm", "dt", "coarse", "grf")
 COARSE_MESH = (10, 3)
 #: Factor on the GRF channels' SDs in the first stage of the ``grf`` start.
 GRF_SD_FACTOR = 0.1
+#: Where a candidate's kept fit started (``Fit.start``): ``"baseline"`` the kept baseline fit
+#: (the first solve; profiled effects); one of :data:`BASELINE_STARTS` the baseline's fit
+#: from that start (the retry); ``"null"`` the null start (:mod:`gaitlib.gap.nullstart`);
+#: ``"baseline (no re-solve)"`` comparison-only effects.
+FIT_STARTS = ("baseline", *BASELINE_STARTS, "null", "baseline (no re-solve)")
 #: A nested candidate (its null parameters are the baseline model) whose fit ends with an
 #: objective above the baseline fit's by more than this relative margin has stopped in a
 #: worse local optimum; :func:`candidate_fits` then re-solves it from the baseline's other
@@ -480,17 +559,23 @@ def needs_retry(n: str, sol, base_sol) -> bool:
 
 
 def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit", root=None, use_cache=True,
-                   alternates: dict | None = None, **sweep_kw) -> dict:
+                   alternates: dict | None = None, null_start: bool = True, **sweep_kw) -> dict:
     """Fits of every candidate on every data set: key → {effect: Fit}.
 
     Each candidate is warm-started from ``bases[key]`` (the baseline fit). ``alternates``
     (key → {start: solution}: the baseline's fits from its other starts, see
     :func:`baseline_fits` ``detail``) enables the retry: an NLP-identified candidate whose
-    fit :func:`needs_retry` is re-solved warm-started from each of them, and the converged
-    fit with the lowest objective (:func:`pick_best`) is kept — if none converged, the one
-    with the lowest objective (:func:`lowest_objective`), reported with its status and never
-    eligible; its ``stats["retry_start"]`` names the start it came from (``"best"``: the
-    first solve)."""
+    fit :func:`needs_retry` is re-solved warm-started from each of them. A nested candidate
+    (:func:`_nested`) whose best fit still :func:`needs_retry` is then (``null_start``)
+    re-solved from the baseline fit itself with its parameters at their null values
+    (:mod:`gaitlib.gap.nullstart`: a start with exactly the baseline's objective). The
+    converged fit with the lowest objective (:func:`pick_best`) is kept — if none converged,
+    the one with the lowest objective (:func:`lowest_objective`), reported with its status
+    and never eligible; ``Fit.start``
+    names where it started (:data:`FIT_STARTS`; ``stats["retry_start"]`` too, ``"best"``
+    for the first solve, when more than one was tried). A nested candidate whose kept fit
+    still :func:`needs_retry` is a failed local search: ``Fit.search = "failed search"``
+    (:func:`assemble` does not rank it)."""
     groups = {}
     for n in names:
         e = fx.EFFECTS[n]
@@ -522,6 +607,27 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
                 retry[f"{n}|retry"] = (spec, jobs)
     if retry:
         res.update({k: v for k, v in solve_many(retry, **kw).items() if k != "__records__"})
+
+    def tried(k, n):
+        t = {"best": res.get(f"{k}|{n}")}
+        for st in list((alternates or {}).get(k) or {}) + ["null"]:
+            if res.get(f"{k}|{n}|{st}") is not None:
+                t[st] = res[f"{k}|{n}|{st}"]
+        return t
+
+    # the null start: a nested candidate still failed or above the baseline after every start
+    null = {}
+    if null_start:
+        for n in names:
+            e = fx.EFFECTS[n]
+            if not (e.resolve and _nested(e)):
+                continue
+            jobs = [(f"{k}|{n}|null", ds.gait, bases[k]) for k, ds in datasets.items()
+                    if bases[k] is not None and needs_retry(n, pick_best(list(tried(k, n).values())), bases[k])]
+            if jobs:
+                null[f"{n}|null"] = (_with_effects(spec0, ((n, None),)), jobs)
+    if null:
+        res.update({k: v for k, v in null_start_many(null, **kw).items() if k != "__records__"})
     out = {}
     for k, ds in datasets.items():
         fits = {}
@@ -530,13 +636,18 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
             if not e.resolve:
                 fits[n] = _comparison_fit(n, bases[k], ds)
             elif e.identify == "nlp":
-                tried = {"best": res.get(f"{k}|{n}")}
-                tried.update({st: res.get(f"{k}|{n}|{st}") for st in (alternates or {}).get(k) or {}
-                              if res.get(f"{k}|{n}|{st}") is not None})
-                sol = pick_best(list(tried.values())) or lowest_objective(list(tried.values()))
-                if sol is not None and len(tried) > 1:
-                    sol.stats["retry_start"] = next(st for st, s in tried.items() if s is sol)
+                t = tried(k, n)
+                sol = pick_best(list(t.values())) or lowest_objective(list(t.values()))
+                start = "baseline"
+                if sol is not None:
+                    key = next(st for st, s in t.items() if s is sol)
+                    if len(t) > 1:
+                        sol.stats["retry_start"] = key
+                    start = "baseline" if key == "best" else key
                 fits[n] = _nlp_fit(n, sol, ds, error=n in recs and bool(recs[n].error))
+                fits[n].start = start
+                if _nested(e) and bases[k] is not None and needs_retry(n, sol, bases[k]):
+                    fits[n].search = "failed search"
             else:
                 prof, best = [], None
                 for m in PROFILE_GRID[n]:
@@ -585,10 +696,13 @@ def _comparison_fit(name: str, base_sol, ds) -> Fit:
         return L.locate(sim, ds, thetas={name: th}).rss
 
     r = minimize_scalar(rss, bounds=(p.lower, p.upper), method="bounded", options={"xatol": 1e-4})
+    # the null value is a member of the search range: kept when the search ends above it
+    x = float(r.x) if float(r.fun) <= rss(p.null) else float(p.null)
     th = e.null_theta()
-    th[p.name] = float(r.x)
+    th[p.name] = x
     loc = L.locate(sim, ds, thetas={name: th})
-    return Fit(name, base_sol, {name: th}, loc, e.n_params, e.identify, "Solve_Succeeded (comparison only)", True)
+    return Fit(name, base_sol, {name: th}, loc, e.n_params, e.identify, "Solve_Succeeded (comparison only)", True,
+               start="baseline (no re-solve)")
 
 
 # ======================================================================================
@@ -596,8 +710,8 @@ def _comparison_fit(name: str, base_sol, ds) -> Fit:
 # ======================================================================================
 
 def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None, solution=None, like=None,
-             fill_from=None, resamples: int = 200, seed: int = 0, root=None, use_cache: bool = True,
-             **sweep_kw) -> Diagnosis:
+             fill_from=None, n_subjects: int | None = None, resamples: int = 200, seed: int = 0, root=None,
+             use_cache: bool = True, **sweep_kw) -> Diagnosis:
     """Diagnose the sim-to-real gap of a baseline model on a data set.
 
     Parameters
@@ -612,7 +726,9 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
         :mod:`gaitlib.gap.solve`.
     warm : a solution to warm-start the baseline fit from (one of :data:`BASELINE_STARTS`).
     solution : a solution (e.g. a thesis chapter's) whose own gap is also located and reported.
-    like, fill_from : passed to :func:`gaitlib.gap.io.read_data`.
+    like, fill_from, n_subjects : passed to :func:`gaitlib.gap.io.read_data` (``n_subjects``:
+        the subjects behind the data's means; required for a CSV of a source the project
+        does not know unless it has an ``n_subjects`` column).
     resamples, seed : data resampling for the % closed intervals.
     root, use_cache : the solutions cache.
     **sweep_kw : ``scheduler``, ``n_workers``, ``serial``, ``progress`` of :func:`gaitlib.sweep.sweep`.
@@ -620,7 +736,7 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
     Raises :class:`BaselineFailed` (with every start's IPOPT status) when no start of the
     baseline fit converged.
     """
-    ds = as_dataset(data, like, fill_from)
+    ds = as_dataset(data, like, fill_from, n_subjects)
     spec0 = base_spec(base)
     names, skipped = candidates(spec0, ds.gait, effects)
     b = baseline_fits(spec0, {"data": ds}, warm, objective=objective, root=root, use_cache=use_cache, detail=True,

@@ -61,8 +61,23 @@ def shrink_heatmaps(loc0, loc1, effect: str, title: str = ""):
     return fig
 
 
+def _rank_label(row) -> str:
+    """``effect (k=1)``, plus where the kept fit started when not from the baseline fit and
+    "does not nest the baseline" where so (a negative % closed is then possible)."""
+    extra = [f"k={int(row['n_params'])}"]
+    start = row.get("start")
+    if isinstance(start, str) and not start.startswith("baseline"):
+        extra.append(f"from {start}")
+    if row.get("nests_baseline") is False or row.get("nests_baseline") is np.False_:
+        extra.append("not nesting")
+    return f"{row['effect']} ({', '.join(extra)})"
+
+
 def ranking_bars(ranking: pd.DataFrame, top: str | None = None, threshold: float | None = None):
-    """% of the RSS closed (raw, with interval where computed) and ΔBIC per effect."""
+    """% of the RSS closed (raw, with interval where computed) and ΔBIC per ranked effect
+    (unranked ones — no ΔBIC: failed searches, nested fits with a located gap above the
+    baseline's — are left out); labels name the start of a fit not from the baseline fit
+    and the effects that do not nest the baseline."""
     import matplotlib.pyplot as plt
 
     from .diagnose import BIC_THRESHOLD
@@ -82,7 +97,7 @@ def ranking_bars(ranking: pd.DataFrame, top: str | None = None, threshold: float
         axs[0].plot(np.r_[lo[m], hi[m]], np.r_[y[m], y[m]], "k|", ms=7)
     axs[0].axvline(0, color="k", lw=0.8)
     axs[0].set_xlabel("RSS closed (%) — raw")
-    axs[0].set_yticks(y, [f"{e} (k={int(k)})" for e, k in zip(r["effect"], r["n_params"])], fontsize=8)
+    axs[0].set_yticks(y, [_rank_label(row) for _, row in r.iterrows()], fontsize=8)
     axs[1].barh(y, r["dBIC"], color=colors)
     axs[1].axvline(threshold, color="tab:red", ls="--", lw=1, label=f"threshold {threshold:g}")
     axs[1].axvline(0, color="k", lw=0.8)

@@ -11,8 +11,8 @@ by the Fourier phase shift).
 Both legs: a model quantity given with sides ``R`` and ``L`` (instead of ``ipsilateral``)
 is read with its measured left leg; otherwise the left leg is generated from the right one.
 
-The base source (speed, cycle time, events, the number of subjects) is: ``like`` if given;
-else the CSV's ``source`` if it is ``schwartz2008`` or ``gaitutils``; else the name inside
+The base source (speed, cycle time, events) is: ``like`` if given; else the CSV's
+``source`` if it is ``schwartz2008`` or ``gaitutils``; else the name inside
 ``twin(<source>)`` (synthetic data sets written by :mod:`gaitlib.gap.twin`).
 
 Accepted values (checked by :func:`read_data` before anything is built; a failure is a
@@ -36,6 +36,17 @@ one-line :class:`gaitlib.data.DataError` naming file, quantity, row and expected
                    ``allow_no_sd=True`` (CLI ``--allow-no-sd``): such a curve is tracked
                    but left out of the located gap.
 See :mod:`gaitlib.plausibility` for every threshold and its source.
+
+Number of subjects. n (the mean's standard error is SD/√n: the band test of
+:mod:`gaitlib.gap.locate` and the % closed intervals scale with √n) is a property of the
+data, never of the base source: in order, the ``n_subjects`` argument (CLI:
+``--n-subjects``); an optional ``n_subjects`` column of the CSV (a positive integer, one
+value per speed class; e.g. ``source,speed_class,quantity,side,percent_cycle,mean,sd,unit,
+n_subjects``); the known source the CSV names itself (:func:`n_subjects`: Schwartz 2008 the
+speed table's n of the class, 82 at Free; gaitutils: not published with its normal data,
+1 — the conservative value; ``twin(<source>)``: the source's, as the twin's noise was
+drawn with it). A CSV of another source without either is an error: ``like`` borrows
+speed, cycle time and events only. :attr:`DataSet.n_source` says which it was.
 """
 
 from __future__ import annotations
@@ -54,7 +65,7 @@ from .. import data as data_mod
 from .. import plausibility
 
 __all__ = ["KNOWN_SOURCES", "REQUIRED_QUANTITIES", "DataSet", "read_data", "load_real", "base_source_of",
-           "n_subjects", "signature", "MODEL_QUANTITIES"]
+           "n_subjects", "subject_count", "known_source", "signature", "MODEL_QUANTITIES"]
 
 KNOWN_SOURCES = ("schwartz2008", "gaitutils")
 #: Quantities the gait problem needs (tracked channels, the hip's pelvis correction, the
@@ -82,6 +93,8 @@ class DataSet:
     filled : quantities taken from another data set (``fill_from``); their channels are
         tracked but excluded from the located gap.
     path : the CSV, if read from one.
+    n_source : where ``n`` came from: ``"option"``, ``"column"`` or ``"known source <name>"``
+        (module docstring).
     """
 
     gait: object
@@ -91,6 +104,7 @@ class DataSet:
     filled: tuple = ()
     path: str | None = None
     notes: tuple = field(default_factory=tuple)
+    n_source: str = ""
 
     @property
     def signature(self) -> str:
@@ -102,16 +116,61 @@ def base_source_of(source: str, like: str | None = None) -> str:
         if like not in KNOWN_SOURCES:
             raise data_mod.DataError(f"like={like!r}: expected one of {KNOWN_SOURCES}")
         return like
-    if source in KNOWN_SOURCES:
-        return source
-    if source.startswith("twin(") and source.endswith(")") and source[5:-1] in KNOWN_SOURCES:
-        return source[5:-1]
+    if known_source(source) is not None:
+        return known_source(source)
     raise data_mod.DataError(f"source {source!r} is not a known data set {KNOWN_SOURCES}: pass like=<source> "
                              "(CLI: --like) to take speed, cycle time and events from it")
 
 
+def known_source(source: str) -> str | None:
+    """The known data set a CSV's ``source`` names (itself, or ``x`` of ``twin(x)``), else None."""
+    if source in KNOWN_SOURCES:
+        return source
+    if source.startswith("twin(") and source.endswith(")") and source[5:-1] in KNOWN_SOURCES:
+        return source[5:-1]
+    return None
+
+
+def subject_count(df: pd.DataFrame, speed_class: str, n_option=None, path=None) -> tuple[int, str]:
+    """(n, where it came from) of a tidy frame of one speed class (module docstring):
+    ``n_option``, else the ``n_subjects`` column, else the known source; a one-line
+    :class:`gaitlib.data.DataError` when none gives it or they disagree."""
+    col = None
+    if "n_subjects" in df.columns:
+        v = pd.to_numeric(df["n_subjects"].replace("", np.nan), errors="coerce")
+        bad = v.isna() | (v < 1) | (v != np.round(v))
+        if bad.any():
+            i = int(np.flatnonzero(bad.to_numpy())[0])
+            raise data_mod.DataError(f"{path}: column 'n_subjects' row {df.index[i] + 2}: {df['n_subjects'].iloc[i]!r} "
+                                     "is not a positive integer (subjects behind the means)")
+        vals = sorted(set(int(x) for x in v))
+        if len(vals) != 1:
+            raise data_mod.DataError(f"{path}: column 'n_subjects' has several values {vals} for speed class "
+                                     f"{speed_class!r}; expected one")
+        col = vals[0]
+    if n_option is not None:
+        n = int(n_option)
+        if n != n_option or n < 1:
+            raise data_mod.DataError(f"n_subjects={n_option!r}: expected a positive integer (subjects behind the means)")
+        if col is not None and col != n:
+            raise data_mod.DataError(f"{path}: column 'n_subjects' says {col}, the option (--n-subjects) {n}: "
+                                     "they disagree")
+        return n, "option"
+    if col is not None:
+        return col, "column"
+    src = str(df["source"].iloc[0])
+    known = known_source(src)
+    if known is None:
+        raise data_mod.DataError(
+            f"{path}: the number of subjects behind the means of source {src!r} is unknown: pass n_subjects "
+            "(CLI: --n-subjects N) or add a column 'n_subjects'; --like borrows speed, cycle time and events only")
+    return n_subjects(known, speed_class), f"known source {known}"
+
+
 def n_subjects(base: str, speed_class: str, data_dir=None) -> int:
-    """Subjects behind the group mean: Schwartz 2008 speed table's n; gaitutils 1 (unknown)."""
+    """Subjects behind the group mean of a known source: Schwartz 2008 the speed table's n
+    of the class (``schwartz2008_speed.csv``, column ``n``); gaitutils 1 (its normal data
+    do not state n; 1 is the conservative value)."""
     if base != "schwartz2008":
         return 1
     d = Path(data_dir) if data_dir is not None else data_mod.DATA_DIR
@@ -159,7 +218,7 @@ def load_real(speed_class: str = "Free", source: str = "schwartz2008", fill_from
 
 
 def read_data(path, like: str | None = None, speed_class: str | None = None,
-              fill_from: str | None = None, allow_no_sd: bool = False) -> DataSet:
+              fill_from: str | None = None, allow_no_sd: bool = False, n_subjects: int | None = None) -> DataSet:
     """Read a tidy CSV (:data:`gaitlib.data.TIDY_COLUMNS`) into a :class:`DataSet`.
 
     Parameters
@@ -174,6 +233,8 @@ def read_data(path, like: str | None = None, speed_class: str | None = None,
         without it a missing quantity is an error naming it.
     allow_no_sd : accept curves whose SD is 0 everywhere: tracked, but left out of the
         located gap (listed in the DataSet's notes).
+    n_subjects : subjects behind the means (module docstring); needed unless the CSV has an
+        ``n_subjects`` column or names a known source.
     """
     path = Path(path)
     df = data_mod.load_tidy(path)
@@ -191,15 +252,19 @@ def read_data(path, like: str | None = None, speed_class: str | None = None,
     if no_sd:
         qs = sorted({c.split(" ")[0] for c in no_sd})
         notes = (f"tracked without SD (left out of the located gap): {', '.join(qs)}",)
-    return _from_frame(df, label=path.name, like=like, fill_from=fill_from, path=str(path), notes=notes)
+    return _from_frame(df, label=path.name, like=like, fill_from=fill_from, path=str(path), notes=notes,
+                       n_option=n_subjects)
 
 
-def _from_frame(df: pd.DataFrame, label: str, like=None, fill_from=None, path=None, notes=()) -> DataSet:
+def _from_frame(df: pd.DataFrame, label: str, like=None, fill_from=None, path=None, notes=(),
+                n_option=None) -> DataSet:
     sources = sorted(set(df["source"]))
     if len(sources) != 1:
         raise data_mod.DataError(f"{path}: column 'source' has several values {sources}; one data set per file")
     speed_class = str(df["speed_class"].iloc[0])
     base = base_source_of(sources[0], like)
+    n, n_source = subject_count(df, speed_class, n_option, path)
+    df = df[list(data_mod.TIDY_COLUMNS)]
     have = set(df["quantity"])
     missing = [q for q in REQUIRED_QUANTITIES if q not in have]
     filled = ()
@@ -237,8 +302,8 @@ def _from_frame(df: pd.DataFrame, label: str, like=None, fill_from=None, path=No
     notes = list(notes)
     if filled:
         notes.append(f"{', '.join(filled)} taken from {fill_from} ({speed_class}) and excluded from the gap")
-    return DataSet(gait=gait, label=label, base=base, n=n_subjects(base, speed_class), filled=filled, path=path,
-                   notes=tuple(notes))
+    return DataSet(gait=gait, label=label, base=base, n=n, filled=filled, path=path, notes=tuple(notes),
+                   n_source=n_source)
 
 
 def _with_left(gait, rows: pd.DataFrame):

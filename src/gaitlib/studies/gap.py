@@ -183,11 +183,13 @@ def top_cells(loc: L.Located, n: int = 6) -> pd.DataFrame:
 
 
 def ranking_table(diag: D.Diagnosis) -> pd.DataFrame:
-    """The ranking for printing: effect, k, identified values, status, % closed (with its
-    95 % resampling interval where computed), ΔAIC, ΔBIC."""
+    """The ranking for printing: effect, k, identified values, where the kept fit started,
+    whether the effect nests the baseline, status, % closed (with its 95 % resampling
+    interval where computed), ΔAIC, ΔBIC. Unranked rows (no rank: failed search, a nested
+    fit with a located gap above the baseline's) come last, without % closed."""
     r = diag.ranking.copy()
     r["identified"] = r["parameters"].map(lambda th: ", ".join(f"{k} = {v:.3g}" for k, v in (th or {}).items()))
-    cols = ["rank", "effect", "n_params", "identified", "status", "rss_after", "pct_closed"]
+    cols = ["rank", "effect", "n_params", "identified", "start", "nests_baseline", "status", "rss_after", "pct_closed"]
     cols += [c for c in ("pct_closed_lo", "pct_closed_hi") if c in r.columns] + ["dAIC", "dBIC"]
     return r[cols]
 
