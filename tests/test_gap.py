@@ -552,3 +552,11 @@ def test_data_signature_ignores_the_last_bits(real):
     col = moved.mean.columns[0]
     moved.mean[col] = moved.mean[col] + 1e-6 * np.abs(moved.mean[col]).max()
     assert gio.signature(moved) != base
+
+
+def test_data_signature_sees_a_column_scaled_by_a_power_of_ten(real):
+    import dataclasses
+
+    g = real.gait
+    scaled = dataclasses.replace(g, sd=g.sd * 10.0)
+    assert gio.signature(scaled) != gio.signature(g)

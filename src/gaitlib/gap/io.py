@@ -190,9 +190,10 @@ def _quantised(a) -> bytes:
     column's largest magnitude (int64 bytes; machine-independent)."""
     a = np.atleast_2d(np.asarray(a, float).T).T
     peak = np.nanmax(np.abs(np.where(np.isfinite(a), a, np.nan)), axis=0, initial=0.0)
-    step = 10.0 ** (np.floor(np.log10(np.where(peak > 0, peak, 1.0))) - SIGNATURE_DIGITS)
-    q = np.where(np.isfinite(a), np.round(np.nan_to_num(a) / step), -2**62)
-    return np.ascontiguousarray(q.astype(np.int64)).tobytes()
+    exponent = np.floor(np.log10(np.where(peak > 0, peak, 1.0))) - SIGNATURE_DIGITS
+    q = np.where(np.isfinite(a), np.round(np.nan_to_num(a) / 10.0 ** exponent), -2**62)
+    # the grid's exponents too: a column scaled by a power of ten keeps its integers
+    return np.ascontiguousarray(exponent.astype(np.int64)).tobytes() + np.ascontiguousarray(q.astype(np.int64)).tobytes()
 
 
 def signature(gait) -> str:
