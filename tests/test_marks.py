@@ -212,3 +212,42 @@ def test_study_bar_figures_hatch_the_failed_run(study):
         assert len(hatched) == len(panels) > 0  # one hatched bar (SDT3) per panel
         assert all(p.get_x() + p.get_width() / 2 == pytest.approx(1.0) for p in hatched)
         plt.close(fig)
+
+
+# ------------------------------------------------------------------ the gap figures
+class _Loc:
+    """The part of a :class:`gaitlib.gap.locate.Located` the heat maps read."""
+
+    channels = pd.DataFrame({"channel": ["angle:knee_r", "grf:grf_y_r"]})
+
+    def heat(self, value="rms_z"):
+        from gaitlib.gap.locate import PHASES
+
+        v = False if value == "significant" else 1.5
+        return pd.DataFrame(v, index=["angle:knee_r", "grf:grf_y_r"], columns=list(PHASES))
+
+
+def test_gap_heatmap_of_a_failed_baseline_is_marked():
+    from gaitlib.gap import figures as F
+
+    label = marks.failure_label(FAILED)
+    fig = F.gap_heatmap(_Loc(), title="gap", mark=label)
+    assert [t.get_text() for t in _watermarks(fig)] == [label]
+    assert fig.axes[0].get_title().startswith(label)
+    plt.close(fig)
+    fig = F.gap_heatmap(_Loc(), title="gap")
+    assert marks.marks_in(fig) == []
+    plt.close(fig)
+
+
+def test_ranking_bars_hatch_a_failed_candidate():
+    from gaitlib.gap import figures as F
+
+    r = pd.DataFrame({"effect": ["a", "b"], "n_params": [1, 2], "pct_closed": [30.0, 10.0], "dBIC": [-20.0, -5.0],
+                      "ok": [True, False], "status": ["Solve_Succeeded", FAILED]})
+    fig = F.ranking_bars(r, top="a")
+    for ax in fig.axes[:2]:
+        hatched = [p for p in ax.patches if p.get_hatch()]
+        assert len(hatched) == 1 and hatched[0].get_width() in (10.0, -5.0)
+    assert any(f"b (k=2) † {FAILED}" == t.get_text() for t in fig.axes[0].get_yticklabels())
+    plt.close(fig)

@@ -9,7 +9,9 @@ figure and table that shows such a solution carries that label where the result 
 - figures: a red title prefix (:func:`mark_figure`);
 - bars: red hatching (:func:`mark_bars`), with a legend entry (:func:`bar_legend_handle`);
 - curves: dashed, their legend entry suffixed with ``† label`` (:func:`run_label`);
-- tables: a ``mark`` column and ``†`` after the row label (:func:`mark_table`).
+- tables: a ``mark`` column and ``†`` after the row label (:func:`mark_table`,
+  :func:`mark_rows` for a table of one solve);
+- a figure of one solve drawn elsewhere: :func:`mark_all`.
 
 Headline numbers are computed from unmarked runs only (:func:`unmarked`).
 """
@@ -20,8 +22,8 @@ import math
 from collections.abc import Mapping
 
 __all__ = ["CONVERGED", "MARK_COLOR", "HATCH", "DAGGER", "MARK_GID", "status_of", "failure_label",
-           "run_label", "mark_axes", "mark_figure", "mark_bars", "bar_legend_handle", "mark_table",
-           "unmarked", "marks_in"]
+           "run_label", "joint_label", "mark_axes", "mark_figure", "mark_all", "mark_bars", "bar_legend_handle", "mark_table",
+           "mark_rows", "unmarked", "marks_in"]
 
 #: IPOPT return statuses counted as converged (as :data:`gaitlib.sweep.ACCEPTED_STATUSES`).
 CONVERGED = frozenset({"Solve_Succeeded", "Solved_To_Acceptable_Level"})
@@ -89,6 +91,18 @@ def failure_label(obj, valid=None) -> str | None:
 def run_label(name: str, label: str | None) -> str:
     """A run's name as shown in legends and tables: ``"NMSK SDT3 † NOT CONVERGED: …"``."""
     return f"{name} {DAGGER} {label}" if label else str(name)
+
+
+def joint_label(labels: Mapping, named: bool = True) -> str | None:
+    """The failure labels of several runs (``{run: label or None}``) as one text, one line
+    per marked run (``"run: label"``; just the label when ``named`` is False and one run is
+    marked); None when none is marked."""
+    bad = [(k, v) for k, v in labels.items() if v]
+    if not bad:
+        return None
+    if len(bad) == 1 and not named:
+        return bad[0][1]
+    return "\n".join(f"{k}: {v}" for k, v in bad)
 
 
 def _axes_size_pt(ax) -> tuple[float, float]:
@@ -167,6 +181,26 @@ def mark_table(df, labels: Mapping, column: str = "mark"):
     out.insert(0, column, col)
     out.index = out.index.map(lambda k: _dagger(k) if labels.get(k) else k)
     return out
+
+
+def mark_all(fig, label: str | None):
+    """Mark a whole figure that shows one solve: a watermark on every axes that draws
+    something (:func:`mark_axes`) and the red title prefix (:func:`mark_figure`). Returns
+    ``fig``; nothing happens when ``label`` is empty."""
+    if label:
+        for ax in fig.axes:
+            if ax.axison and (ax.lines or ax.patches or ax.collections or ax.images):
+                mark_axes(ax, label)
+        mark_figure(fig, label)
+    return fig
+
+
+def mark_rows(df, label: str | None, column: str = "mark"):
+    """A table that comes from one solve: every row marked with ``label``
+    (:func:`mark_table`); ``df`` itself when ``label`` is empty."""
+    if not label:
+        return df
+    return mark_table(df, {k: label for k in df.index}, column)
 
 
 def unmarked(df, column: str = "mark"):

@@ -511,21 +511,10 @@ def tracking_figure(gait, sims: dict, channels=GAIT_CHANNELS, ncols: int = 4, co
                         lw=1.4, ls="--" if lab in marks else "-", label=mk.run_label(lab, marks.get(lab)))
                 shown.append(lab)
         _label_panel(ax, ch, unit, name)
-        mk.mark_axes(ax, _joint_label(marks, shown, len(sims)))
+        mk.mark_axes(ax, mk.joint_label({k: marks.get(k) for k in shown}, named=len(sims) > 1))
     fig = _finish_panels(fig, axes, len(channels), title)
-    mk.mark_figure(fig, _joint_label(marks, list(sims), len(sims)))
+    mk.mark_figure(fig, mk.joint_label(marks, named=len(sims) > 1))
     return fig
-
-
-def _joint_label(marks: dict, labels: list, n_runs: int) -> str | None:
-    """The failure labels of the marked ``labels`` as one text; a run is named only when the
-    figure shows more than one."""
-    bad = [lab for lab in labels if marks.get(lab)]
-    if not bad:
-        return None
-    if n_runs == 1:
-        return marks[bad[0]]
-    return "\n".join(f"{lab}: {marks[lab]}" for lab in bad)
 
 
 def animate_jump(jump_model, t, Q, p_contact=None, grf=None, cop=None, fps: float = 12,

@@ -418,7 +418,7 @@ def cot_table(ch7: StudyResult, natural=None) -> pd.DataFrame:
     rows = []
     items = [(s.spec.speed_class, k, s) for k, s in ch7.solutions.items() if k.startswith("NMSK ")]
     if isinstance(natural, dict):
-        items += [(lab, lab, s) for lab, s in natural.items() if s is not None]
+        items += [(lab, f"{s.spec.model} {s.spec.cost}", s) for lab, s in natural.items() if s is not None]
     elif natural is not None:
         items.append(("Free", f"{natural.spec.model} {natural.spec.cost}", natural))
     for row, src, s in items:
