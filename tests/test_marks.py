@@ -251,3 +251,24 @@ def test_ranking_bars_hatch_a_failed_candidate():
         assert len(hatched) == 1 and hatched[0].get_width() in (10.0, -5.0)
     assert any(f"b (k=2) † {FAILED}" == t.get_text() for t in fig.axes[0].get_yticklabels())
     plt.close(fig)
+
+
+def test_cot_table_and_stats_table_mark_the_failed_solve(stored_sk):
+    bad = _failed(stored_sk)
+    ch7 = pr.StudyResult({"NMSK Free": bad.spec}, {}, {"NMSK Free": bad}, {})
+    cot = pr.cot_table(ch7, {"Free (reference)": stored_sk})
+    assert cot.loc["Free", "mark"] == f"NOT CONVERGED: {FAILED}" and not cot.loc["Free", "converged"]
+    assert cot.loc["Free (reference)", "mark"] == ""
+    st = gait.stats_table({"ok": stored_sk, "bad": bad})
+    assert st.loc["bad", "mark"] == f"NOT CONVERGED: {FAILED}" and st.loc["ok", "mark"] == ""
+
+
+def test_mark_all_watermarks_every_drawn_axes():
+    fig, axes = plt.subplots(1, 3)
+    axes[0].plot([0, 1], [0, 1])
+    axes[1].bar([0], [1])
+    axes[2].axis("off")
+    marks.mark_all(fig, "NOT CONVERGED: x")
+    assert [t.axes for t in _watermarks(fig)] == [axes[0], axes[1]]
+    assert fig._suptitle.get_text() == "NOT CONVERGED: x"
+    plt.close(fig)

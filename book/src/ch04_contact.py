@@ -52,7 +52,7 @@ import pandas as pd
 import matplotlib.pyplot as plt
 from IPython.display import display
 
-from gaitlib import contact, conventions as cv, data, plots
+from gaitlib import contact, conventions as cv, data, marks, plots
 from gaitlib.model import ChildModel
 from gaitlib.studies import contact_id as ci, gait
 
@@ -132,14 +132,15 @@ ci.solver_table(res)
 
 # %%
 frames = {ci.APPROACHES[k]: r.channels() for k, r in res.items()}
+approach_marks = {ci.APPROACHES[k]: marks.failure_label(r.stats) for k, r in res.items()}  # None: converged
 fig = plots.tracking_figure(tracked, frames, channels=("grf_x_r", "grf_y_r", "grf_x_l", "grf_y_l"), ncols=4,
-                            title="Figs 4.9 / 4.15: tangential (x) and normal (y) GRFs")
+                            title="Figs 4.9 / 4.15: tangential (x) and normal (y) GRFs", marks=approach_marks)
 plt.show()
 fig = plots.tracking_figure(tracked, frames, channels=[f"tau_{j}" for j in cv.JOINTS], ncols=4,
-                            title="Fig 4.8: net joint torques (metatarsal: no data)")
+                            title="Fig 4.8: net joint torques (metatarsal: no data)", marks=approach_marks)
 plt.show()
 fig = plots.tracking_figure(tracked, {k: v for k, v in frames.items() if not k.startswith("(a)")},
-                            channels=list(cv.JOINTS), ncols=4,
+                            channels=list(cv.JOINTS), ncols=4, marks=approach_marks,
                             title="Fig 4.12: joint angles of (b) and (c) (metatarsal: the planned reference)")
 plt.show()
 
@@ -217,6 +218,7 @@ for ax, col, u in zip(axes, cv.RESIDUALS, ("N", "N", "N·m")):
     ax.set_title(f"{col} ({u})", fontsize=9)
     ax.set_xlabel("% gait cycle")
 axes[0].legend(fontsize=7)
+marks.mark_all(fig, marks.joint_label(approach_marks))
 plt.show()
 fig, axes = plt.subplots(1, 3, figsize=(12, 3), constrained_layout=True)
 for ax, col, u in zip(axes, cv.RESIDUALS, ("N", "N", "N·m")):
@@ -226,6 +228,7 @@ for ax, col, u in zip(axes, cv.RESIDUALS, ("N", "N", "N·m")):
     ax.set_title(f"{col} ({u}), (b) and (c) only", fontsize=9)
     ax.set_xlabel("% gait cycle")
 axes[0].legend(fontsize=7)
+marks.mark_all(fig, marks.joint_label({k: v for k, v in approach_marks.items() if not k.startswith("(a)")}))
 plt.show()
 
 # %% [markdown]
@@ -245,6 +248,7 @@ for k, r in res.items():
         {f"ours {ci.APPROACHES[k]}": r.p_contact,
          ci.THESIS_GEOMETRY_SOURCE[k]: ci.thesis_params(k)},
         model=model, title=f"{ci.APPROACHES[k]}: contact geometry, ours vs {ci.THESIS_GEOMETRY_SOURCE[k]}")
+    marks.mark_all(fig, approach_marks[ci.APPROACHES[k]])
     plt.show()
 
 # %% [markdown]
@@ -294,6 +298,7 @@ for ax, side in zip(axes, cv.SIDES):
     ax.set_title(f"(c): normal force per ellipsoid, {'right' if side == 'r' else 'left'} foot (N)", fontsize=9)
     ax.set_xlabel("% gait cycle")
     ax.legend(fontsize=7)
+marks.mark_all(fig, marks.failure_label(c.stats))
 plt.show()
 
 # %% [markdown]
