@@ -272,3 +272,30 @@ def test_mark_all_watermarks_every_drawn_axes():
     assert [t.axes for t in _watermarks(fig)] == [axes[0], axes[1]]
     assert fig._suptitle.get_text() == "NOT CONVERGED: x"
     plt.close(fig)
+
+
+# ------------------------------------------------------------------ the book's sources pass the marks on
+def test_every_book_figure_of_a_solve_passes_its_mark():
+    """Every call in book/src that draws simulated curves or animates a solve hands over the
+    failure labels (``marks=``/``mark=``); bar charts get them through the scores' ``mark``
+    column (checked above). Data-only drawings are listed by file and line of the call."""
+    import ast
+    from pathlib import Path
+
+    data_only = {("appendix_physics.py", "animate_gait")}  # the data's kinematics, no solve
+    src = Path(__file__).resolve().parents[1] / "book" / "src"
+    missing = []
+    for f in sorted(src.glob("ch0[2-8]*.py")) + [src / "appendix_physics.py"]:
+        cells = [c for c in f.read_text().split("# %%") if not c.startswith(" [markdown]")]
+        code = "\n".join("# %%" + c for c in cells)
+        for node in ast.walk(ast.parse(code)):
+            if not (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)):
+                continue
+            name = node.func.attr
+            if name not in ("tracking_figure", "animate_gait", "animate_jump", "animate"):
+                continue
+            if (f.name, name) in data_only:
+                continue
+            if not {kw.arg for kw in node.keywords} & {"marks", "mark"}:
+                missing.append(f"{f.name} (code line {node.lineno}) {name}")
+    assert not missing, "figures of a solve without its failure label: " + ", ".join(missing)

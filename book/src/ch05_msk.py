@@ -235,7 +235,8 @@ chan = plots.GAIT_CHANNELS
 for title, sel in (("Fig 5.4 (ours): joint angles, MSK", [c for c in chan if not c.startswith(("tau", "grf"))]),
                    ("Fig 5.5 (ours): joint torques, MSK", [c for c in chan if c.startswith("tau")]),
                    ("Fig 5.6 (ours): ground reaction forces, MSK", [c for c in chan if c.startswith("grf")])):
-    plots.tracking_figure(tracked, *gait.sims_and_marks({"MSK (Eq 5.33)": msk_sol}), channels=sel, title=title)
+    sims, sim_marks = gait.sims_and_marks({"MSK (Eq 5.33)": msk_sol})
+    plots.tracking_figure(tracked, sims, channels=sel, title=title, marks=sim_marks)
     plt.show()
 
 # %% [markdown]
@@ -339,7 +340,8 @@ t511.rename(columns={"ours": marks.run_label("ours (NMSK)", marks.failure_label(
 for title, sel in (("Fig 5.8 (ours): joint angles, NMSK", [c for c in chan if not c.startswith(("tau", "grf"))]),
                    ("Fig 5.9 (ours): joint torques, NMSK", [c for c in chan if c.startswith("tau")]),
                    ("Fig 5.10 (ours): ground reaction forces, NMSK", [c for c in chan if c.startswith("grf")])):
-    plots.tracking_figure(tracked, *gait.sims_and_marks({"NMSK": nmsk_sol, "MSK": msk_sol}), channels=sel, title=title)
+    sims, sim_marks = gait.sims_and_marks({"NMSK": nmsk_sol, "MSK": msk_sol})
+    plots.tracking_figure(tracked, sims, channels=sel, title=title, marks=sim_marks)
     plt.show()
 
 # %% [markdown]
