@@ -70,6 +70,17 @@ def test_invalid_is_a_second_reason():
     assert marks.failure_label("Solve_Succeeded", valid=Gate()) == "INVALID: knee torque above strength"
 
 
+def test_a_validity_check_reaches_every_label():
+    try:
+        marks.use_validity_check(lambda obj: "foot loaded in swing" if obj == "Solve_Succeeded" else None)
+        assert marks.failure_label("Solve_Succeeded") == "INVALID: foot loaded in swing"
+        assert marks.failure_label("Solve_Succeeded", valid=True) is None  # an explicit verdict wins
+        assert marks.failure_label(FAILED) == f"NOT CONVERGED: {FAILED}"
+    finally:
+        marks.use_validity_check(None)
+    assert marks.failure_label("Solve_Succeeded") is None
+
+
 def test_mark_table_flags_rows_and_unmarked_drops_them():
     df = pd.DataFrame({"nrmse": [0.1, 0.2]}, index=pd.MultiIndex.from_tuples([("NMSK", "DT"), ("NMSK", "SDT3")]))
     out = marks.mark_table(df, {("NMSK", "SDT3"): f"NOT CONVERGED: {FAILED}"})

@@ -22,6 +22,7 @@ import math
 from collections.abc import Mapping
 
 __all__ = ["CONVERGED", "MARK_COLOR", "HATCH", "DAGGER", "MARK_GID", "status_of", "failure_label",
+           "use_validity_check",
            "run_label", "joint_label", "mark_axes", "mark_figure", "mark_all", "mark_bars", "bar_legend_handle", "mark_table",
            "mark_rows", "unmarked", "marks_in"]
 
@@ -65,6 +66,20 @@ def status_of(obj) -> tuple[bool | None, str | None]:
     return bool(success), None if status is None else str(status)
 
 
+#: The physical-validity check :func:`failure_label` applies when it is given no ``valid``
+#: (see :func:`use_validity_check`); None: no check.
+_validity_check = None
+
+
+def use_validity_check(check) -> None:
+    """Make every :func:`failure_label` call without ``valid`` ask ``check(obj)`` for the
+    verdict (a callable taking a solution, a run record or a status and returning what
+    ``valid`` accepts, or None when it cannot judge ``obj``); ``None`` removes the check.
+    This is how the physical validity gates reach every figure and table at once."""
+    global _validity_check
+    _validity_check = check
+
+
 def failure_label(obj, valid=None) -> str | None:
     """Why a result must not be read as one, or None if nothing is known against it.
 
@@ -74,6 +89,8 @@ def failure_label(obj, valid=None) -> str | None:
     ``"NOT CONVERGED: Maximum_Iterations_Exceeded"``, ``"INVALID: foot loaded in swing"``
     or both joined by ``"; "``.
     """
+    if valid is None and _validity_check is not None and obj is not None:
+        valid = _validity_check(obj)
     reasons = []
     conv, status = status_of(obj)
     if conv is False:
