@@ -122,7 +122,16 @@ c.stages
 # (Secs 4.3.3 and 4.4.2), labelled.
 
 # %%
-ci.solver_table(res)
+approach_marks = {ci.APPROACHES[k]: marks.failure_label(r.stats) for k, r in res.items()}  # None: converged
+
+
+def mark_approaches(df):
+    """A table by approach (its first index level) with † and the failure label on the rows of
+    an approach whose solve did not converge."""
+    return marks.mark_table(df, {k: approach_marks.get(k[0] if isinstance(k, tuple) else k) for k in df.index})
+
+
+mark_approaches(ci.solver_table(res))
 
 # %% [markdown]
 # ## Ground reaction forces, torques and angles (Figs 4.8, 4.9, 4.12, 4.15)
@@ -132,7 +141,6 @@ ci.solver_table(res)
 
 # %%
 frames = {ci.APPROACHES[k]: r.channels() for k, r in res.items()}
-approach_marks = {ci.APPROACHES[k]: marks.failure_label(r.stats) for k, r in res.items()}  # None: converged
 fig = plots.tracking_figure(tracked, frames, channels=("grf_x_r", "grf_y_r", "grf_x_l", "grf_y_l"), ncols=4,
                             title="Figs 4.9 / 4.15: tangential (x) and normal (y) GRFs", marks=approach_marks)
 plt.show()
@@ -152,7 +160,9 @@ plt.show()
 # (c) only for the GRFs (Sec 4.4.2).
 
 # %%
-ci.rmse_beside_thesis(res)
+t49 = ci.rmse_beside_thesis(res)
+marks.mark_table(t49, {k: approach_marks.get(str(k).split(" — ")[0]) if str(k).endswith("ours") else None
+                       for k in t49.index})
 
 # %% [markdown]
 # Which approach fits the GRFs best — the RMSE of each foot force, their mean, and the GRF
@@ -160,7 +170,7 @@ ci.rmse_beside_thesis(res)
 
 # %%
 fit = ci.grf_fit(res)
-fit
+mark_approaches(fit)
 
 # %% [markdown]
 # ### Why the GRF fits differ from the thesis's: where the error is
@@ -197,7 +207,8 @@ ph
 # %%
 cw = ci.optimal_control_body(spec=ci.spec_c(contact_bounds="widened"), warm=b)
 print({k: cw.stats[k] for k in ("status", "iterations", "wall_s", "objective", "max_violation", "from_cache")})
-display(ci.grf_fit({"b": b, "c": c, "c_wide": cw}))
+approach_marks[ci.APPROACHES["c_wide"]] = marks.failure_label(cw.stats)
+display(mark_approaches(ci.grf_fit({"b": b, "c": c, "c_wide": cw})))
 for r in (c, cw):
     ab = ci.at_bounds(r)
     print(f"{r.label}: at a bound:", ", ".join(f"{p} ({s_})" for p, s_ in zip(ab["parameter"], ab["bound"])) or "none")
@@ -240,7 +251,7 @@ plt.show()
 
 # %%
 geo = ci.geometry_table(res)
-geo
+mark_approaches(geo)
 
 # %%
 for k, r in res.items():
@@ -255,14 +266,14 @@ for k, r in res.items():
 # ## Stiffness, damping and friction (Tables 4.12, 4.13, 4.18)
 
 # %%
-ci.contact_table(res)
+mark_approaches(ci.contact_table(res))
 
 # %% [markdown]
 # Friction ratios μ_d/μ_s (Eq 4.4 bounds them to [0.55, 0.99]) and the parameters that
 # ended on a bound of Table 4.7 (or Table 4.14 for (c)'s body parameters):
 
 # %%
-display(ci.friction_ratios(res))
+display(ci.friction_ratios(res).rename(columns=lambda a: marks.run_label(a, approach_marks.get(a))))
 for k, r in res.items():
     ab = ci.at_bounds(r)
     print(f"{ci.APPROACHES[k]}: {len(ab)} of {39 + (25 if k == 'c' else 0)} parameters at a bound:",
@@ -276,7 +287,7 @@ for k, r in res.items():
 # values (as printed; its initial MOIs differ slightly from $SM\,(ROG\,SL)^2$).
 
 # %%
-bt = ci.body_table(c)
+bt = marks.mark_rows(ci.body_table(c), marks.failure_label(c.stats))
 bt
 
 # %%

@@ -817,14 +817,11 @@ def rmse_beside_thesis(results: dict[str, ApproachResult]) -> pd.DataFrame:
 
 def grf_fit(results: dict[str, ApproachResult]) -> pd.DataFrame:
     """How well each approach fits the GRFs: RMSE per foot force (N), their mean, and the
-    GRF term of Eq 4.5 (mean squared range-normalised error); ``mark``: the solve's failure
-    label (:func:`gaitlib.marks.failure_label`, empty when converged)."""
-    from ..marks import failure_label
-
+    GRF term of Eq 4.5 (mean squared range-normalised error)."""
     rows = []
     for k, res in results.items():
         r = res.rmse.set_index("channel")["rmse"]
-        row = {"approach": APPROACHES[k], "mark": failure_label(res.stats) or ""}
+        row = {"approach": APPROACHES[k]}
         for g in tr.GRF_CHANNELS:
             row[f"{g} (N)"] = float(r[g])
         row["mean GRF RMSE (N)"] = float(np.mean([r[g] for g in tr.GRF_CHANNELS]))
@@ -834,16 +831,12 @@ def grf_fit(results: dict[str, ApproachResult]) -> pd.DataFrame:
 
 
 def solver_table(results: dict[str, ApproachResult]) -> pd.DataFrame:
-    """Status (and its failure label, ``mark``), iterations, wall time and time per iteration
-    of each approach beside the thesis's compute times (different machine and software:
-    labelled)."""
-    from ..marks import failure_label
-
+    """Status, iterations, wall time and time per iteration of each approach beside the
+    thesis's compute times (different machine and software: labelled)."""
     rows = []
     for k, res in results.items():
         s = res.stats
-        rows.append({"approach": APPROACHES[k], "mark": failure_label(s) or "", "status": s["status"],
-                     "iterations": s["iterations"],
+        rows.append({"approach": APPROACHES[k], "status": s["status"], "iterations": s["iterations"],
                      "build (s)": s["build_s"], "solve (s)": s["solve_s"], "wall (s)": s["wall_s"],
                      "ms / iteration": 1e3 * s["time_per_iteration_s"], "objective": s["objective"],
                      "Eq 4.5 part": s["eq4_5"], "from cache": s["from_cache"],
@@ -854,33 +847,27 @@ def solver_table(results: dict[str, ApproachResult]) -> pd.DataFrame:
 def geometry_table(results: dict[str, ApproachResult]) -> pd.DataFrame:
     """Tables 4.10 / 4.11 / 4.17: left-foot ellipsoid geometry (mm, deg), ours beside the
     thesis's, rows (approach, ellipsoid, source)."""
-    from ..marks import failure_label
-
     rows = []
     for k, res in results.items():
         for e in cv.ELLIPSOIDS:
             ours = {f"{n} ({u})": res.p_contact[contact_mod.param_index(e, n)] * _table_scale(n)
                     for n, u in zip(_GEOM, _GEOM_UNIT)}
-            rows.append({"approach": APPROACHES[k], "ellipsoid": e, "source": "ours",
-                         "mark": failure_label(res.stats) or "", **ours})
+            rows.append({"approach": APPROACHES[k], "ellipsoid": e, "source": "ours", **ours})
             th = dict(zip([f"{n} ({u})" for n, u in zip(_GEOM, _GEOM_UNIT)], THESIS_GEOMETRY[k][e]))
-            rows.append({"approach": APPROACHES[k], "ellipsoid": e, "source": THESIS_GEOMETRY_SOURCE[k], "mark": "", **th})
+            rows.append({"approach": APPROACHES[k], "ellipsoid": e, "source": THESIS_GEOMETRY_SOURCE[k], **th})
     return pd.DataFrame(rows).set_index(["approach", "ellipsoid", "source"])
 
 
 def contact_table(results: dict[str, ApproachResult]) -> pd.DataFrame:
     """Tables 4.12 / 4.13 / 4.18: k_v, a_v, μ_s, μ_d per ellipsoid, ours beside the thesis's."""
-    from ..marks import failure_label
-
     rows = []
     for k, res in results.items():
         for e in cv.ELLIPSOIDS:
             ours = {f"{n} ({u})" if u != "-" else n: res.p_contact[contact_mod.param_index(e, n)]
                     for n, u in zip(_FRIC, _FRIC_UNIT)}
-            rows.append({"approach": APPROACHES[k], "ellipsoid": e, "source": "ours",
-                         "mark": failure_label(res.stats) or "", **ours})
+            rows.append({"approach": APPROACHES[k], "ellipsoid": e, "source": "ours", **ours})
             th = dict(zip([f"{n} ({u})" if u != "-" else n for n, u in zip(_FRIC, _FRIC_UNIT)], THESIS_CONTACT[k][e]))
-            rows.append({"approach": APPROACHES[k], "ellipsoid": e, "source": THESIS_CONTACT_SOURCE[k], "mark": "", **th})
+            rows.append({"approach": APPROACHES[k], "ellipsoid": e, "source": THESIS_CONTACT_SOURCE[k], **th})
     return pd.DataFrame(rows).set_index(["approach", "ellipsoid", "source"])
 
 
