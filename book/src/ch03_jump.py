@@ -31,7 +31,7 @@ import pandas as pd
 import matplotlib.pyplot as plt
 from IPython.display import HTML, display
 
-from gaitlib import contact, conventions as cv, plots
+from gaitlib import contact, conventions as cv, marks, plots
 from gaitlib.jump import JUMP_SEGMENTS, JumpModel
 from gaitlib.studies import jump
 
@@ -160,6 +160,16 @@ pd.DataFrame(spec_rows).T
 sols = {n: jump.solve(n, use_cache=True) for n in NAMES}
 for n, s in sols.items():
     print(f"{s.spec.label:34s} {s.solution.summary().splitlines()[0]}")
+jump_marks = {s.spec.label: marks.failure_label(s) for s in sols.values()}  # None: converged
+
+
+def mark_jump_columns(fig):
+    """A failed solve's column of a jump figure gets the red watermark (one column per model)."""
+    labs = list(jump_marks.values())
+    for k, ax in enumerate(fig.axes):
+        marks.mark_axes(ax, labs[k % len(labs)])
+    marks.mark_figure(fig, marks.joint_label(jump_marks))
+    return fig
 
 # %% [markdown]
 # ### Solver statistics
@@ -187,14 +197,14 @@ pd.concat({s.spec.label: s.solution.goals.set_index(["phase", "goal"])["weighted
 # kinematic models together the thesis's preflight phase) and flight.
 
 # %%
-fig = jump.plot_channels(sols, "angles")
+fig = mark_jump_columns(jump.plot_channels(sols, "angles"))
 plt.show()
 
 # %% [markdown]
 # ## Joint torques (thesis Fig 3.4)
 
 # %%
-fig = jump.plot_channels(sols, "torques")
+fig = mark_jump_columns(jump.plot_channels(sols, "torques"))
 plt.show()
 
 # %% [markdown]
@@ -229,11 +239,11 @@ pd.DataFrame(rows)
 # while F_y ≥ 5 % of the weight (`fy_min_fraction`).
 
 # %%
-fig = jump.plot_channels(sols, "grf")
+fig = mark_jump_columns(jump.plot_channels(sols, "grf"))
 plt.show()
 
 # %%
-fig = jump.plot_channels(sols, "friction")
+fig = mark_jump_columns(jump.plot_channels(sols, "friction"))
 plt.show()
 
 # %%
@@ -246,7 +256,7 @@ for n, s in sols.items():
                               "peak F_y / weight": c["grf_y"].max() / (s.model.total_mass * cv.G),
                               "required μ_s = max|F_x/F_y|": s.required_friction,
                               "μ_s, thesis, Sec 3.4.3": jump.THESIS[n]["mu_s"]}
-pd.DataFrame(grf_rows).T
+marks.mark_table(pd.DataFrame(grf_rows).T, jump_marks)
 
 # %% [markdown]
 # ## Foot position and orientation (thesis Fig 3.8)
@@ -255,7 +265,7 @@ pd.DataFrame(grf_rows).T
 # segment (the toe; the foot for the toeless model) and of the foot, relative to standing.
 
 # %%
-fig = jump.plot_channels(sols, "foot")
+fig = mark_jump_columns(jump.plot_channels(sols, "foot"))
 plt.show()
 
 # %% [markdown]
@@ -268,7 +278,7 @@ plt.show()
 
 # %%
 results = jump.results_table(sols)
-results
+marks.mark_table(results, jump_marks)
 
 # %% [markdown]
 # ### How much do these numbers depend on the mesh?
@@ -301,13 +311,13 @@ pd.DataFrame(mesh_rows).set_index(["jump", "intervals per phase"])
 # normal-force-weighted mean of the ellipsoid centres.
 
 # %%
-HTML(plots.animation_html(jump.animate(sols["toeless"], max_frames=30, dpi=60)))
+HTML(plots.animation_html(jump.animate(sols["toeless"], max_frames=30, dpi=60, mark=marks.failure_label(sols["toeless"]))))
 
 # %%
-HTML(plots.animation_html(jump.animate(sols["toe"], max_frames=30, dpi=60)))
+HTML(plots.animation_html(jump.animate(sols["toe"], max_frames=30, dpi=60, mark=marks.failure_label(sols["toe"]))))
 
 # %%
-HTML(plots.animation_html(jump.animate(sols["ellipsoid"], max_frames=30, dpi=60)))
+HTML(plots.animation_html(jump.animate(sols["ellipsoid"], max_frames=30, dpi=60, mark=marks.failure_label(sols["ellipsoid"]))))
 
 # %% [markdown]
 # ## What we found

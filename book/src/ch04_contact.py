@@ -52,7 +52,7 @@ import pandas as pd
 import matplotlib.pyplot as plt
 from IPython.display import display
 
-from gaitlib import contact, conventions as cv, data, plots
+from gaitlib import contact, conventions as cv, data, marks, plots
 from gaitlib.model import ChildModel
 from gaitlib.studies import contact_id as ci, gait
 
@@ -122,7 +122,16 @@ c.stages
 # (Secs 4.3.3 and 4.4.2), labelled.
 
 # %%
-ci.solver_table(res)
+approach_marks = {ci.APPROACHES[k]: marks.failure_label(r.stats) for k, r in res.items()}  # None: converged
+
+
+def mark_approaches(df):
+    """A table by approach (its first index level) with † and the failure label on the rows of
+    an approach whose solve did not converge."""
+    return marks.mark_table(df, {k: approach_marks.get(k[0] if isinstance(k, tuple) else k) for k in df.index})
+
+
+mark_approaches(ci.solver_table(res))
 
 # %% [markdown]
 # ## Ground reaction forces, torques and angles (Figs 4.8, 4.9, 4.12, 4.15)
@@ -133,13 +142,13 @@ ci.solver_table(res)
 # %%
 frames = {ci.APPROACHES[k]: r.channels() for k, r in res.items()}
 fig = plots.tracking_figure(tracked, frames, channels=("grf_x_r", "grf_y_r", "grf_x_l", "grf_y_l"), ncols=4,
-                            title="Figs 4.9 / 4.15: tangential (x) and normal (y) GRFs")
+                            title="Figs 4.9 / 4.15: tangential (x) and normal (y) GRFs", marks=approach_marks)
 plt.show()
 fig = plots.tracking_figure(tracked, frames, channels=[f"tau_{j}" for j in cv.JOINTS], ncols=4,
-                            title="Fig 4.8: net joint torques (metatarsal: no data)")
+                            title="Fig 4.8: net joint torques (metatarsal: no data)", marks=approach_marks)
 plt.show()
 fig = plots.tracking_figure(tracked, {k: v for k, v in frames.items() if not k.startswith("(a)")},
-                            channels=list(cv.JOINTS), ncols=4,
+                            channels=list(cv.JOINTS), ncols=4, marks=approach_marks,
                             title="Fig 4.12: joint angles of (b) and (c) (metatarsal: the planned reference)")
 plt.show()
 
@@ -151,7 +160,9 @@ plt.show()
 # (c) only for the GRFs (Sec 4.4.2).
 
 # %%
-ci.rmse_beside_thesis(res)
+t49 = ci.rmse_beside_thesis(res)
+marks.mark_table(t49, {k: approach_marks.get(str(k).split(" — ")[0]) if str(k).endswith("ours") else None
+                       for k in t49.index})
 
 # %% [markdown]
 # Which approach fits the GRFs best — the RMSE of each foot force, their mean, and the GRF
@@ -159,7 +170,7 @@ ci.rmse_beside_thesis(res)
 
 # %%
 fit = ci.grf_fit(res)
-fit
+mark_approaches(fit)
 
 # %% [markdown]
 # ### Why the GRF fits differ from the thesis's: where the error is
@@ -196,7 +207,8 @@ ph
 # %%
 cw = ci.optimal_control_body(spec=ci.spec_c(contact_bounds="widened"), warm=b)
 print({k: cw.stats[k] for k in ("status", "iterations", "wall_s", "objective", "max_violation", "from_cache")})
-display(ci.grf_fit({"b": b, "c": c, "c_wide": cw}))
+approach_marks[ci.APPROACHES["c_wide"]] = marks.failure_label(cw.stats)
+display(mark_approaches(ci.grf_fit({"b": b, "c": c, "c_wide": cw})))
 for r in (c, cw):
     ab = ci.at_bounds(r)
     print(f"{r.label}: at a bound:", ", ".join(f"{p} ({s_})" for p, s_ in zip(ab["parameter"], ab["bound"])) or "none")
@@ -217,6 +229,7 @@ for ax, col, u in zip(axes, cv.RESIDUALS, ("N", "N", "N·m")):
     ax.set_title(f"{col} ({u})", fontsize=9)
     ax.set_xlabel("% gait cycle")
 axes[0].legend(fontsize=7)
+marks.mark_all(fig, marks.joint_label(approach_marks))
 plt.show()
 fig, axes = plt.subplots(1, 3, figsize=(12, 3), constrained_layout=True)
 for ax, col, u in zip(axes, cv.RESIDUALS, ("N", "N", "N·m")):
@@ -226,6 +239,7 @@ for ax, col, u in zip(axes, cv.RESIDUALS, ("N", "N", "N·m")):
     ax.set_title(f"{col} ({u}), (b) and (c) only", fontsize=9)
     ax.set_xlabel("% gait cycle")
 axes[0].legend(fontsize=7)
+marks.mark_all(fig, marks.joint_label({k: v for k, v in approach_marks.items() if not k.startswith("(a)")}))
 plt.show()
 
 # %% [markdown]
@@ -237,7 +251,7 @@ plt.show()
 
 # %%
 geo = ci.geometry_table(res)
-geo
+mark_approaches(geo)
 
 # %%
 for k, r in res.items():
@@ -245,20 +259,21 @@ for k, r in res.items():
         {f"ours {ci.APPROACHES[k]}": r.p_contact,
          ci.THESIS_GEOMETRY_SOURCE[k]: ci.thesis_params(k)},
         model=model, title=f"{ci.APPROACHES[k]}: contact geometry, ours vs {ci.THESIS_GEOMETRY_SOURCE[k]}")
+    marks.mark_all(fig, approach_marks[ci.APPROACHES[k]])
     plt.show()
 
 # %% [markdown]
 # ## Stiffness, damping and friction (Tables 4.12, 4.13, 4.18)
 
 # %%
-ci.contact_table(res)
+mark_approaches(ci.contact_table(res))
 
 # %% [markdown]
 # Friction ratios μ_d/μ_s (Eq 4.4 bounds them to [0.55, 0.99]) and the parameters that
 # ended on a bound of Table 4.7 (or Table 4.14 for (c)'s body parameters):
 
 # %%
-display(ci.friction_ratios(res))
+display(ci.friction_ratios(res).rename(columns=lambda a: marks.run_label(a, approach_marks.get(a))))
 for k, r in res.items():
     ab = ci.at_bounds(r)
     print(f"{ci.APPROACHES[k]}: {len(ab)} of {39 + (25 if k == 'c' else 0)} parameters at a bound:",
@@ -272,7 +287,7 @@ for k, r in res.items():
 # values (as printed; its initial MOIs differ slightly from $SM\,(ROG\,SL)^2$).
 
 # %%
-bt = ci.body_table(c)
+bt = marks.mark_rows(ci.body_table(c), marks.failure_label(c.stats))
 bt
 
 # %%
@@ -294,6 +309,7 @@ for ax, side in zip(axes, cv.SIDES):
     ax.set_title(f"(c): normal force per ellipsoid, {'right' if side == 'r' else 'left'} foot (N)", fontsize=9)
     ax.set_xlabel("% gait cycle")
     ax.legend(fontsize=7)
+marks.mark_all(fig, marks.failure_label(c.stats))
 plt.show()
 
 # %% [markdown]

@@ -46,7 +46,8 @@ import numpy as np
 import pandas as pd
 import matplotlib.pyplot as plt
 
-from gaitlib import conventions as cv, data, mtg, plots
+from gaitlib import conventions as cv, data, marks, mtg, params, plots
+from gaitlib.model import P_BODY_NAMES
 from gaitlib import transcription as tr
 from gaitlib.studies import gait, msk, mtg_id
 
@@ -82,16 +83,28 @@ print("parameter sets of the MSK/NMSK solves:", sets)
 
 # **What the generators must supply.** The data give net joint torques; the model's joints
 # also carry spring–dampers (Table 4.2 / 4.16) in parallel with the MTGs, so the MTG pair
-# must supply net − spring–damper on the tracked motion. With the thesis's tuned dampers
-# (this chapter's body set) and with the untuned adult values (Table 4.2, the Ch 2 model),
-# the largest demands per joint are:
+# must supply net − spring–damper on the tracked motion. The largest demands per joint
+# with this chapter's body set (the one the identification below runs with), the thesis's
+# tuned set (Table 4.16) and the untuned adult values (Table 4.2, the Ch 2 model), each with
+# its knee and ankle dampers:
 
 # %%
 spec_id = mtg_id.chapter_spec()
+
+
+def dampers(body):
+    p = dict(zip(P_BODY_NAMES, params.body_params(body)))
+    return p["B_knee"], p["B_ankle"]
+
+
 rows = {}
-for lab, body in ((f"body '{spec_id.body_params}' (this chapter)", spec_id.body_params),
-                  ("body 'default' (Table 4.2 dampers)", "default")):
+sets = {f"body '{spec_id.body_params}' (this chapter)": spec_id.body_params,
+        "body 'thesis' (Table 4.16, tuned)": "thesis", "body 'default' (Table 4.2, adult)": "default"}
+for lab, body in sets.items():
+    if body in [sets[k] for k in rows]:  # the chapter's set is one of the other two
+        continue
     d = mtg_id.demanded_torques(mtg_id.IdentSpec(body_params=body))
+    rows.setdefault(lab, {})["knee / ankle damper (N·m·s/rad)"] = "{:.2f} / {:.2f}".format(*dampers(body))
     for j in ("hip", "knee", "ankle"):
         rows.setdefault(lab, {})[f"{j}: max flexor/extensor share (N·m)"] = "{:.1f} / {:.1f}".format(
             *[float(v.max()) for v in mtg_id.split(j, d[f"tau_{j}"].to_numpy()).values()])
@@ -104,7 +117,7 @@ ident_thesis_tol = mtg_id.identify(mtg_id.chapter_spec(tol=1e-5))   # the thesis
 rows = []
 for lab, r in (("ours, tol 1e-10", ident), ("tol 1e-5 (thesis's setting)", ident_thesis_tol)):
     st = r.stats
-    rows.append({"run": lab, "status": st["status"], "iterations": st["iterations"],
+    rows.append({"run": lab, "mark": marks.failure_label(st) or "", "status": st["status"], "iterations": st["iterations"],
                  "solve (s)": st["solve_time_s"], "build (s)": st["build_time_s"],
                  "ms/iteration": 1e3 * st["time_per_iteration_s"], "objective (Eq 5.23)": st["objective"],
                  "w1·Γ term": st["cost_Gamma"], "w2·x term": st["cost_x"],
@@ -126,6 +139,17 @@ tab = mtg_id.table_beside_thesis(ident)
 tab.insert(2, "ours at tol 1e-5", mtg_id.table_beside_thesis(ident_thesis_tol)["ours"])
 tab = tab.rename(columns={"ours": "ours (tol 1e-10)"})
 tab
+
+# %% [markdown]
+# Under which joint dampers this identification ran (computed from the run's own body
+# parameters; the parameters it moved are listed in *What we found*):
+
+# %%
+bk, ba = dampers(spec_id.body_params)
+tk, ta = dampers("thesis")
+print(f"• The identification ran with body set '{spec_id.body_params}': knee / ankle dampers {bk:.2f} / {ba:.2f} "
+      f"N·m·s/rad (the thesis's tuned set, Table 4.16: {tk:.2f} / {ta:.2f}"
+      + ("; so NOT under the thesis's ≈ 0 dampers" if max(bk, ba) > 10 * max(tk, ta, 0.05) else "") + ").")
 
 # %%
 stored = tr.load_mtg_params(mtg_id.PARAMS_FILE)
@@ -162,11 +186,13 @@ margins.style.format("{:.2f}")
 # %%
 fig = mtg_id.envelope_figure(ident)
 fig.suptitle("Fig 5.1 (ours): demanded torque inside the isometric envelope")
+marks.mark_all(fig, marks.failure_label(ident.stats))
 plt.show()
 
 # %%
 fig = mtg_id.velocity_figure(ident)
 fig.suptitle("Fig 5.2 (ours): demanded active torque under the torque–velocity limit")
+marks.mark_all(fig, marks.failure_label(ident.stats))
 plt.show()
 
 # %% [markdown]
@@ -190,7 +216,7 @@ print("from cache:", msk_sol.stats.get("from_cache"))
 # RMSE against the data mean at the 100 collocation nodes; thesis values on *its* data.
 
 # %%
-gait.rmse_beside_thesis(msk_sol)
+marks.mark_rows(gait.rmse_beside_thesis(msk_sol), marks.failure_label(msk_sol))
 
 # %% [markdown]
 # ### Figs 5.4–5.6: angles, torques and GRFs (MSK)
@@ -204,7 +230,8 @@ chan = plots.GAIT_CHANNELS
 for title, sel in (("Fig 5.4 (ours): joint angles, MSK", [c for c in chan if not c.startswith(("tau", "grf"))]),
                    ("Fig 5.5 (ours): joint torques, MSK", [c for c in chan if c.startswith("tau")]),
                    ("Fig 5.6 (ours): ground reaction forces, MSK", [c for c in chan if c.startswith("grf")])):
-    plots.tracking_figure(tracked, {"MSK (Eq 5.33)": gait.channels_frame(msk_sol)}, channels=sel, title=title)
+    sims, sim_marks = gait.sims_and_marks({"MSK (Eq 5.33)": msk_sol})
+    plots.tracking_figure(tracked, sims, channels=sel, title=title, marks=sim_marks)
     plt.show()
 
 # %% [markdown]
@@ -221,7 +248,8 @@ def mtp_table(sols):
                          "mtp range (deg)": float(np.ptp(s.q[f"mtp_{side}"])) / cv.DEG,
                          "peak |mtp torque| (N·m)": float(s.torques[f"mtp_{side}"].abs().max()),
                          "per body mass (N·m/kg)": float(s.torques[f"mtp_{side}"].abs().max()) / cv.BODY_MASS})
-    return pd.DataFrame(rows).set_index(["run", "side"])
+    df = pd.DataFrame(rows).set_index(["run", "side"])
+    return marks.mark_table(df, {(lab, side): marks.failure_label(s) for lab, s in sols.items() for side in cv.SIDES})
 
 mtp_table({"MSK": msk_sol})
 
@@ -231,7 +259,7 @@ mtp_table({"MSK": msk_sol})
 # torque error grow.
 
 # %%
-msk.saturation(msk_sol).to_frame("MSK").T
+marks.mark_rows(msk.saturation(msk_sol).to_frame("MSK").T, marks.failure_label(msk_sol))
 
 # %% [markdown]
 # ## 5.3 NMSK model (Sec 5.3)
@@ -285,10 +313,10 @@ stats
 # smaller $\tau_{act}$ lets activations follow the torque demand more closely.
 
 # %%
-msk.activation_table(nmsk_sol)
+marks.mark_rows(msk.activation_table(nmsk_sol), marks.failure_label(nmsk_sol))
 
 # %%
-msk.synergy_cost_table(nmsk_sol)
+marks.mark_rows(msk.synergy_cost_table(nmsk_sol), marks.failure_label(nmsk_sol))
 
 # %% [markdown]
 # ### Table 5.11 beside ours
@@ -297,7 +325,8 @@ msk.synergy_cost_table(nmsk_sol)
 t511 = gait.rmse_beside_thesis(nmsk_sol).merge(
     gait.rmse_beside_thesis(msk_sol)[["kind", "channel", "side", "ours"]],
     on=["kind", "channel", "side"], suffixes=("", " (MSK)"))
-t511.rename(columns={"ours": "ours (NMSK)"})
+t511.rename(columns={"ours": marks.run_label("ours (NMSK)", marks.failure_label(nmsk_sol)),
+                     "ours (MSK)": marks.run_label("ours (MSK)", marks.failure_label(msk_sol))})
 
 # %% [markdown]
 # ### Figs 5.8–5.10: angles, torques and GRFs (NMSK)
@@ -306,8 +335,8 @@ t511.rename(columns={"ours": "ours (NMSK)"})
 for title, sel in (("Fig 5.8 (ours): joint angles, NMSK", [c for c in chan if not c.startswith(("tau", "grf"))]),
                    ("Fig 5.9 (ours): joint torques, NMSK", [c for c in chan if c.startswith("tau")]),
                    ("Fig 5.10 (ours): ground reaction forces, NMSK", [c for c in chan if c.startswith("grf")])):
-    plots.tracking_figure(tracked, {"NMSK": gait.channels_frame(nmsk_sol), "MSK": gait.channels_frame(msk_sol)},
-                          channels=sel, title=title)
+    sims, sim_marks = gait.sims_and_marks({"NMSK": nmsk_sol, "MSK": msk_sol})
+    plots.tracking_figure(tracked, sims, channels=sel, title=title, marks=sim_marks)
     plt.show()
 
 # %% [markdown]
@@ -328,8 +357,9 @@ for title, sel in (("Fig 5.8 (ours): joint angles, NMSK", [c for c in chan if no
 # %%
 fig = msk.excitation_figure(nmsk_sol)
 fig.suptitle("Fig 5.11 (ours): NMSK excitations, right leg")
+marks.mark_all(fig, marks.failure_label(nmsk_sol))
 plt.show()
-scores = msk.excitation_scores(nmsk_sol)
+scores = marks.mark_rows(msk.excitation_scores(nmsk_sol), marks.failure_label(nmsk_sol))
 scores
 
 # %% [markdown]
@@ -345,7 +375,7 @@ scores
 
 # %%
 cot = msk.cot_breakdown(nmsk_sol)
-cot
+marks.mark_rows(cot, marks.failure_label(nmsk_sol))
 
 # %% [markdown]
 # How much the Mtb term weighs in the objective (Eq 5.56 normalisation). The thesis scales
@@ -353,7 +383,7 @@ cot
 # D (the only reading that shrinks the term, as the thesis says it should).
 
 # %%
-msk.mtb_scale_table(nmsk_sol)
+marks.mark_rows(msk.mtb_scale_table(nmsk_sol), marks.failure_label(nmsk_sol))
 
 # %% [markdown]
 # ## What we found
@@ -396,7 +426,7 @@ for lab, s, th in (("MSK", msk_sol, "Table 5.4"), ("NMSK", nmsk_sol, "Table 5.11
           f"RMSE angles {rng(s, 'angle')} deg, torques {rng(s, 'torque')} N·m, GRFs {rng(s, 'grf')} N "
           f"(thesis, {th}: angles {thesis_rng(lab, 'angle')} deg, torques {thesis_rng(lab, 'torque')} N·m, "
           f"GRFs {thesis_rng(lab, 'grf')} N).")
-act = msk.activation_table(nmsk_sol)
+act = marks.mark_rows(msk.activation_table(nmsk_sol), marks.failure_label(nmsk_sol))
 print("• Activation parameters (ours): " + ", ".join(
     f"{k} = {v:.4g}" + (f" (at its {b} bound)" if b else "") for k, v, b in
     zip(act.index, act["ours"], act["ours at bound"])) + " — thesis Table 5.10: τ_act 0.006 s, c3 0.0001, s1 = s2 = 0.25.")
@@ -420,7 +450,7 @@ print(f"• The MSK's largest angle error: {worst_j} {err[worst_j][0]:.0f} deg a
 gw = 1 - nmsk_sol.stats["activation_parameters"]["s1"] - nmsk_sol.stats["activation_parameters"]["s2"]
 print(f"• GAM's weight in the ankle extensor (1 − s1 − s2) = {gw:.2g}; mean node-to-node |Δe| of our excitations "
       f"{scores['mean |Δe| per node (ours)'].mean():.3f} vs {scores['mean |Δ| per node (EMG)'].mean():.3f} for the EMG.")
-mt = msk.mtb_scale_table(nmsk_sol)
+mt = marks.mark_rows(msk.mtb_scale_table(nmsk_sol), marks.failure_label(nmsk_sol))
 print(f"• The Mtb term is {100 * mt['w·Mtb (approx.)'].iloc[0] / nmsk_sol.stats['objective']:.1f} % of the NMSK "
       f"objective with d read as the stride; read as the 50 ms delay it would be "
       f"{mt['w·Mtb (approx.)'].iloc[1] / nmsk_sol.stats['objective']:.0f}× the whole objective.")
@@ -430,17 +460,13 @@ print(f"• This page's solves and identifications took {time.perf_counter() - T
 # %% [markdown]
 # **Where we differ from the thesis, and why** (reading the numbers above):
 #
-# * *MTG identification.* With the thesis's tuned joint dampers (≈ 0 at knee and ankle,
-#   Table 4.16) the child's torques on our data fit almost inside the adult Gymnast curves
-#   scaled by mass × height: the identification only shifts the ankle extensor's passive
-#   curve (and, barely, its active and velocity curves), as the thesis's Table 5.2 does
-#   (there also a Δ^P of the ankle extensor). The other small deviations of Table 5.2 —
+# * *MTG identification.* Our identification ran under the body set and joint dampers
+#   printed after Table 5.2 above, beside the thesis's tuned ones (Table 4.16); where ours
+#   are larger the MTGs must also supply the dampers' torque (the demand table of Sec 5.1
+#   gives its size). The parameters it moved are listed in *What we found* below. Some small deviations of the thesis's Table 5.2 —
 #   e.g. the same λ^P for five generators, s^V above 1 everywhere — look like what IPOPT
-#   returns when stopped at tolerance 1e-5 on this tiny objective: drift from the barrier,
-#   not information from the data. With the adult joint dampers (the Ch 2 model) the
-#   ankle's push-off demand grows by the damper's torque (first table of Sec 5.1) and the
-#   identification must raise the ankle extensor's s^τ, s^A and s^V
-#   (`tests/test_mtg_id.py`).
+#   returns when stopped at tolerance 1e-5 on this tiny objective (compare our tol-1e-5
+#   column): drift from the barrier, not information from the data.
 # * *MSK and NMSK tracking.* Our RMSEs are several times Tables 5.4 and 5.11's, as in Ch 2:
 #   different data, contact parameters identified on other data (unless Ch 4's are used),
 #   and the right leg landing with a flexed knee. The NMSK fit is close to the MSK fit,

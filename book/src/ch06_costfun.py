@@ -46,7 +46,7 @@ import pandas as pd
 import matplotlib.pyplot as plt
 from IPython.display import HTML
 
-from gaitlib import data, plots
+from gaitlib import data, marks, plots
 from gaitlib.model import ChildModel
 from gaitlib.studies import gait, msk, predictive as pr
 
@@ -60,7 +60,7 @@ res = pr.cost_function_study(("MSK", "NMSK"), pr.CH6_COSTS, progress=False)
 # ## The Ch 5 solutions the runs start from
 
 # %%
-base = pd.DataFrame({m: {"cost": b.spec.cost, "status": b.stats["status"], "iterations": b.stats["iterations"],
+base = pd.DataFrame({m: {"cost": b.spec.cost, "mark": marks.failure_label(b) or "", "status": b.stats["status"], "iterations": b.stats["iterations"],
                          "solve (s)": b.stats["solve_time_s"], "body params": b.spec.body_params,
                          "contact params": b.spec.contact_params, "MTG params": b.spec.mtg_params,
                          "objective": b.stats["objective"]} for m, b in res.baselines.items()}).T
@@ -71,11 +71,13 @@ base
 #
 # Our wall time per run (2-core machine, IPOPT + MUMPS, exact Hessian) beside the hours the
 # thesis reports (GPOPS-II, i7-6700; thesis Table 6.3 — labelled). A run that did not
-# converge keeps its IPOPT status here and is marked in every figure below.
+# converge keeps its IPOPT status here (column `mark`) and is marked in every figure and
+# table below: hatched red bars with a red †, a red watermark across curves, † after its
+# row label; no headline number on this page comes from it.
 
 # %%
 stats = res.stats()
-stats[["status", "converged", "iterations", "solve (s)", "ms/iteration", "objective", "max violation",
+stats[["mark", "status", "converged", "iterations", "solve (s)", "ms/iteration", "objective", "max violation",
        "COT (J/kg/m)"]]
 
 # %% [markdown]
@@ -85,7 +87,7 @@ stats[["status", "converged", "iterations", "solve (s)", "ms/iteration", "object
 
 # %%
 res_thesis_guess = pr.cost_function_study(("NMSK",), pr.CH6_COSTS, progress=False, guess={"NMSK": "thesis"})
-tg = res_thesis_guess.stats()[["status", "iterations", "solve (s)", "objective", "max violation"]]
+tg = res_thesis_guess.stats()[["mark", "status", "iterations", "solve (s)", "objective", "max violation"]]
 tg
 
 # %% [markdown]
@@ -100,14 +102,14 @@ res.rerun_table(inv) if inv else "every run converged"
 
 # %%
 times = pr.times_table(res, pr.THESIS_HOURS_TABLE_6_3)
-times.pivot(index="case", columns="model", values=["total (s)", "iterations", "ms/iteration", "thesis (h)", "speed-up"]).loc[list(pr.CH6_COSTS)]
+times.pivot(index="case", columns="model", values=["mark", "total (s)", "iterations", "ms/iteration", "thesis (h)", "speed-up"]).loc[list(pr.CH6_COSTS)]
 
 # %% [markdown]
 # ## Accuracy per cost function (thesis Figs 6.1–6.4)
 #
 # RMSE of each channel against the *Free* data mean (angles: hip = thigh in the
-# laboratory, as tracked), per cost function, MSK beside NMSK. Runs that did not converge are
-# listed above; their bars are drawn too, so compare with the status table.
+# laboratory, as tracked), per cost function, MSK beside NMSK. A run that did not converge
+# is drawn hatched red with a red † above its bars, named in red in the title.
 
 # %%
 sc = res.scores
@@ -125,12 +127,14 @@ fig = plots.score_bars(sc, "excitation", cases=pr.CH6_COSTS, models=["NMSK"],
 
 # %% [markdown]
 # The same numbers as one table (mean over the channels of a kind, NRMSE = RMSE / data
-# range, dimensionless):
+# range, dimensionless); a run that did not converge has † after its name and its status
+# in `mark`:
 
 # %%
 summary = (sc.groupby(["model", "case", "kind"])["nrmse"].mean().unstack("kind")
            .reindex(pd.MultiIndex.from_product([["MSK", "NMSK"], pr.CH6_COSTS])))
-summary
+run_marks = res.marks()
+marks.mark_table(summary, {tuple(k.split(" ", 1)): v for k, v in run_marks.items()})
 
 # %% [markdown]
 # ## The fully predictive NMSK gait (thesis Figs 6.5–6.8)
@@ -140,20 +144,17 @@ summary
 # %%
 fp = res.solutions.get("NMSK FP")
 fp_msk = res.solutions.get("MSK FP")
-sims = {}
-for lab, s in (("NMSK FP", fp), ("MSK FP", fp_msk)):
-    if s is not None:
-        sims[lab + ("" if s.stats["success"] else f" — {s.stats['status']}")] = gait.channels_frame(s)
+sims, sim_marks = gait.sims_and_marks({lab: s for lab, s in (("NMSK FP", fp), ("MSK FP", fp_msk)) if s is not None})
 fig = plots.tracking_figure(tracked, sims, channels=[f"{j}_{s}" for s in "rl" for j in ("hip", "knee", "ankle")],
-                            ncols=3, title="Angles, fully predictive (cf. thesis Fig 6.5)")
+                            ncols=3, title="Angles, fully predictive (cf. thesis Fig 6.5)", marks=sim_marks)
 
 # %%
 fig = plots.tracking_figure(tracked, sims, channels=["grf_x_r", "grf_y_r", "grf_x_l", "grf_y_l"], ncols=4,
-                            title="Foot forces, fully predictive (cf. thesis Fig 6.6)")
+                            title="Foot forces, fully predictive (cf. thesis Fig 6.6)", marks=sim_marks)
 
 # %%
 fig = plots.tracking_figure(tracked, sims, channels=[f"tau_{j}_{s}" for s in "rl" for j in ("hip", "knee", "ankle")],
-                            ncols=3, title="Net joint torques, fully predictive (cf. thesis Fig 6.7)")
+                            ncols=3, title="Net joint torques, fully predictive (cf. thesis Fig 6.7)", marks=sim_marks)
 
 # %%
 emg_frames = {}
@@ -167,7 +168,8 @@ if fp is not None:
     emg_frames["NMSK FP excitation"] = pd.DataFrame(cols, index=ex.index)
     chans = [c for c in cols if c in free.mean.columns]
     fig = plots.tracking_figure(free, emg_frames, channels=chans, ncols=4, data_label="EMG ±1 SD",
-                                title="Excitations vs EMG, fully predictive (cf. thesis Fig 6.8)")
+                                title="Excitations vs EMG, fully predictive (cf. thesis Fig 6.8)",
+                                marks={"NMSK FP excitation": marks.failure_label(fp)})
 
 # %% [markdown]
 # ## The predicted gait
@@ -175,7 +177,8 @@ if fp is not None:
 # %%
 if fp is not None:
     anim = plots.animate_gait(ChildModel(), fp.q.index.to_numpy(), fp.q.to_numpy(), fp.qd.to_numpy(),
-                              max_frames=40, title="NMSK fully predictive (FP), Free speed")
+                              max_frames=40, title="NMSK fully predictive (FP), Free speed",
+                              mark=marks.failure_label(fp))
     display_anim = HTML(plots.animation_html(anim))
 else:
     display_anim = "NMSK FP returned no solution (see the status table)"
@@ -183,12 +186,27 @@ display_anim
 
 # %% [markdown]
 # ## What we found
+#
+# Computed from the runs above. A run that did not converge supplies no number here: where
+# it would, the line says so (the investigated 3000-iteration rerun is used only where
+# named).
 
 # %%
 ok = stats["converged"]
-nr = summary[["angle", "torque", "grf"]].mean(axis=1)  # the same kinds for both models
+csc = res.converged_scores()  # the scores of converged runs only
+nr = (csc[csc["kind"].isin(["angle", "torque", "grf"])].groupby(["model", "case", "kind"])["nrmse"].mean()
+      .unstack("kind").mean(axis=1))  # the same kinds for both models
+
+
 def _nr(model, case):
     return nr.get((model, case), np.nan)
+
+
+def _f(model, case):
+    v = _nr(model, case)
+    return f"{v:.3f}" if np.isfinite(v) else f"— ({run_marks.get(f'{model} {case}') or 'no result'})"
+
+
 tg_ok = tg["status"] == "Solve_Succeeded"
 lines = [f"- {int(ok.sum())} of {len(ok)} runs converged (IPOPT Solve_Succeeded)"
          + ("" if ok.all() else "; not converged: " + ", ".join(f"{k} ({v})" for k, v in stats.loc[~ok, 'status'].items()))
@@ -196,17 +214,26 @@ lines = [f"- {int(ok.sum())} of {len(ok)} runs converged (IPOPT Solve_Succeeded)
          f"against 1–15 h in the thesis (Table 6.3). NMSK runs start from the whole Ch 5 NMSK solution; from the "
          f"thesis's partial guess {int(tg_ok.sum())} of {len(tg)} NMSK runs converged"
          + ("" if tg_ok.all() else " (not: " + ", ".join(f"{k} {v}" for k, v in tg.loc[~tg_ok, 'status'].items()) + ")") + ".",
-         f"- Mean NRMSE over angles, torques and forces: MSK DT {_nr('MSK', 'DT'):.3f} → FP {_nr('MSK', 'FP'):.3f}; "
-         f"NMSK DT {_nr('NMSK', 'DT'):.3f} → FP {_nr('NMSK', 'FP'):.3f}."]
-better = [c for c in pr.CH6_COSTS if _nr("NMSK", c) < _nr("MSK", c)]
-lines.append(f"- NMSK is more accurate than MSK (mean NRMSE) for {', '.join(better) if better else 'no cost function'}; "
-             "the thesis found NMSK better for SDT1, SP2 and FP, MSK better for SDT2 and SP3, similar for DT, SDT3 and SP1 (Sec 6.2.3).")
-fp_claim = _nr("NMSK", "FP") < _nr("MSK", "FP")
-lines.append(f"- Thesis claim *NMSK FP more accurate than MSK FP*: {'holds' if fp_claim else 'does not hold'} on our data "
-             f"({_nr('NMSK', 'FP'):.3f} vs {_nr('MSK', 'FP'):.3f}). "
-             f"*NMSK FP faster than MSK FP*: {'holds' if stats.loc['NMSK FP', 'solve (s)'] < stats.loc['MSK FP', 'solve (s)'] else 'does not hold'} "
-             f"({stats.loc['NMSK FP', 'solve (s)']:.0f} s vs {stats.loc['MSK FP', 'solve (s)']:.0f} s; not a like-for-like "
-             "comparison: the NMSK runs start from the whole Ch 5 solution, the MSK runs from the thesis's partial guess).")
+         f"- Mean NRMSE over angles, torques and forces: MSK DT {_f('MSK', 'DT')} → FP {_f('MSK', 'FP')}; "
+         f"NMSK DT {_f('NMSK', 'DT')} → FP {_f('NMSK', 'FP')}."]
+both = [c for c in pr.CH6_COSTS if np.isfinite(_nr("NMSK", c)) and np.isfinite(_nr("MSK", c))]
+better = [c for c in both if _nr("NMSK", c) < _nr("MSK", c)]
+skipped = [c for c in pr.CH6_COSTS if c not in both]
+lines.append(f"- NMSK is more accurate than MSK (mean NRMSE) for {', '.join(better) if better else 'no cost function'}"
+             + (f" (of {len(both)} cost functions where both runs converged; not compared: {', '.join(skipped)})" if skipped else "")
+             + "; the thesis found NMSK better for SDT1, SP2 and FP, MSK better for SDT2 and SP3, similar for DT, SDT3 and SP1 (Sec 6.2.3).")
+if "FP" in both:
+    fp_claim = _nr("NMSK", "FP") < _nr("MSK", "FP")
+    lines.append(f"- Thesis claim *NMSK FP more accurate than MSK FP*: {'holds' if fp_claim else 'does not hold'} on our data "
+                 f"({_f('NMSK', 'FP')} vs {_f('MSK', 'FP')}). "
+                 f"*NMSK FP faster than MSK FP*: {'holds' if stats.loc['NMSK FP', 'solve (s)'] < stats.loc['MSK FP', 'solve (s)'] else 'does not hold'} "
+                 f"({stats.loc['NMSK FP', 'solve (s)']:.0f} s vs {stats.loc['MSK FP', 'solve (s)']:.0f} s; not a like-for-like "
+                 "comparison: the NMSK runs start from the whole Ch 5 solution, the MSK runs from the thesis's partial guess).")
+else:
+    lines.append("- Thesis claims *NMSK FP more accurate / faster than MSK FP*: not tested — "
+                 f"MSK FP {_f('MSK', 'FP')}, NMSK FP {_f('NMSK', 'FP')}.")
+
+
 def _nr_of(sol):
     d = pr.score(sol, free)
     return d[d["kind"].isin(["angle", "torque", "grf"])].groupby("kind")["nrmse"].mean().mean()
@@ -217,15 +244,20 @@ if not stats.loc["NMSK SDT3", "converged"]:
     r = inv.get("NMSK SDT3")
     if r is not None and r.stats["success"]:
         sdt3_val = _nr_of(r)
-        note = f" (the 1000-iteration run did not converge; its converged 3000-iteration rerun, {r.stats['iterations']} iterations)"
-    else:
-        note = " (NOT converged — the comparison is indicative only)"
-sdt3 = sdt3_val <= _nr("NMSK", "DT") * 1.1
-lines.append(f"- Thesis claim *SDT3 (Trq + Ang) is enough for NMSK*: NMSK SDT3 mean NRMSE {sdt3_val:.3f}{note} vs DT "
-             f"{_nr('NMSK', 'DT'):.3f} — {'holds (within 10 %)' if sdt3 else 'does not hold'}.")
-exc = sc[sc["kind"] == "excitation"].groupby("case")["rmse"].mean()
+        note = (f" (the study's 1000-iteration run did not converge; this is its converged 3000-iteration rerun, "
+                f"{r.stats['iterations']} iterations)")
+if np.isfinite(sdt3_val) and np.isfinite(_nr("NMSK", "DT")):
+    sdt3 = sdt3_val <= _nr("NMSK", "DT") * 1.1
+    lines.append(f"- Thesis claim *SDT3 (Trq + Ang) is enough for NMSK*: NMSK SDT3 mean NRMSE {sdt3_val:.3f}{note} vs DT "
+                 f"{_nr('NMSK', 'DT'):.3f} — {'holds (within 10 %)' if sdt3 else 'does not hold'}.")
+else:
+    lines.append(f"- Thesis claim *SDT3 (Trq + Ang) is enough for NMSK*: not tested — NMSK SDT3 {_f('NMSK', 'SDT3')}, "
+                 f"DT {_f('NMSK', 'DT')}.")
+exc = csc[csc["kind"] == "excitation"].groupby("case")["rmse"].mean()
+not_conv = [c for c in pr.CH6_COSTS if run_marks.get(f"NMSK {c}")]
 if len(exc):
-    lines.append(f"- Excitation RMSE vs EMG (mean over mapped muscles): best {exc.idxmin()} {exc.min():.3f}, "
-                 f"worst {exc.idxmax()} {exc.max():.3f}; FP {exc.get('FP', np.nan):.3f} vs DT {exc.get('DT', np.nan):.3f} "
-                 "(thesis: FP 12 % better than DT).")
+    lines.append(f"- Excitation RMSE vs EMG (mean over mapped muscles, converged NMSK runs"
+                 + (f"; {', '.join(not_conv)} left out: not converged" if not_conv else "") + "): "
+                 f"best {exc.idxmin()} {exc.min():.3f}, worst {exc.idxmax()} {exc.max():.3f}; "
+                 f"FP {exc.get('FP', np.nan):.3f} vs DT {exc.get('DT', np.nan):.3f} (thesis: FP 12 % better than DT).")
 print("\n".join(lines))

@@ -29,7 +29,7 @@ import numpy as np
 import pandas as pd
 import matplotlib.pyplot as plt
 
-from gaitlib import data, plots
+from gaitlib import data, marks, plots
 from gaitlib.studies import gait, predictive as pr
 
 pd.set_option("display.precision", 3)
@@ -41,7 +41,8 @@ pd.DataFrame({c: {"speed (m/s)": g.speed, "cycle time (s)": g.cycle_time, "strid
 # %%
 res = pr.speed_study(("MSK", "NMSK"), classes, progress=False)
 stats = res.stats()
-stats[["status", "converged", "iterations", "solve (s)", "ms/iteration", "objective", "max violation",
+run_marks = res.marks()
+stats[["mark", "status", "converged", "iterations", "solve (s)", "ms/iteration", "objective", "max violation",
        "COT (J/kg/m)"]]
 
 # %% [markdown]
@@ -52,7 +53,7 @@ stats[["status", "converged", "iterations", "solve (s)", "ms/iteration", "object
 
 # %%
 res_thesis_guess = pr.speed_study(("NMSK",), classes, progress=False, guess={"NMSK": "thesis"})
-tg = res_thesis_guess.stats()[["status", "iterations", "solve (s)", "objective", "max violation"]]
+tg = res_thesis_guess.stats()[["mark", "status", "iterations", "solve (s)", "objective", "max violation"]]
 tg
 
 # %% [markdown]
@@ -74,10 +75,13 @@ res.rerun_table(inv) if inv else "every run converged"
 # %%
 times = pr.times_table(res, pr.THESIS_HOURS_TABLE_7_2, lambda s: pr.THESIS_CLASS[s.speed_class])
 times["class"] = [s.speed_class for s in res.specs.values()]
-times.set_index(["model", "class"])[["status", "iterations", "build (s)", "solve (s)", "ms/iteration", "thesis (h)", "speed-up"]]
+times.set_index(["model", "class"])[["mark", "status", "iterations", "build (s)", "solve (s)", "ms/iteration", "thesis (h)", "speed-up"]]
 
 # %% [markdown]
 # ## Accuracy against each class's own (untracked) data — thesis Figs 7.1–7.4
+#
+# A run that did not converge is drawn hatched red with a red † above its bars and named in
+# red in the title; the table below gives it a `mark`, and the findings leave it out.
 
 # %%
 sc = res.scores
@@ -112,31 +116,55 @@ for c in classes:
         ctrl.append({"class": c, "kind": kind, "scaled Free data": float(np.mean(nr))})
 ctrl = pd.DataFrame(ctrl).pivot(index="class", columns="kind", values="scaled Free data").loc[list(classes)]
 pred = sc[sc["kind"].isin(["angle", "torque", "grf"])].groupby(["model", "case", "kind"])["nrmse"].mean().unstack("kind")
-pd.concat({"scaled Free data vs class data": ctrl,
-           "MSK prediction": pred.loc["MSK"].reindex(classes) if "MSK" in pred.index else None,
-           "NMSK prediction": pred.loc["NMSK"].reindex(classes) if "NMSK" in pred.index else None}, axis=1)
+
+
+def _pred(model):
+    if model not in pred.index:
+        return None
+    p = pred.loc[model].reindex(classes)
+    p.insert(0, "mark", [run_marks.get(f"{model} {c}") or "" for c in classes])
+    return p
+
+
+pd.concat({"scaled Free data vs class data": ctrl, "MSK prediction": _pred("MSK"), "NMSK prediction": _pred("NMSK")},
+          axis=1)
 
 # %% [markdown]
 # ## Cost of transport against speed (thesis Fig 7.5)
 #
-# The NMSK runs here and the natural-speed NMSK solution of Ch 5 (Eq 5.55). The thesis's
-# points are drawn at their own speeds, labelled.
+# The NMSK runs here and, at the natural speed, the like-for-like point: the Ch 6 NMSK DT
+# run — the same cost function (Table 6.2's DT = Table 7.1), activation parameters (thesis
+# Table 5.10), HAT reference and kind of initial guess as the runs here, on the Free data.
+# The Ch 5 NMSK solution (Eq 5.55: another cost function, with its own identified
+# activation parameters) is drawn apart, as a labelled reference, not part of the curve.
+# The thesis's points are drawn at their own speeds, labelled.
 
 # %%
-cot = pr.cot_table(res, res.baselines.get("NMSK"))
-fig, ax = plt.subplots(figsize=(5.5, 3.6), layout="constrained")
-okc = cot[cot["converged"]]
-ax.plot(okc["speed (m/s)"], okc["COT (J/kg/m)"], "o-", color="C1", label="ours (NMSK, converged)")
-bad = cot[~cot["converged"]]
+ch6_dt = pr.cost_function_study(("NMSK",), ("DT",), progress=False).solutions.get("NMSK DT")
+CH5_ROW = "Free (Ch 5 Eq 5.55)"
+cot = pr.cot_table(res, {"Free": ch6_dt, CH5_ROW: res.baselines.get("NMSK")})
+curve = cot.drop(index=CH5_ROW, errors="ignore")
+fig, ax = plt.subplots(figsize=(8.0, 3.6), layout="constrained")
+okc = curve[curve["mark"] == ""]
+ax.plot(okc["speed (m/s)"], okc["COT (J/kg/m)"], "o-", color="C1", label="ours (NMSK DT, converged; Free = Ch 6 DT)")
+bad = curve[curve["mark"] != ""]
 if len(bad):
-    ax.plot(bad["speed (m/s)"], bad["COT (J/kg/m)"], "x", color="C3", ms=9, label="ours, NOT converged")
+    ax.plot(bad["speed (m/s)"], bad["COT (J/kg/m)"], "x", color=marks.MARK_COLOR, ms=9, mew=2,
+            label=f"{marks.DAGGER} ours, NOT converged")
+    for name, r in bad.iterrows():
+        ax.annotate(f"{marks.DAGGER} {r['mark']}", (r["speed (m/s)"], r["COT (J/kg/m)"]), fontsize=6,
+                    color=marks.MARK_COLOR, textcoords="offset points", xytext=(-4, -12), ha="right")
+if CH5_ROW in cot.index:
+    r5 = cot.loc[CH5_ROW]
+    ax.plot([r5["speed (m/s)"]], [r5["COT (J/kg/m)"]], "D", mfc="none", color="C2", ms=7,
+            label=marks.run_label("Ch 5 NMSK Eq 5.55 (own activation params)", r5["mark"]))
 th = pd.DataFrame(pr.THESIS_COT_FIG_7_5, columns=["class", "speed", "COT"])
 ax.plot(th["speed"], th["COT"], "s--", color="0.5", label="thesis, Fig 7.5 (different data)")
-for _, r in cot.iterrows():
-    ax.annotate(r.name, (r["speed (m/s)"], r["COT (J/kg/m)"]), fontsize=7, textcoords="offset points", xytext=(4, 4))
+for name, r in curve.iterrows():
+    ax.annotate(name, (r["speed (m/s)"], r["COT (J/kg/m)"]), fontsize=7, textcoords="offset points", xytext=(4, 4))
 ax.set_xlabel("walking speed (m/s)")
 ax.set_ylabel("COT (J kg⁻¹ m⁻¹)")
-ax.legend(fontsize=8)
+ax.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.01, 0.5))
 cot
 
 # %% [markdown]
@@ -147,35 +175,49 @@ for c in classes:
     s = res.solutions.get(f"NMSK {c}")
     if s is None:
         continue
-    lab = f"NMSK {c}" + ("" if s.stats["success"] else f" — {s.stats['status']}")
-    fig = plots.tracking_figure(gait.tracking_data(gaits[c]), {lab: gait.channels_frame(s)},
+    sims, sim_marks = gait.sims_and_marks({f"NMSK {c}": s})
+    fig = plots.tracking_figure(gait.tracking_data(gaits[c]), sims,
                                 channels=[f"{j}_r" for j in ("hip", "knee", "ankle")]
                                 + [f"tau_{j}_r" for j in ("hip", "knee", "ankle")] + ["grf_x_r", "grf_y_r"],
-                                ncols=4, title=f"{c}: prediction vs the class's data (right leg)")
+                                ncols=4, title=f"{c}: prediction vs the class's data (right leg)", marks=sim_marks)
 
 # %% [markdown]
 # ## What we found
+#
+# Computed from the runs above; a run that did not converge supplies no number here (the
+# 3000-iteration reruns are reported apart, named).
 
 # %%
 ok = stats["converged"]
+pred_ok = (res.converged_scores().query("kind in ['angle', 'torque', 'grf']")
+           .groupby(["model", "case", "kind"])["nrmse"].mean().unstack("kind"))
+left_out = [k for k, v in run_marks.items() if v]
 lines = [f"- {int(ok.sum())} of {len(ok)} runs converged"
          + ("" if ok.all() else "; not converged: " + ", ".join(f"{k} ({v})" for k, v in stats.loc[~ok, 'status'].items()))
          + f"; IPOPT solve time {stats['solve (s)'].min():.0f}–{stats['solve (s)'].max():.0f} s per run here vs 4–18 h in the thesis (Table 7.2)."]
-if "MSK" in pred.index and "NMSK" in pred.index:
-    tq = pred["torque"]
-    better = [c for c in classes if tq.get(("NMSK", c), np.inf) < tq.get(("MSK", c), -np.inf)]
-    lines.append(f"- Torque NRMSE: NMSK below MSK for {', '.join(better) if better else 'no class'} "
-                 "(thesis: NMSK 2–17 % better at every speed).")
-beat = [(c, k) for c in classes for k in ("angle", "torque", "grf")
-        if ("NMSK", c) in pred.index and pred.loc[("NMSK", c), k] < ctrl.loc[c, k]]
-lines.append(f"- The NMSK prediction is closer to the untracked class data than the scaled Free data it tracked in "
-             f"{len(beat)} of {3 * len(classes)} class × kind cells.")
-cc = cot[cot["converged"]]
+both = [c for c in classes if ("NMSK", c) in pred_ok.index and ("MSK", c) in pred_ok.index]
+if both:
+    tq = pred_ok["torque"]
+    better = [c for c in both if tq[("NMSK", c)] < tq[("MSK", c)]]
+    lines.append(f"- Torque NRMSE: NMSK below MSK for {', '.join(better) if better else 'no class'} of the "
+                 f"{len(both)} classes where both runs converged"
+                 + (f" (not compared: {', '.join(c for c in classes if c not in both)})" if len(both) < len(classes) else "")
+                 + " (thesis: NMSK 2–17 % better at every speed).")
+nm = [c for c in classes if ("NMSK", c) in pred_ok.index]
+beat = [(c, k) for c in nm for k in ("angle", "torque", "grf") if pred_ok.loc[("NMSK", c), k] < ctrl.loc[c, k]]
+lines.append(f"- The converged NMSK predictions are closer to the untracked class data than the scaled Free data they "
+             f"tracked in {len(beat)} of {3 * len(nm)} class × kind cells"
+             + (f" ({', '.join(c for c in classes if c not in nm)} left out: not converged)" if len(nm) < len(classes) else "") + ".")
+cc = curve[curve["mark"] == ""]
+r5 = cot.loc[CH5_ROW] if CH5_ROW in cot.index else None
 if len(cc) >= 3:
     imin = cc["COT (J/kg/m)"].idxmin()
-    lines.append(f"- COT: {', '.join(f'{i} {v:.2f}' for i, v in cc['COT (J/kg/m)'].items())} J/(kg·m); minimum at {imin} "
+    lines.append(f"- COT (NMSK DT, converged runs; Free = the Ch 6 NMSK DT run): "
+                 f"{', '.join(f'{i} {v:.2f}' for i, v in cc['COT (J/kg/m)'].items())} J/(kg·m); minimum at {imin} "
                  f"({'the natural speed — a U-curve as the thesis reports' if imin == 'Free' else 'not at the natural speed — no U-curve with the minimum at Free'}). "
-                 "Thesis (Fig 7.5): 2.18, 1.99, 1.53, 1.96, 1.99 at XS, S, N, M, L.")
+                 "Thesis (Fig 7.5): 2.18, 1.99, 1.53, 1.96, 1.99 at XS, S, N, M, L."
+                 + (f" The Ch 5 NMSK solution (Eq 5.55, its own activation parameters) has {r5['COT (J/kg/m)']:.2f}"
+                    + (f" ({r5['mark']})" if r5["mark"] else "") + "; it is not on the curve." if r5 is not None else ""))
 for k, r in inv.items():
     if k.startswith("NMSK "):
         lines.append(f"- {k} stopped at 1000 iterations; rerun at 3000 it {'converged' if r.stats['success'] else 'did NOT converge'} "

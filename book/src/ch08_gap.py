@@ -30,7 +30,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from gaitlib import gap
+from gaitlib import gap, marks
 from gaitlib.gap import diagnose as D, figures as F, locate as L
 from gaitlib.studies import gap as G
 from IPython.display import Markdown, display
@@ -75,7 +75,8 @@ sS = G.summary(dS)
 print(f"baseline fit: {dS.baseline.stats['status']}, {dS.baseline.stats['iterations']} iterations; "
       f"RSS = {sS['rss']:.1f} over {dS.located.n_points} points (n_eff = {sS['n_eff']:.0f} resels), "
       f"RMS z = {sS['rms_z']:.2f}; {sS['significant_cells']} of {sS['cells']} cells leave the band significantly")
-F.gap_heatmap(dS.located, title="SK baseline fit vs Schwartz 2008 Free: RMS z by channel and phase (* significant)");
+F.gap_heatmap(dS.located, title="SK baseline fit vs Schwartz 2008 Free: RMS z by channel and phase (* significant)",
+              mark=marks.failure_label(dS.baseline));
 plt.show()
 G.top_cells(dS.located)
 
@@ -306,7 +307,7 @@ display(Markdown("\n\n".join(lines_f)))
 # resampling interval for the top three) and penalised (ΔBIC; dashed line the threshold):
 
 # %%
-F.ranking_bars(dS.ranking, top=dS.top_effect);
+F.ranking_bars(dS.ranking, top=dS.top_effect, mark=marks.failure_label(dS.baseline));
 plt.show()
 G.ranking_table(dS)
 
@@ -314,6 +315,7 @@ G.ranking_table(dS)
 best = sS["best"]
 if best is not None:
     F.shrink_heatmaps(dS.located, dS.fits[best].located, best,
+                      marks=(marks.failure_label(dS.baseline), marks.failure_label(dS.fits[best].status)),
                       title=f"Schwartz 2008 Free: gap of the SK baseline fit and with {best}");
     plt.show()
     sh = dS.shrink[best]
@@ -335,9 +337,9 @@ sU = G.summary(dU)
 print("excluded channels:", [(d["id"], d["reason"]) for d in dU.located.excluded])
 print(f"baseline fit: {dU.baseline.stats['status']}; RSS = {sU['rss']:.1f}, RMS z = {sU['rms_z']:.2f}; "
       f"{sU['significant_cells']} of {sU['cells']} cells significant (n = 1: the band test is conservative)")
-F.gap_heatmap(dU.located, title="SK baseline fit vs gaitutils normal data");
+F.gap_heatmap(dU.located, title="SK baseline fit vs gaitutils normal data", mark=marks.failure_label(dU.baseline));
 plt.show()
-F.ranking_bars(dU.ranking, top=dU.top_effect);
+F.ranking_bars(dU.ranking, top=dU.top_effect, mark=marks.failure_label(dU.baseline));
 plt.show()
 G.ranking_table(dU)
 
@@ -376,9 +378,10 @@ llc
 
 # %%
 F.data_views(dS.located, chkS["located_exact"], ["grf:grf_x_l", "grf:grf_y_l", "torque:ankle_l", "torque:hip_l"],
-             sim_label="SK baseline fit");
+             sim_label="SK baseline fit", mark=marks.failure_label(dS.baseline));
 plt.show()
-F.gap_heatmap(chkS["located_exact"], title="SK baseline fit vs Schwartz 2008 Free, left leg shifted exactly");
+F.gap_heatmap(chkS["located_exact"], title="SK baseline fit vs Schwartz 2008 Free, left leg shifted exactly",
+              mark=marks.failure_label(dS.baseline));
 plt.show()
 
 # %% [markdown]
@@ -412,7 +415,8 @@ dN = G.nmsk_attribution()
 sN = G.summary(dN)
 print(f"Ch 5 NMSK solution: {dN.baseline.stats['status']}, {dN.baseline.stats['iterations']} iterations; "
       f"RSS = {sN['rss']:.1f} (RMS z = {sN['rms_z']:.2f}) over {dN.located.n_points} points incl. EMG")
-F.gap_heatmap(dN.located, title="Ch 5 NMSK solution vs Schwartz 2008 Free (with EMG)");
+F.gap_heatmap(dN.located, title="Ch 5 NMSK solution vs Schwartz 2008 Free (with EMG)",
+              mark=marks.failure_label(dN.baseline));
 plt.show()
 for n, f in dN.fits.items():
     if f.profile:
@@ -436,7 +440,8 @@ for n, t in prof.items():
 cc = dN.fits.get("co_contraction")
 if cc is not None and cc.located is not None:
     F.channel_curves(dN.located, cc.located, ["emg:TA_r", "emg:MG_r", "emg:TA_l", "emg:MG_l"],
-                     labels=("Ch 5 NMSK", f"co-contraction c = {cc.thetas['co_contraction']['c']:.2f}"));
+                     labels=("Ch 5 NMSK", f"co-contraction c = {cc.thetas['co_contraction']['c']:.2f}"),
+                     marks=(marks.failure_label(dN.baseline), marks.failure_label(cc.status)));
     plt.show()
 
 # %% [markdown]

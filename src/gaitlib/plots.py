@@ -371,7 +371,7 @@ def _pick_frames(n: int, max_frames: int) -> np.ndarray:
 def animate_gait(model, t, Q, Qd=None, p_contact=None, p_body=None, fps: float = 12,
                  interval=None, max_frames: int = 50, camera: str = "stride",
                  window: float = 1.6, figsize=(6.0, 4.0), dpi: int = 72, grf=True,
-                 ellipsoids=True, grf_scale=None, title=None):
+                 ellipsoids=True, grf_scale=None, title=None, mark=None):
     """Animate a gait trajectory of the child model.
 
     Parameters
@@ -388,6 +388,8 @@ def animate_gait(model, t, Q, Qd=None, p_contact=None, p_body=None, fps: float =
         every frame, their size does not). The vertical limits are fixed over the motion in
         both cases.
     grf, ellipsoids, grf_scale : as :func:`draw_model`.
+    mark : the solve's failure label (:func:`gaitlib.marks.failure_label`), written as a
+        red watermark across every frame; None for a converged solve.
 
     Returns
     -------
@@ -421,6 +423,7 @@ def animate_gait(model, t, Q, Qd=None, p_contact=None, p_body=None, fps: float =
     label = ax.text(0.02, 0.96, "", transform=ax.transAxes, va="top", fontsize=9)
     if title:
         ax.set_title(title, fontsize=10)
+    _mark_animation(ax, mark)
 
     def update(k):
         i = idx[k]
@@ -438,6 +441,15 @@ def animate_gait(model, t, Q, Qd=None, p_contact=None, p_body=None, fps: float =
     anim.frame_indices = idx
     plt.close(fig)  # the notebook shows the animation, not a static copy
     return anim
+
+
+def _mark_animation(ax, mark):
+    from . import marks as mk
+
+    if mark:
+        mk.mark_axes(ax, mark)
+        ax.set_title(f"{mark} — {ax.get_title()}" if ax.get_title() else mark, fontsize=9, color=mk.MARK_COLOR,
+                     fontweight="bold")
 
 
 def animation_html(anim) -> str:
@@ -461,7 +473,7 @@ GAIT_CHANNELS = ("hip_r", "knee_r", "ankle_r", "mtp_r", "hip_l", "knee_l", "ankl
 
 
 def tracking_figure(gait, sims: dict, channels=GAIT_CHANNELS, ncols: int = 4, colors=None,
-                    figsize_per=(3.0, 2.1), title=None, data_label="data ±1 SD"):
+                    figsize_per=(3.0, 2.1), title=None, data_label="data ±1 SD", marks=None):
     """Simulated channels over the data's mean ± 1 SD band, one panel per channel.
 
     Parameters
@@ -472,10 +484,17 @@ def tracking_figure(gait, sims: dict, channels=GAIT_CHANNELS, ncols: int = 4, co
         :func:`gaitlib.studies.gait.channels_frame`. Drawn in display units
         (:func:`channel_display`). Channels the data lack (the metatarsal torque) show the
         simulation only; a planned reference (``mtp_*``) is drawn as a band of zero width.
+    marks : optional ``{label: failure label or None}`` (:func:`gaitlib.marks.failure_label`
+        of each simulation's solve). A marked simulation is drawn dashed, its legend entry
+        says why, every panel that shows it carries the label as a red watermark and the
+        title starts with it in red (:mod:`gaitlib.marks`).
     """
     import matplotlib.pyplot as plt
 
+    from . import marks as mk
+
     channels = list(channels)
+    marks = {lab: m for lab, m in (marks or {}).items() if m and lab in sims}
     fig, axes = _panel_grid(len(channels), ncols, figsize_per)
     cmap = plt.get_cmap("tab10")
     colors = colors or {lab: cmap(i) for i, lab in enumerate(sims)}
@@ -484,18 +503,23 @@ def tracking_figure(gait, sims: dict, channels=GAIT_CHANNELS, ncols: int = 4, co
         name, scale, unit = channel_display(ch)
         if ch in gait.mean:
             band(ax, pct_data, scale * gait.mean[ch], scale * gait.sd[ch], label=data_label)
+        shown = []
         for lab, frame in sims.items():
             if ch in frame:
                 t = np.asarray(frame.index, dtype=float)
                 ax.plot(100 * (t - t[0]) / gait.cycle_time, scale * frame[ch].to_numpy(), color=colors[lab],
-                        lw=1.4, label=lab)
+                        lw=1.4, ls="--" if lab in marks else "-", label=mk.run_label(lab, marks.get(lab)))
+                shown.append(lab)
         _label_panel(ax, ch, unit, name)
-    return _finish_panels(fig, axes, len(channels), title)
+        mk.mark_axes(ax, mk.joint_label({k: marks.get(k) for k in shown}, named=len(sims) > 1))
+    fig = _finish_panels(fig, axes, len(channels), title)
+    mk.mark_figure(fig, mk.joint_label(marks, named=len(sims) > 1))
+    return fig
 
 
 def animate_jump(jump_model, t, Q, p_contact=None, grf=None, cop=None, fps: float = 12,
                  interval=None, max_frames: int = 50, figsize=(4.5, 5.0), dpi: int = 72,
-                 grf_scale=None, grf_min=None, ellipsoids=None, title=None):
+                 grf_scale=None, grf_min=None, ellipsoids=None, title=None, mark=None):
     """Animate a vertical jump of a :class:`gaitlib.jump.JumpModel` (thesis Ch 3).
 
     Parameters
@@ -509,7 +533,7 @@ def animate_jump(jump_model, t, Q, p_contact=None, grf=None, cop=None, fps: floa
         arrow from ``(cop[i], 0)`` (``cop`` (n,) m; default: below the MTP point), hidden
         where F_y < ``grf_min`` (default 4 % of the weight) or where ``cop`` is NaN.
         ``grf_scale`` m per N (default: one body weight ↦ 0.5 m).
-    fps, interval, max_frames, figsize, dpi, title : as :func:`animate_gait`.
+    fps, interval, max_frames, figsize, dpi, title, mark : as :func:`animate_gait`.
 
     Fixed axes that contain every frame (so the height of the jump is visible); the body
     is drawn with :func:`draw_jump`. Returns a ``FuncAnimation`` (``anim.frame_indices``).
@@ -544,6 +568,7 @@ def animate_jump(jump_model, t, Q, p_contact=None, grf=None, cop=None, fps: floa
     label = ax.text(0.02, 0.97, "", transform=ax.transAxes, va="top", fontsize=9)
     if title:
         ax.set_title(title, fontsize=10)
+    _mark_animation(ax, mark)
 
     def update(k):
         i = idx[k]
@@ -580,10 +605,23 @@ def score_bars(scores, kind: str, value: str = "rmse", cases=None, models=None, 
     kind : ``"angle"``, ``"torque"``, ``"grf"`` or ``"excitation"`` — one panel per
         channel and side; x = the cases (cost functions or speed classes) in order, one bar
         per model. A run missing from ``scores`` leaves a gap.
+
+    A run whose rows carry a failure label in the column ``mark`` (see
+    :func:`gaitlib.marks.failure_label`; :attr:`~gaitlib.studies.predictive.StudyResult.scores`
+    has it) is drawn with red hatching and a red ``†`` above the bar; the legend explains the
+    hatching and the title starts with the marked runs and their labels, in red.
     """
     import matplotlib.pyplot as plt
 
+    from . import marks as mk
+
     df = scores[scores["kind"] == kind]
+    run_marks = {}
+    if "mark" in df.columns:
+        for (m, c), g in df.groupby(["model", "case"], sort=False):
+            labs = [v for v in g["mark"] if isinstance(v, str) and v]
+            if labs:
+                run_marks[(m, c)] = labs[0]
     cases = list(cases) if cases is not None else list(dict.fromkeys(df["case"]))
     models = list(models) if models is not None else list(dict.fromkeys(df["model"]))
     panels = list(dict.fromkeys(zip(df["channel"], df["side"])))
@@ -597,7 +635,13 @@ def score_bars(scores, kind: str, value: str = "rmse", cases=None, models=None, 
         for i, m in enumerate(models):
             vals = [sub[(sub["model"] == m) & (sub["case"] == c)][value] for c in cases]
             vals = [float(v.iloc[0]) if len(v) else np.nan for v in vals]
-            ax.bar(x + (i - (len(models) - 1) / 2) * width, vals, width, color=colors[m], label=m)
+            xs = x + (i - (len(models) - 1) / 2) * width
+            bars = ax.bar(xs, vals, width, color=colors[m], label=m)
+            for j, c in enumerate(cases):
+                if (m, c) in run_marks and np.isfinite(vals[j]):
+                    mk.mark_bars([bars[j]], run_marks[(m, c)])
+                    ax.annotate(mk.DAGGER, (xs[j], vals[j]), ha="center", va="bottom", color=mk.MARK_COLOR,
+                                fontsize=9, fontweight="bold", gid=mk.MARK_GID)
         ax.set_xticks(x, cases, rotation=60, fontsize=7)
         unit = sub["unit"].iloc[0] if value == "rmse" and len(sub) else ""
         ax.set_title(f"{ch} ({'right' if side == 'r' else 'left'})", fontsize=9)
@@ -606,10 +650,16 @@ def score_bars(scores, kind: str, value: str = "rmse", cases=None, models=None, 
     for ax in axes.flat[len(panels):]:
         ax.axis("off")
     h, lab = axes.flat[0].get_legend_handles_labels()
+    shown = {k: v for k, v in run_marks.items() if k[0] in models and k[1] in cases}
+    if shown:
+        h, lab = h + [mk.bar_legend_handle()], lab + [mk.bar_legend_handle().get_label()]
     if h:
-        fig.legend(h, lab, loc="outside upper right", fontsize=8, ncols=len(models))
+        fig.legend(h, lab, loc="outside lower center" if shown else "outside upper right", fontsize=8,
+                   ncols=len(h))
     if title:
         fig.suptitle(title, fontsize=10)
+    if shown:
+        mk.mark_figure(fig, "; ".join(f"{mk.DAGGER} {m} {c} {v}" for (m, c), v in shown.items()))
     return fig
 
 

@@ -297,14 +297,18 @@ class Diagnosis:
             import matplotlib
 
             matplotlib.use("Agg")
+            from .. import marks
             from . import figures as F
 
-            F.gap_heatmap(self.located, title=f"gap of the baseline fit — {self.data.label}").savefig(
+            m0 = marks.failure_label(self.baseline)
+            F.gap_heatmap(self.located, title=f"gap of the baseline fit — {self.data.label}", mark=m0).savefig(
                 out / "gap_heatmap.png", dpi=110)
-            F.ranking_bars(self.ranking, top=self.top_effect).savefig(out / "ranking.png", dpi=110)
+            F.ranking_bars(self.ranking, top=self.top_effect, mark=m0).savefig(out / "ranking.png", dpi=110)
             if self.shrink:
                 first = next(iter(self.shrink))
-                F.shrink_heatmaps(self.located, self.fits[first].located, first).savefig(out / "shrink.png", dpi=110)
+                m1 = marks.failure_label(self.fits[first].solution or self.fits[first].status)
+                F.shrink_heatmaps(self.located, self.fits[first].located, first, marks=(m0, m1)).savefig(
+                    out / "shrink.png", dpi=110)
         return out
 
 

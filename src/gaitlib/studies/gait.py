@@ -28,7 +28,7 @@ from .. import ocp
 from .. import transcription as tr
 
 __all__ = ["THESIS_RMSE", "solve_cached", "natural_gait", "natural_gait_spec", "rmse_beside_thesis",
-           "channels_frame", "write_outputs", "stats_table", "tracking_data"]
+           "channels_frame", "sims_and_marks", "write_outputs", "stats_table", "tracking_data"]
 
 #: Thesis RMSEs (different data, Bovi 2011): (kind, joint/component, side) → value.
 #: Table 4.9, optimal control row (SK, contact parameters identified), torques N·m, GRF N.
@@ -168,12 +168,25 @@ def channels_frame(sol: tr.GaitSolution) -> pd.DataFrame:
     return out
 
 
+def sims_and_marks(solutions: dict) -> tuple[dict, dict]:
+    """``{label: GaitSolution}`` → (``{label: channels_frame}``, ``{label: failure label}``):
+    the ``sims`` and ``marks`` arguments of :func:`gaitlib.plots.tracking_figure`
+    (:func:`gaitlib.marks.failure_label`; None for a converged solve)."""
+    from .. import marks
+
+    return ({k: channels_frame(s) for k, s in solutions.items()},
+            {k: marks.failure_label(s) for k, s in solutions.items()})
+
+
 def stats_table(solutions: dict) -> pd.DataFrame:
-    """One row of solver statistics per labelled solution."""
+    """One row of solver statistics per labelled solution; ``mark`` is its failure label
+    (:func:`gaitlib.marks.failure_label`, empty when converged)."""
+    from .. import marks
+
     rows = []
     for label, s in solutions.items():
         st = s.stats
-        rows.append({"run": label, "status": st["status"], "iterations": st["iterations"],
+        rows.append({"run": label, "mark": marks.failure_label(s) or "", "status": st["status"], "iterations": st["iterations"],
                      "solve (s)": st["solve_time_s"], "ms/iteration": 1e3 * st["time_per_iteration_s"],
                      "build (s)": st["build_time_s"], "objective": st["objective"],
                      "max violation": st["max_violation"], "variables": st["n_variables"],
@@ -183,7 +196,8 @@ def stats_table(solutions: dict) -> pd.DataFrame:
 
 def write_outputs(sol: tr.GaitSolution, out, figures: bool = True) -> Path:
     """Write ``sol`` (frames, ``summary.json``, ``rmse_vs_thesis.csv``) and, with
-    ``figures``, ``tracking.png`` (angles, torques, GRFs vs the data's ±1 SD bands)."""
+    ``figures``, ``tracking.png`` (angles, torques, GRFs vs the data's ±1 SD bands; a solve
+    that did not converge is marked in it, :mod:`gaitlib.marks`)."""
     out = Path(out)
     sol.save(out)
     rmse_beside_thesis(sol).to_csv(out / "rmse_vs_thesis.csv", index=False, float_format="%.6g")
@@ -195,7 +209,8 @@ def write_outputs(sol: tr.GaitSolution, out, figures: bool = True) -> Path:
         from .. import plots
 
         gait = tracking_data(data_mod.load_gait_data(sol.spec.speed_class, sol.spec.source))
-        fig = plots.tracking_figure(gait, {f"{sol.spec.model} {sol.spec.cost}": channels_frame(sol)})
+        sims, marks = sims_and_marks({f"{sol.spec.model} {sol.spec.cost}": sol})
+        fig = plots.tracking_figure(gait, sims, marks=marks)
         fig.savefig(out / "tracking.png", dpi=110)
     summary = json.loads((out / "summary.json").read_text())
     summary["files"] = sorted(p.name for p in out.iterdir())

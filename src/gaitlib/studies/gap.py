@@ -328,11 +328,13 @@ def book_gaps(root=None) -> pd.DataFrame:
     Ch 5: the MSK and NMSK data-tracking solutions; Ch 6: the 16 cost-function runs; Ch 7:
     the 8 speed runs — each located against **its own speed class's data** (Schwartz 2008),
     which Ch 7 never tracked (it tracks the Free data scaled in time). One row per solution:
-    chapter, model, case (cost function or class), IPOPT status, RMS z of the angles, torques
+    chapter, model, case (cost function or class), mark (:func:`gaitlib.marks.failure_label`),
+    IPOPT status, RMS z of the angles, torques
     and GRFs (against the data as tracked and with the left leg shifted exactly,
     :func:`exact_left_leg`), RMS z of the EMG channels (muscle models), the number of
     significant channel × phase cells (non-EMG) and the largest such cell.
     """
+    from ..marks import failure_label
     from . import msk
     from . import predictive as pr
 
@@ -353,7 +355,7 @@ def book_gaps(root=None) -> pd.DataFrame:
         t = loc.table[loc.table["kind"] != "emg"]
         top = t.sort_values("rms_z", ascending=False).iloc[0]
         rows.append({"chapter": chapter, "model": model, "case": case, "speed class (data)": cls,
-                     "status": sol.stats["status"],
+                     "mark": failure_label(sol) or "", "status": sol.stats["status"],
                      "RMS z, angles/torques/GRFs": _rms(ch[ch["kind"] != "emg"]),
                      "RMS z, same, left leg shifted exactly": _rms(chx[chx["kind"] != "emg"]),
                      "RMS z, EMG": _rms(ch[ch["kind"] == "emg"]),

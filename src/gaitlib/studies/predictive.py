@@ -264,7 +264,9 @@ class StudyResult:
     included); ``solutions``: name → GaitSolution (every run that returned one, converged
     or not — check ``stats["success"]``); ``specs``: name → GaitSpec; ``baselines``: model →
     the Ch 5 solution used for HAT reference and guess; ``scores``: long table (run, model,
-    cost/class, kind, channel, side, rmse, nrmse, mean_z) against the scoring data."""
+    case = cost/class, mark, kind, channel, side, rmse, nrmse, mean_z) against the scoring
+    data; ``mark`` is the run's :func:`gaitlib.marks.failure_label` (None when converged) —
+    figures hatch marked runs, headlines use :meth:`converged_scores`."""
 
     specs: dict
     records: dict
@@ -288,22 +290,39 @@ class StudyResult:
 
     def rerun_table(self, reruns: dict) -> pd.DataFrame:
         """The study's own status and objective of each rerun run beside the rerun's."""
+        from .. import marks
+
         rows = {}
         for k, s in reruns.items():
             own = self.solutions.get(k)
-            rows[k] = {"status (study)": self.records[k].status,
+            rows[k] = {"mark (rerun)": marks.failure_label(s) or "", "status (study)": self.records[k].status,
                        "objective (study)": own.stats["objective"] if own is not None else np.nan,
                        "max_iter (rerun)": s.spec.max_iter, "status (rerun)": s.stats["status"],
                        "iterations (rerun)": s.stats["iterations"], "objective (rerun)": s.stats["objective"],
                        "max violation (rerun)": s.stats["max_violation"], "solve (s, rerun)": s.stats["solve_time_s"]}
         return pd.DataFrame(rows).T
 
+    def marks(self) -> dict:
+        """Run name → failure label (:func:`gaitlib.marks.failure_label`; None when converged)."""
+        from .. import marks
+
+        return {k: marks.failure_label(self.solutions.get(k, rec)) for k, rec in self.records.items()}
+
+    def converged_scores(self) -> pd.DataFrame:
+        """:attr:`scores` of the unmarked (converged) runs only — what a headline may use."""
+        from .. import marks
+
+        return marks.unmarked(self.scores)
+
     def stats(self) -> pd.DataFrame:
+        from .. import marks
+
         rows = []
         for name, rec in self.records.items():
             sol = self.solutions.get(name)
             st = sol.stats if sol is not None else {}
-            rows.append({"run": name, "guess": self.guess.get(name.split(" ", 1)[0]), "status": rec.status, "converged": bool(st.get("success", False)),
+            rows.append({"run": name, "mark": marks.failure_label(sol if sol is not None else rec) or "",
+                         "guess": self.guess.get(name.split(" ", 1)[0]), "status": rec.status, "converged": bool(st.get("success", False)),
                          "iterations": st.get("iterations"), "solve (s)": st.get("solve_time_s"),
                          "ms/iteration": 1e3 * st["time_per_iteration_s"] if st else np.nan,
                          "build (s)": st.get("build_time_s"), "objective": st.get("objective"),
@@ -322,6 +341,8 @@ def _run(specs: dict, guesses: dict, *, root, scheduler, n_workers, serial, prog
 
 
 def _scores(sols: dict, gaits: dict, key_of) -> pd.DataFrame:
+    from .. import marks
+
     parts = []
     for name, sol in sols.items():
         model, label = name.split(" ", 1)
@@ -332,6 +353,7 @@ def _scores(sols: dict, gaits: dict, key_of) -> pd.DataFrame:
         df.insert(0, "run", name)
         df.insert(1, "model", model)
         df.insert(2, "case", label)
+        df.insert(3, "mark", marks.failure_label(sol))
         parts.append(df)
     return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame()
 
@@ -390,27 +412,41 @@ def speed_study(models=("MSK", "NMSK"), classes=CH7_CLASSES, *, n_intervals: int
                        guess=how, guesses=guesses)
 
 
-def cot_table(ch7: StudyResult, natural: tr.GaitSolution | None = None) -> pd.DataFrame:
+def cot_table(ch7: StudyResult, natural=None) -> pd.DataFrame:
     """COT (Eq 5.57) of the NMSK runs against walking speed, ours beside the thesis's
-    Fig 7.5 point of the class of the same rank (labelled; different classes and speeds)."""
+    Fig 7.5 point of the class of the same rank (labelled; different classes and speeds).
+
+    ``natural``: the natural-speed (*Free*) point(s) — a GaitSolution (row ``Free``) or
+    ``{row label: GaitSolution}``, e.g. the like-for-like Ch 6 NMSK DT run (same cost
+    function and activation parameters as the Ch 7 runs) and, labelled apart, the Ch 5
+    NMSK solution. Columns ``source`` (the run), ``mark``
+    (:func:`gaitlib.marks.failure_label`) and ``converged`` say what each point is."""
+    from .. import marks
+
     thesis = {c: (v, cot) for c, v, cot in THESIS_COT_FIG_7_5}
     rows = []
-    items = [(s.spec.speed_class, s) for k, s in ch7.solutions.items() if k.startswith("NMSK ")]
-    if natural is not None:
-        items.append(("Free", natural))
-    for cls, s in items:
+    items = [(s.spec.speed_class, k, s) for k, s in ch7.solutions.items() if k.startswith("NMSK ")]
+    if isinstance(natural, dict):
+        items += [(lab, f"{s.spec.model} {s.spec.cost}", s) for lab, s in natural.items() if s is not None]
+    elif natural is not None:
+        items.append(("Free", f"{natural.spec.model} {natural.spec.cost}", natural))
+    for row, src, s in items:
+        cls = s.spec.speed_class
         g = data_mod.load_gait_data(cls, s.spec.source)
         tc = THESIS_CLASS[cls]
-        rows.append({"class": cls, "speed (m/s)": g.speed, "converged": bool(s.stats.get("success")),
+        rows.append({"class": row, "speed (m/s)": g.speed, "source": src,
+                     "mark": marks.failure_label(s) or "", "converged": bool(s.stats.get("success")),
                      "COT (J/kg/m)": s.stats.get("COT", np.nan), "thesis class": tc,
                      "thesis speed (m/s, Fig 7.5)": thesis[tc][0], "thesis COT (Fig 7.5)": thesis[tc][1]})
-    return pd.DataFrame(rows).sort_values("speed (m/s)").set_index("class")
+    return pd.DataFrame(rows).sort_values("speed (m/s)", kind="stable").set_index("class")
 
 
 def times_table(result: StudyResult, thesis_hours: dict, label_of=lambda spec: spec.cost) -> pd.DataFrame:
     """Our times (build = symbolic graph + derivatives + nlpsol; solve = IPOPT), iterations
     and time per iteration per run beside the thesis's hours (Table 6.3 or 7.2; labelled)
     and the speed-up (thesis hours / our build + solve)."""
+    from ..marks import failure_label
+
     rows = []
     for name, spec in result.specs.items():
         sol = result.solutions.get(name)
@@ -419,6 +455,7 @@ def times_table(result: StudyResult, thesis_hours: dict, label_of=lambda spec: s
         st = sol.stats if sol is not None else {}
         t = st.get("solve_time_s", np.nan) + st.get("build_time_s", np.nan)
         rows.append({"model": spec.model, "case": lab, "status": result.records[name].status,
+                     "mark": failure_label(sol if sol is not None else result.records[name]) or "",
                      "iterations": st.get("iterations"), "build (s)": st.get("build_time_s", np.nan),
                      "solve (s)": st.get("solve_time_s", np.nan), "total (s)": t,
                      "ms/iteration": 1e3 * st.get("time_per_iteration_s", np.nan), "thesis (h)": h,
