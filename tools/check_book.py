@@ -11,8 +11,9 @@ waits for MathJax to typeset, and fails if a page
 - has an image that did not load (naturalWidth 0),
 - has a table, code block, output or equation that is wider than the text column and is
   neither scrolled inside its own box nor wrapped (cut off, or widening the page).
-It saves a full-page screenshot of each page (at most 16000 px tall) under
-book/_build/screenshots/. Debian's `chromium` is installed with apt-get when missing.
+It saves a full-page screenshot of each page under book/_build/screenshots/ (a page taller
+than 16000 px in parts: ch05_msk.png, ch05_msk-2.png, ...). Debian's `chromium` is installed
+with apt-get when missing.
 
 `remote_references(html_dir)` is the static part (no browser): every <script src>,
 <link href> (stylesheets, fonts, preloads, icons), media src and CSS @import/url() of the built
@@ -38,7 +39,9 @@ from urllib.parse import unquote, urlsplit
 ROOT = Path(__file__).resolve().parents[1]
 REMOTE = re.compile(r"^\s*(?:[a-z][a-z0-9+.-]*:)?//", re.I)  # http://, https://, //host
 CSS_URL = re.compile(r"""(?:@import\s+(?:url\(\s*)?|url\(\s*)(['"]?)([^'")\s]+)\1""", re.I)
-ASSET_IN_JS = re.compile(r"""["'`]((?:https?:)?//[^"'`\s]+\.(?:m?js|css|woff2?|ttf|otf|eot)(?:\?[^"'`\s]*)?)["'`]""", re.I)
+# a quoted remote script, stylesheet or font in inline JavaScript (e.g. a loader's URL)
+ASSET_IN_JS = re.compile(r"""["'`]((?:https?:)?//[^"'`\s]+\.(?:m?js|css|woff2?|ttf|otf|eot)"""
+                         r"""(?:\?[^"'`\s]*)?)["'`]""", re.I)
 LINK_ASSET_RELS = {"stylesheet", "preload", "modulepreload", "prefetch", "icon", "shortcut",
                    "apple-touch-icon", "mask-icon", "manifest", "preconnect", "dns-prefetch"}
 MEDIA_ATTRS = {"img": ("src", "srcset"), "source": ("src", "srcset"), "iframe": ("src",),
@@ -212,21 +215,27 @@ class Browser:
             raise RuntimeError(f"{method}: {reply['error'].get('message')}")
         return reply.get("result", {})
 
-    def full_page_png(self, session) -> bytes:
-        """Screenshot of the whole page (at most MAX_SHOT_HEIGHT px): the window is made as
-        tall as the page for the shot (Chromium's capture beyond the viewport lays the page
-        out differently), then set back."""
+    def full_page_pngs(self, session) -> list:
+        """Screenshots of the whole page, top to bottom, each at most MAX_SHOT_HEIGHT px tall:
+        the window is made as tall as the part for each shot (Chromium's capture beyond the
+        viewport lays the page out differently), then set back."""
         metrics = self.send("Page.getLayoutMetrics", session=session)
-        height = min(int(metrics["cssContentSize"]["height"]) + 1, MAX_SHOT_HEIGHT)
+        total = int(metrics["cssContentSize"]["height"]) + 1
         size = {"width": self.width, "deviceScaleFactor": 1, "mobile": False}
-        self.send("Emulation.setDeviceMetricsOverride", {**size, "height": height}, session)
+        shots = []
         try:
-            self.send("Runtime.evaluate", {"expression": "new Promise(r => requestAnimationFrame("
-                      "() => requestAnimationFrame(r)))", "awaitPromise": True}, session)
-            png = self.send("Page.captureScreenshot", {"format": "png"}, session, timeout=120)
+            for top in range(0, total, MAX_SHOT_HEIGHT):
+                height = min(MAX_SHOT_HEIGHT, total - top)
+                self.send("Emulation.setDeviceMetricsOverride", {**size, "height": height}, session)
+                self.send("Runtime.evaluate", {"expression": f"window.scrollTo(0, {top}); new Promise("
+                          "r => requestAnimationFrame(() => requestAnimationFrame(r)))",
+                          "awaitPromise": True}, session)
+                png = self.send("Page.captureScreenshot", {"format": "png"}, session, timeout=120)
+                shots.append(base64.b64decode(png["data"]))
         finally:
             self.send("Emulation.setDeviceMetricsOverride", {**size, "height": self.height}, session)
-        return base64.b64decode(png["data"])
+            self.send("Runtime.evaluate", {"expression": "window.scrollTo(0, 0)"}, session)
+        return shots
 
     def close(self):
         try:
@@ -353,7 +362,8 @@ def check_page(browser, session, path: Path, shot: Path, mathjax_timeout_s=30):
     if r["pageWidth"] > r["viewWidth"] + 1:
         problems.append(f"the page scrolls sideways ({r['pageWidth']} px > window {r['viewWidth']} px)")
 
-    shot.write_bytes(browser.full_page_png(session))
+    for k, png in enumerate(browser.full_page_pngs(session)):  # page.png, page-2.png, ...
+        (shot if k == 0 else shot.with_name(f"{shot.stem}-{k + 1}.png")).write_bytes(png)
     summary = (f"math {r['nTypeset']}/{r['nMath']}"
                + (f" (MathJax {r['mathjax']})" if r["mathjax"] else "")
                + f", images {len(r['images']) - len(bad)}/{len(r['images'])}"
