@@ -1,4 +1,5 @@
-# Two entry points for a newcomer: `make book` and `make test`.
+# Two entry points for a newcomer: `make book` and `make test`; `make check-book` then opens
+# every built page offline in headless Chromium (tools/check_book.py).
 # Each bootstraps .venv from requirements.txt when it is missing or out of date.
 PYTHON ?= python3
 VENV := .venv
@@ -14,7 +15,7 @@ export MKL_NUM_THREADS := 1
 # data's numbers) miss every stored solution (see environment.md).
 export OPENBLAS_CORETYPE := Haswell
 
-.PHONY: book test venv data clean
+.PHONY: book test check-book venv data clean
 
 venv: $(STAMP)
 
@@ -28,6 +29,12 @@ $(STAMP): requirements.txt pyproject.toml
 
 book: $(STAMP)
 	$(BIN)/jupyter-book build book -W -n --keep-going
+
+# Every built page in headless Chromium with the network blocked: math typeset, figures
+# loaded, nothing wide cut off; screenshots in book/_build/screenshots/. Installs Debian's
+# chromium with apt-get when it is missing. Needs a built book (make book).
+check-book: $(STAMP)
+	$(BIN)/python tools/check_book.py book/_build/html
 
 test: $(STAMP)
 	$(BIN)/python -m pytest tests

@@ -165,3 +165,6 @@ def test_animate_gait_frame_count(model, free, n, max_frames, expected):
     html = plots.animation_html(anim)
     assert len(re.findall(r"frames\[\d+\] = ", html)) == expected  # one image per frame
     assert len(html) < 3e6
+    # offline: no stylesheet from a CDN (matplotlib links Font Awesome 4); the buttons stay
+    assert not re.search(r"""(?:href|src)=["'](?:https?:)?//""", html)
+    assert 'class="fa fa-play"' in html

@@ -6,6 +6,8 @@ edge; every input is SI (see :mod:`gaitlib.conventions`).
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from . import conventions as cv
@@ -452,13 +454,22 @@ def _mark_animation(ax, mark):
                      fontweight="bold")
 
 
+#: The stylesheet link of matplotlib's JS/HTML player (Font Awesome 4 from a CDN, for the icons
+#: of its buttons).
+_REMOTE_ICON_CSS = re.compile(r"""<link\s+rel=["']stylesheet["']\s+href=["'](?:https?:)?//[^"']*font-awesome"""
+                              r"""[^"']*["']\s*/?>\s*""", re.I)
+
+
 def animation_html(anim) -> str:
-    """The animation as a self-contained JavaScript/HTML string (``anim.to_jshtml()``);
-    show it with ``IPython.display.HTML(animation_html(anim))``."""
+    """The animation as a self-contained JavaScript/HTML string (``anim.to_jshtml()``) that
+    loads nothing from the internet: matplotlib's link to Font Awesome on a CDN is removed,
+    and the page's own icon font draws the player's buttons (the book's theme ships Font
+    Awesome, whose names include the player's ``fa-play``, ``fa-step-forward``, ...).
+    Show it with ``IPython.display.HTML(animation_html(anim))``."""
     import matplotlib as mpl
 
     with mpl.rc_context({"animation.embed_limit": 20.0}):  # MB
-        return anim.to_jshtml()
+        return _REMOTE_ICON_CSS.sub("", anim.to_jshtml())
 
 
 # =====================================================================================
