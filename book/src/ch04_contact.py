@@ -122,7 +122,7 @@ c.stages
 # (Secs 4.3.3 and 4.4.2), labelled.
 
 # %%
-approach_marks = {ci.APPROACHES[k]: marks.failure_label(r.stats) for k, r in res.items()}  # None: converged
+approach_marks = {ci.APPROACHES[k]: marks.failure_label(r) for k, r in res.items()}  # None: converged
 
 
 def mark_approaches(df):
@@ -207,7 +207,7 @@ ph
 # %%
 cw = ci.optimal_control_body(spec=ci.spec_c(contact_bounds="widened"), warm=b)
 print({k: cw.stats[k] for k in ("status", "iterations", "wall_s", "objective", "max_violation", "from_cache")})
-approach_marks[ci.APPROACHES["c_wide"]] = marks.failure_label(cw.stats)
+approach_marks[ci.APPROACHES["c_wide"]] = marks.failure_label(cw)
 display(mark_approaches(ci.grf_fit({"b": b, "c": c, "c_wide": cw})))
 for r in (c, cw):
     ab = ci.at_bounds(r)
@@ -287,7 +287,7 @@ for k, r in res.items():
 # values (as printed; its initial MOIs differ slightly from $SM\,(ROG\,SL)^2$).
 
 # %%
-bt = marks.mark_rows(ci.body_table(c), marks.failure_label(c.stats))
+bt = marks.mark_rows(ci.body_table(c), marks.failure_label(c))
 bt
 
 # %%
@@ -309,7 +309,7 @@ for ax, side in zip(axes, cv.SIDES):
     ax.set_title(f"(c): normal force per ellipsoid, {'right' if side == 'r' else 'left'} foot (N)", fontsize=9)
     ax.set_xlabel("% gait cycle")
     ax.legend(fontsize=7)
-marks.mark_all(fig, marks.failure_label(c.stats))
+marks.mark_all(fig, marks.failure_label(c))
 plt.show()
 
 # %% [markdown]

@@ -187,13 +187,14 @@ display_anim
 # %% [markdown]
 # ## What we found
 #
-# Computed from the runs above. A run that did not converge supplies no number here: where
-# it would, the line says so (the investigated 3000-iteration rerun is used only where
-# named).
+# Computed from the runs above. A run that did not converge, or that fails a physical
+# validity gate (`gaitlib.validity`: e.g. a foot loaded while the data say it swings, both feet
+# loaded for most of the cycle), supplies no number here: where it would, the line says so
+# with its mark (the investigated 3000-iteration rerun is used only where named).
 
 # %%
 ok = stats["converged"]
-csc = res.converged_scores()  # the scores of converged runs only
+csc = res.converged_scores()  # the scores of converged and valid runs only
 nr = (csc[csc["kind"].isin(["angle", "torque", "grf"])].groupby(["model", "case", "kind"])["nrmse"].mean()
       .unstack("kind").mean(axis=1))  # the same kinds for both models
 
@@ -220,7 +221,7 @@ both = [c for c in pr.CH6_COSTS if np.isfinite(_nr("NMSK", c)) and np.isfinite(_
 better = [c for c in both if _nr("NMSK", c) < _nr("MSK", c)]
 skipped = [c for c in pr.CH6_COSTS if c not in both]
 lines.append(f"- NMSK is more accurate than MSK (mean NRMSE) for {', '.join(better) if better else 'no cost function'}"
-             + (f" (of {len(both)} cost functions where both runs converged; not compared: {', '.join(skipped)})" if skipped else "")
+             + (f" (of {len(both)} cost functions where both runs converged and pass the validity gates; not compared: {', '.join(skipped)})" if skipped else "")
              + "; the thesis found NMSK better for SDT1, SP2 and FP, MSK better for SDT2 and SP3, similar for DT, SDT3 and SP1 (Sec 6.2.3).")
 if "FP" in both:
     fp_claim = _nr("NMSK", "FP") < _nr("MSK", "FP")

@@ -184,8 +184,9 @@ for c in classes:
 # %% [markdown]
 # ## What we found
 #
-# Computed from the runs above; a run that did not converge supplies no number here (the
-# 3000-iteration reruns are reported apart, named).
+# Computed from the runs above; a run that did not converge, or that fails a physical
+# validity gate (`gaitlib.validity`), supplies no number here (the 3000-iteration reruns are
+# reported apart, named).
 
 # %%
 ok = stats["converged"]
@@ -200,7 +201,7 @@ if both:
     tq = pred_ok["torque"]
     better = [c for c in both if tq[("NMSK", c)] < tq[("MSK", c)]]
     lines.append(f"- Torque NRMSE: NMSK below MSK for {', '.join(better) if better else 'no class'} of the "
-                 f"{len(both)} classes where both runs converged"
+                 f"{len(both)} classes where both runs converged and pass the validity gates"
                  + (f" (not compared: {', '.join(c for c in classes if c not in both)})" if len(both) < len(classes) else "")
                  + " (thesis: NMSK 2–17 % better at every speed).")
 nm = [c for c in classes if ("NMSK", c) in pred_ok.index]

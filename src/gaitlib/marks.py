@@ -66,9 +66,36 @@ def status_of(obj) -> tuple[bool | None, str | None]:
     return bool(success), None if status is None else str(status)
 
 
+_verdicts: dict = {}
+
+
+def validity_verdict(obj):
+    """The physical validity gates' verdict on a solution (:func:`gaitlib.validity.check`):
+    True (valid), the invalid reasons as text (without the convergence check, which
+    :func:`status_of` reports), or None when ``obj`` is no solution the gates can judge (a
+    status string, a stats mapping). A sweep record is judged by its solution. Memoised per
+    object (the gates take a fraction of a second; a figure asks several times)."""
+    obj = getattr(obj, "value", obj) if hasattr(obj, "ok") and hasattr(obj, "value") else obj
+    if obj is None or isinstance(obj, (str, Mapping)) or not (hasattr(obj, "spec") or hasattr(obj, "solution")):
+        return None
+    hit = _verdicts.get(id(obj))
+    if hit is not None and hit[0] is obj:
+        return hit[1]
+    from . import validity
+
+    try:
+        lab = validity.check(obj).label()
+    except (TypeError, ValueError, KeyError, AttributeError):
+        verdict = None  # not a kind of solution the gates know
+    else:
+        verdict = lab.split("invalid: ", 1)[1] if "invalid: " in lab else True
+    _verdicts[id(obj)] = (obj, verdict)
+    return verdict
+
+
 #: The physical-validity check :func:`failure_label` applies when it is given no ``valid``
-#: (see :func:`use_validity_check`); None: no check.
-_validity_check = None
+#: (see :func:`use_validity_check`): the validity gates by default; None: no check.
+_validity_check = validity_verdict
 
 
 def use_validity_check(check) -> None:

@@ -309,7 +309,8 @@ class StudyResult:
         return {k: marks.failure_label(self.solutions.get(k, rec)) for k, rec in self.records.items()}
 
     def converged_scores(self) -> pd.DataFrame:
-        """:attr:`scores` of the unmarked (converged) runs only — what a headline may use."""
+        """:attr:`scores` of the unmarked runs only (converged and passing the validity gates,
+        :func:`gaitlib.marks.failure_label`) — what a headline may use."""
         from .. import marks
 
         return marks.unmarked(self.scores)
