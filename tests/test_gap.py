@@ -345,7 +345,9 @@ def test_candidate_retry_keeps_the_best_start(tmp_path, real):
     start named."""
     from gaitlib.gap import diagnose as D
 
-    spec = tr.GaitSpec(model="SK", cost="DT", **TINY)
+    # 4 x 3: at 3 x 2 whether a baseline start converges depends on the CPU's last bits (both
+    # stopped at the iteration limit on an AVX2-only EPYC)
+    spec = tr.GaitSpec(model="SK", cost="DT", n_intervals=4, degree=3)
     root = tmp_path / "sol"
     det = D.baseline_fits(spec, {"d": real}, None, root=root, detail=True, starts=("cold", "dt"), serial=True,
                           progress=False)
@@ -364,10 +366,11 @@ def test_candidate_retry_keeps_the_best_start(tmp_path, real):
                             progress=False)["d"]
     f = fits[name]
     assert f.solution is not None and "retry_start" in f.solution.stats
-    assert f.solution.stats["retry_start"] in {"best"} | set(alts["d"])
-    # without alternates: no retry, the first solve is kept
+    assert f.solution.stats["retry_start"] in {"best", "null"} | set(alts["d"])  # null: the null start
+    # without alternates: no retry from other starts; only the null start (from the baseline
+    # itself) may follow the first solve
     f1 = D.candidate_fits(spec, {"d": real}, {"d": low}, [name], root=root, serial=True, progress=False)["d"][name]
-    assert "retry_start" not in f1.solution.stats
+    assert f1.solution.stats.get("retry_start", "best") in {"best", "null"}
     if f.ok and f1.ok:
         assert f.solution.stats["objective"] <= f1.solution.stats["objective"] + 1e-12
 

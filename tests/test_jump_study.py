@@ -16,6 +16,7 @@ import pandas as pd
 import pytest
 
 from gaitlib import conventions as cv, ocp
+from gaitlib import cache
 from gaitlib.studies import jump as J
 
 COARSE = dict(n_intervals=4)
@@ -190,7 +191,7 @@ def test_cache_roundtrip(toe, tmp_path):
     """A cached solution reloads with the same numbers and says so."""
     sp = toe.spec
     where = J.cache_location(sp, tmp_path)
-    toe.solution.save(where)
+    cache.save(where, toe.solution.save)  # entries are written with their checksums
     s2 = J.solve(sp, use_cache=True, root=tmp_path)
     assert s2.from_cache and s2.stats["from_cache"]
     assert s2.jump_height == pytest.approx(toe.jump_height)
