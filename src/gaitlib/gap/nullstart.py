@@ -35,7 +35,7 @@ from .. import cache
 from .. import ocp
 from .. import transcription as tr
 from .solve import FORMULATION as FIT_FORMULATION
-from .solve import Runner, _check_same_cycle, _load, guess_signature
+from .solve import Lazy, Runner, _check_same_cycle, guess_signature, solve_or_load
 
 __all__ = ["NULL_START_IPOPT", "FORMULATION", "null_start_on", "null_start_many", "null_guess"]
 
@@ -100,31 +100,14 @@ def null_start_on(spec: tr.GaitSpec, gait, base, *, root=None, use_cache: bool =
                   runner=None) -> tr.GaitSolution:
     """Solve ``spec`` (the baseline spec plus free effects) tracking ``gait`` from the
     baseline solution ``base`` with the effects at their null values, or reload it."""
-    where = _where(spec, gait, base, root, objective)
-    found = cache.find(where, "spec.json") if use_cache else None
-    if found is not None:
-        return _load(found, objective)
-    runner = runner or _NullRunner(spec, objective)
-    sol = runner.solve_null(gait, base)
-    if use_cache:
-        cache.save(where, sol.save)
-    return sol
-
-
-class _LazyRunner:
-    """Builds its :class:`_NullRunner` on first use (a fully cached group builds nothing)."""
-
-    def __init__(self, spec, objective):
-        self.spec, self.objective, self._r = spec, objective, None
-
-    def solve_null(self, gait, base):
-        self._r = self._r or _NullRunner(self.spec, self.objective)
-        return self._r.solve_null(gait, base)
+    runner = runner or Lazy(lambda: _NullRunner(spec, objective))
+    return solve_or_load(_where(spec, gait, base, root, objective), lambda: runner.solve_null(gait, base),
+                         use_cache=use_cache, objective=objective)
 
 
 def _work(arg):
     spec, jobs, root, use_cache, objective = arg
-    runner = _LazyRunner(spec, objective)
+    runner = Lazy(lambda: _NullRunner(spec, objective))
     return {key: null_start_on(spec, gait, base, root=root, use_cache=use_cache, objective=objective, runner=runner)
             for key, gait, base in jobs}
 

@@ -36,7 +36,7 @@ from .. import cache
 from .. import ocp
 from .. import transcription as tr
 
-__all__ = ["Runner", "solve_on", "solve_many", "guess_signature", "FORMULATION", "OBJECTIVES", "FIT_WEIGHT",
+__all__ = ["Runner", "Lazy", "solve_on", "solve_or_load", "solve_many", "guess_signature", "FORMULATION", "OBJECTIVES", "FIT_WEIGHT",
            "fit_problem"]
 
 OBJECTIVES = ("fit", "cost")
@@ -218,39 +218,47 @@ def _load(found: Path, objective: str) -> tr.GaitSolution:
     return sol
 
 
+def solve_or_load(where: Path, solve, *, use_cache: bool = True, objective: str = "fit") -> tr.GaitSolution:
+    """The solution cached at ``where`` (a :func:`gaitlib.cache.lookup` result), or
+    ``solve()``'s, then stored there (atomically, :func:`gaitlib.cache.save`)."""
+    found = cache.find(where, "spec.json") if use_cache else None
+    if found is not None:
+        return _load(found, objective)
+    sol = solve()
+    if use_cache:
+        cache.save(where, sol.save)
+    return sol
+
+
+class Lazy:
+    """A runner built on first use (a fully cached group builds nothing): ``factory()``
+    makes it; attribute access builds it once."""
+
+    def __init__(self, factory):
+        self._factory, self._obj = factory, None
+
+    def __getattr__(self, name):
+        if self._obj is None:
+            self._obj = self._factory()
+        return getattr(self._obj, name)
+
+
 def solve_on(spec: tr.GaitSpec, gait, guess=None, *, root=None, use_cache: bool = True,
              runner: Runner | None = None, objective: str = "fit") -> tr.GaitSolution:
     """Solve ``spec`` tracking ``gait`` (a GaitData) with ``objective``, warm-started from
     ``guess``, or reload it from the cache."""
-    where = _where(spec, gait, guess, root, objective)
-    found = cache.find(where, "spec.json") if use_cache else None
-    if found is not None:
-        return _load(found, objective)
-    runner = runner or Runner(spec, objective)
-    sol = runner.solve(gait, guess)
-    if use_cache:
-        cache.save(where, sol.save)
-    return sol
+    runner = runner or Lazy(lambda: Runner(spec, objective))
+    return solve_or_load(_where(spec, gait, guess, root, objective), lambda: runner.solve(gait, guess),
+                         use_cache=use_cache, objective=objective)
 
 
 def _work(arg):
     """Sweep worker: one spec, several data sets → {key: GaitSolution}. Builds lazily (a
     fully cached item builds nothing)."""
     spec, jobs, root, use_cache, objective = arg
-    runner = None
-    out = {}
-    for key, gait, guess in jobs:
-        where = _where(spec, gait, guess, root, objective)
-        found = cache.find(where, "spec.json") if use_cache else None
-        if found is not None:
-            out[key] = _load(found, objective)
-            continue
-        runner = runner or Runner(spec, objective)
-        sol = runner.solve(gait, guess)
-        if use_cache:
-            cache.save(where, sol.save)
-        out[key] = sol
-    return out
+    runner = Lazy(lambda: Runner(spec, objective))
+    return {key: solve_on(spec, gait, guess, root=root, use_cache=use_cache, runner=runner, objective=objective)
+            for key, gait, guess in jobs}
 
 
 def solve_many(groups: dict, *, root=None, use_cache: bool = True, objective: str = "fit", **sweep_kw) -> dict:
