@@ -35,7 +35,7 @@ from .. import cache
 from .. import ocp
 from .. import transcription as tr
 from .solve import FORMULATION as FIT_FORMULATION
-from .solve import Lazy, Runner, _check_same_cycle, guess_signature, solve_or_load
+from .solve import Lazy, Runner, _check_same_cycle, guess_signature, solve_or_load, sweep_groups
 
 __all__ = ["NULL_START_IPOPT", "FORMULATION", "null_start_on", "null_start_many", "null_guess"]
 
@@ -116,13 +116,4 @@ def null_start_many(groups: dict, *, root=None, use_cache: bool = True, objectiv
     """:func:`null_start_on` for groups of jobs, as :func:`gaitlib.gap.solve.solve_many`:
     ``groups`` name → (spec, [(key, gait, baseline solution), ...]); returns key →
     GaitSolution plus ``"__records__"``."""
-    from .. import sweep
-
-    root = str(Path(root if root is not None else cache.default_dir()).resolve())
-    items = {name: (spec, jobs, root, use_cache, objective) for name, (spec, jobs) in groups.items()}
-    recs = sweep.sweep(_work, items, **sweep_kw)
-    out: dict = {"__records__": {r.name: r for r in recs}}
-    for r in recs:
-        if r.value is not None:
-            out.update(r.value)
-    return out
+    return sweep_groups(_work, groups, root=root, use_cache=use_cache, objective=objective, **sweep_kw)

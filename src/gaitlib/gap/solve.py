@@ -277,11 +277,18 @@ def solve_many(groups: dict, *, root=None, use_cache: bool = True, objective: st
     dict key → GaitSolution, plus ``"__records__"`` → {group: RunRecord} (failed groups:
     ``ok=False`` with the traceback; a non-converged solve is a solution with its status).
     """
+    return sweep_groups(_work, groups, root=root, use_cache=use_cache, objective=objective, **sweep_kw)
+
+
+def sweep_groups(work, groups: dict, *, root=None, use_cache: bool = True, objective: str = "fit",
+                 **sweep_kw) -> dict:
+    """``work((spec, jobs, root, use_cache, objective))`` per group through
+    :func:`gaitlib.sweep.sweep`; key → GaitSolution plus ``"__records__"``."""
     from .. import sweep
 
     root = str(Path(root if root is not None else cache.default_dir()).resolve())
     items = {name: (spec, jobs, root, use_cache, objective) for name, (spec, jobs) in groups.items()}
-    recs = sweep.sweep(_work, items, **sweep_kw)
+    recs = sweep.sweep(work, items, **sweep_kw)
     out: dict = {"__records__": {r.name: r for r in recs}}
     for r in recs:
         if r.value is not None:
