@@ -247,13 +247,13 @@ def measure(quick: bool) -> dict:
 
     import gaitlib  # noqa: F401  (one BLAS thread)
     from gaitlib import ocp
-    from gaitlib import transcription as tr
+    from gaitlib.problems import gait as gait_ocp
     from gaitlib.studies import gait
 
     spec = gait.natural_gait_spec("MSK")
     if quick:
         spec = dataclasses.replace(spec, n_intervals=4, degree=3)
-    gp = tr.build(spec)
+    gp = gait_ocp.build(spec)
     t0 = time.perf_counter()
     nlp = ocp.transcribe(gp.problem, gp.mesh, gp.options)
     build_s = time.perf_counter() - t0

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import gaitlib  # noqa: F401  (sets one BLAS thread)
 from gaitlib import ocp
-from gaitlib import transcription as tr
+from gaitlib.problems import gait as gait_ocp
 from gaitlib.studies import gait
 
 OUT = Path(__file__).resolve().parent / "results"
@@ -49,21 +49,21 @@ def main(argv=None):
     rows = []
     for rep in range(args.repeats):
         sk_spec = gait.natural_gait_spec("SK")
-        sk = tr.solve(sk_spec)
+        sk = gait_ocp.solve(sk_spec)
         rows.append(_row("SK Eq4.11, data guess", sk, "11 min (Sec 4.3.3; 39 contact parameters identified)"))
         msk_spec = gait.natural_gait_spec("MSK")
-        gp = tr.build(msk_spec)
+        gp = gait_ocp.build(msk_spec)
         t0 = time.perf_counter()
         nlp = ocp.transcribe(gp.problem, gp.mesh, gp.options)
         build = time.perf_counter() - t0
         for label, guess in (("MSK Eq5.33, data guess", gp.guess),
-                             ("MSK Eq5.33, warm start from SK", tr.warm_start(gp, sk))):
-            sol = tr.postprocess(gp, nlp.solve(guess))
+                             ("MSK Eq5.33, warm start from SK", gait_ocp.warm_start(gp, sk))):
+            sol = gait_ocp.postprocess(gp, nlp.solve(guess))
             sol.stats["build_time_s"] = build
             rows.append(_row(label, sol, "2 h (Sec 5.2.2)", "same NLP object: built once"))
         if not args.skip_lbfgs and rep == 0:
             lm = dataclasses.replace(msk_spec, hessian="limited-memory", max_iter=3000)
-            sol = tr.solve(lm)
+            sol = gait_ocp.solve(lm)
             rows.append(_row("MSK Eq5.33, data guess, L-BFGS", sol, "2 h (Sec 5.2.2)"))
         for r in rows[-4:]:
             print(r)

@@ -56,12 +56,12 @@ def fill(K) -> dict:
 
 def measure(model: str, n_intervals: int, degree: int, periodic: bool) -> dict:
     from gaitlib import ocp
-    from gaitlib import transcription as tr
+    from gaitlib.problems import gait as gait_ocp
     from gaitlib.studies import gait
 
     spec = dataclasses.replace(gait.natural_gait_spec(model), n_intervals=n_intervals, degree=degree,
                                periodic=periodic)
-    gp = tr.build(spec)
+    gp = gait_ocp.build(spec)
     t0 = time.perf_counter()
     T = ocp.transcribe(gp.problem, gp.mesh, gp.options)
     row = {"model": model, "periodic": periodic, "n_intervals": n_intervals, "degree": degree,

@@ -69,11 +69,11 @@ def child(model: str, n: int, repeats: int) -> dict:
 
     import gaitlib  # noqa: F401  (one BLAS thread)
     from gaitlib import ocp
-    from gaitlib import transcription as tr
+    from gaitlib.problems import gait as gait_ocp
     from gaitlib.studies import gait
 
     spec = dataclasses.replace(gait.natural_gait_spec(model), n_intervals=n, degree=5)
-    gp = tr.build(spec)
+    gp = gait_ocp.build(spec)
     t0 = time.perf_counter()
     nlp = ocp.transcribe(gp.problem, gp.mesh, gp.options)
     build = time.perf_counter() - t0

@@ -84,9 +84,9 @@ def child(args) -> None:
 
     import gaitlib  # noqa: F401  (one BLAS thread)
     from gaitlib import ocp
-    from gaitlib import transcription as tr
+    from gaitlib.problems import gait as gait_ocp
 
-    gp = tr.build(_spec(args.quick))
+    gp = gait_ocp.build(_spec(args.quick))
     opts = dataclasses.replace(gp.options, print_level=5,
                                ipopt={**dict(gp.options.ipopt), "print_timing_statistics": "yes",
                                       **json.loads(args.child)})
@@ -119,11 +119,11 @@ def graph_sizes(quick: bool) -> list[dict]:
 
     import gaitlib  # noqa: F401
     from gaitlib import ocp
-    from gaitlib import transcription as tr
+    from gaitlib.problems import gait as gait_ocp
 
     rows = []
     for model in ("SK", "MSK"):
-        gp = tr.build(_spec(quick, model))
+        gp = gait_ocp.build(_spec(quick, model))
         nlp = ocp.transcribe(gp.problem, gp.mesh, gp.options)
         w, p, f, g = nlp.nlp["x"], nlp.nlp["p"], nlp.nlp["f"], nlp.nlp["g"]
         lam = ca.SX.sym("lam", g.shape[0])

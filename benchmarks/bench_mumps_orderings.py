@@ -71,11 +71,11 @@ def child(model: str, n_intervals: int, degree: int) -> None:
 
     import gaitlib  # noqa: F401
     from gaitlib import ocp
-    from gaitlib import transcription as tr
+    from gaitlib.problems import gait as gait_ocp
     from gaitlib.studies import gait
 
     spec = dataclasses.replace(gait.natural_gait_spec(model), n_intervals=n_intervals, degree=degree)
-    gp = tr.build(spec)
+    gp = gait_ocp.build(spec)
     nlp = ocp.transcribe(gp.problem, gp.mesh, gp.options)
     s = nlp.solver
     shared = {k: s.get_function(f) for k, f in (("hess_lag", "nlp_hess_l"), ("jac_g", "nlp_jac_g"),

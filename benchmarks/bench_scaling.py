@@ -55,18 +55,18 @@ ENV1 = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": 
 
 def _one(case: dict) -> dict:
     import gaitlib  # noqa: F401  (one BLAS thread)
-    from gaitlib import transcription as tr
+    from gaitlib.problems import gait as gait_ocp
     from gaitlib.studies import gait
 
     spec = gait.natural_gait_spec(case["model"], n_intervals=case["n_intervals"], degree=case["degree"],
                                   hessian=case.get("hessian", "exact"), max_iter=case.get("max_iter", 1000))
     t0 = time.perf_counter()
-    gp = tr.build(spec)
+    gp = gait_ocp.build(spec)
     setup = time.perf_counter() - t0
     ls = case.get("linear_solver", "mumps")
     if ls != "mumps":
         gp = dataclasses.replace(gp, options=dataclasses.replace(gp.options, linear_solver=ls))
-    sol = tr.solve(gp)
+    sol = gait_ocp.solve(gp)
     st = sol.stats
     tw = sol.solution.info.get("ipopt_t_wall", {})
     evals = sum(v for k, v in tw.items() if k.startswith("t_wall_nlp_"))
@@ -324,7 +324,7 @@ def main(argv=None) -> int:
                         "nodes": "collocation nodes = intervals x degree",
                         "solve_s": "wall time of the IPOPT call",
                         "build_s": "building the NLP: symbolic graph + nlpsol with its exact derivatives",
-                        "setup_s": "gaitlib.transcription.build: data, reference, bounds, guess (before build_s)",
+                        "setup_s": "gaitlib.problems.gait.build: data, reference, bounds, guess (before build_s)",
                         "function_evals": "IPOPT's t_wall_nlp_* (CasADi function and derivative evaluations)",
                         "ipopt_rest": "solve_s minus function evaluations: IPOPT's own work, mostly MUMPS",
                         "outcome": "finished = IPOPT returned (any status); timeout; error"}},

@@ -8,9 +8,9 @@ import pytest
 
 from gaitlib import cache
 from gaitlib import data as data_mod
-from gaitlib import transcription as tr
+from gaitlib.problems import gait as gait_ocp
 
-F = tr.FORMULATION
+F = gait_ocp.FORMULATION
 
 
 @pytest.fixture
@@ -23,9 +23,9 @@ def data_copy(tmp_path, monkeypatch):
 
 
 def test_identified_sets_of_a_spec():
-    assert tr.GaitSpec(model="SK", cost="Eq4.11").identified_sets() == ()
-    assert tr.GaitSpec(model="SK", cost="Eq4.11", body_params="ch4").identified_sets() == ("ch4_child",)
-    s = tr.GaitSpec(model="MSK", cost="Eq5.33", contact_params="ch4", body_params="ch4", mtg_params="ch5")
+    assert gait_ocp.GaitSpec(model="SK", cost="Eq4.11").identified_sets() == ()
+    assert gait_ocp.GaitSpec(model="SK", cost="Eq4.11", body_params="ch4").identified_sets() == ("ch4_child",)
+    s = gait_ocp.GaitSpec(model="MSK", cost="Eq5.33", contact_params="ch4", body_params="ch4", mtg_params="ch5")
     assert s.identified_sets() == ("ch4_child", "ch5_mtg")
 
 

@@ -13,7 +13,7 @@ from gaitlib import __version__, cli
 from gaitlib import data as data_mod
 from gaitlib import sweep as sw
 from gaitlib.gap import diagnose as D
-from gaitlib.gap import effects as fx
+from gaitlib import effects
 from gaitlib.gap import io as gio
 
 FAILED = "Maximum_Iterations_Exceeded"
@@ -89,7 +89,7 @@ def test_bad_options_are_rejected_at_parse_time(argv, capsys, no_solve, tmp_path
     (["sweep", "--costs", "DT,XX", "--out", "o"], ["unknown cost 'XX'"]),
     (["sweep", "--costs", ",", "--out", "o"], ["--costs and --speeds"]),
     (["gap", "--data", "missing.csv", "--out", "o", "--effects", "friction,nope"],
-     ["unknown effect(s) nope", "known: " + ", ".join(fx.EFFECTS)]),
+     ["unknown effect(s) nope", "known: " + ", ".join(effects.EFFECTS)]),
     (["gap-twin", "--effect", "body_mass", "--out", "t.csv"], ["needs --magnitude", "[-0.3, 0.3]"]),
     (["gap-twin", "--effect", "body_mass", "--magnitude", "5", "--out", "t.csv"], ["outside [-0.3, 0.3]"]),
     (["gap-twin", "--effect", "nope", "--magnitude", "0.1", "--out", "t.csv"], ["unknown effect 'nope'"]),

@@ -9,7 +9,7 @@ import pytest
 
 from gaitlib import cache, contact, params
 from gaitlib import conventions as cv
-from gaitlib import transcription as tr
+from gaitlib.problems import gait as gait_ocp
 from gaitlib.model import P_BODY_NAMES, ChildModel
 from gaitlib.studies import contact_id as ci
 
@@ -110,7 +110,7 @@ def test_specs_b_and_c_follow_the_thesis():
     assert c.term_weights == {**b.term_weights, "Imp": 0.25, "Rsd": 0.25}  # Sec 4.4.2: w5 = w6 = 1/4
     assert b.free_contact and not b.free_body and not b.normal_force_constraint
     assert c.free_contact and c.free_body and c.normal_force_constraint
-    gp = tr.build(c)
+    gp = gait_ocp.build(c)
     lo, hi = contact.bounds()
     P = {p.name: p for p in gp.problem.parameters}
     for i, n in enumerate(contact.param_names()):  # Table 4.7 verbatim
@@ -145,7 +145,7 @@ def test_identified_file_round_trip_with_provenance(tmp_path, monkeypatch):
     prov = raw["provenance"]
     for k in ("spec", "gaitlib_version", "cache_fingerprint", "ipopt_status", "iterations", "date"):
         assert k in prov
-    assert prov["cache_fingerprint"] == cache.fingerprint((tr.FORMULATION, ci.FORMULATION),
+    assert prov["cache_fingerprint"] == cache.fingerprint((gait_ocp.FORMULATION, ci.FORMULATION),
                                                           identified=ci.spec_c(4, 3).identified_sets())
     assert prov["spec"]["cost"] == "Eq4.13"
     assert raw["units"]["p_contact"]["toe.k_v"] == "N/m^3" and raw["units"]["p_body"]["mass_hat"] == "kg"
@@ -158,7 +158,7 @@ def test_identified_file_round_trip_with_provenance(tmp_path, monkeypatch):
     np.testing.assert_array_equal(params.contact_params("ch4"), pc)
     np.testing.assert_array_equal(params.body_params("ch4"), pb)
     # a gait spec loads them as its fixed parameters
-    gp = tr.build(tr.GaitSpec(model="SK", cost="Eq4.11", n_intervals=3, degree=2, contact_params="ch4",
+    gp = gait_ocp.build(gait_ocp.GaitSpec(model="SK", cost="Eq4.11", n_intervals=3, degree=2, contact_params="ch4",
                               body_params="ch4"))
     np.testing.assert_array_equal(gp.p_contact, pc)
     np.testing.assert_array_equal(gp.p_body, pb)
@@ -171,12 +171,12 @@ def test_identified_file_missing_or_bad_is_a_clear_error(tmp_path, monkeypatch):
     with pytest.raises(FileNotFoundError, match="ch4_child.json"):
         params.load_identified("ch4_child")
     with pytest.raises(FileNotFoundError, match="ch4_child.json"):
-        tr.build(tr.GaitSpec(model="SK", n_intervals=3, degree=2, contact_params="ch4"))
+        gait_ocp.build(gait_ocp.GaitSpec(model="SK", n_intervals=3, degree=2, contact_params="ch4"))
     (tmp_path / "ch4_child.json").write_text(json.dumps({"p_contact": {}, "p_body": {}, "provenance": {}}))
     with pytest.raises(ValueError, match="p_contact has missing"):
         params.load_identified("ch4_child")
     with pytest.raises(ValueError, match="contact_params"):
-        tr.GaitSpec(contact_params="thesis")
+        gait_ocp.GaitSpec(contact_params="thesis")
 
 
 def test_save_refuses_unconverged(tmp_path):

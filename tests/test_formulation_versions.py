@@ -7,7 +7,7 @@ constraints at the initial guess, the guess, the bounds, the parameters and the 
 options. The numbers are summarised (count, sum, absolute sum and a position-weighted sum of
 each vector) and compared, to a relative 1e-7, with ``tests/formulation_probes.json`` under
 the formulation's current version string. A mismatch means the problem changed: bump the
-version (``gaitlib.transcription.FORMULATION`` …) and record the probe anew with
+version (``gaitlib.problems.gait.FORMULATION`` …) and record the probe anew with
 
     GAITLIB_RECORD_PROBES=1 python -m pytest tests/test_formulation_versions.py
 
@@ -27,7 +27,7 @@ import numpy as np
 import pytest
 
 from gaitlib import cache
-from gaitlib import transcription as tr
+from gaitlib.problems import gait as gait_ocp
 from gaitlib.gap import solve as gsolve
 from gaitlib.studies import contact_id as ci
 from gaitlib.studies import jump
@@ -86,13 +86,13 @@ def _probe(run, monkeypatch) -> dict:
 
 
 def _gait(spec):
-    return lambda: tr.solve(spec)
+    return lambda: gait_ocp.solve(spec)
 
 
 def _gap():
     from gaitlib import data
 
-    spec = tr.GaitSpec(model="SK", cost="DT", n_intervals=3, degree=2)
+    spec = gait_ocp.GaitSpec(model="SK", cost="DT", n_intervals=3, degree=2)
     return lambda: gsolve.Runner(spec).solve(data.load_gait_data("Free"))
 
 
@@ -109,12 +109,12 @@ def _trajopt():
 #: (formulation version, probe name, what is solved). Each formulation's versions are the
 #: strings its cache keys use.
 PROBES = [
-    (tr.FORMULATION, "SK Eq4.11", _gait(tr.GaitSpec(model="SK", cost="Eq4.11", n_intervals=3, degree=2))),
-    (tr.FORMULATION, "MSK DT", _gait(tr.GaitSpec(model="MSK", cost="DT", n_intervals=3, degree=2))),
-    (tr.FORMULATION, "NMSK Eq5.55", _gait(tr.GaitSpec(model="NMSK", cost="Eq5.55", n_intervals=3, degree=2))),
-    (tr.FORMULATION, "SK DT + effect", _gait(tr.GaitSpec(model="SK", cost="DT", n_intervals=3, degree=2,
+    (gait_ocp.FORMULATION, "SK Eq4.11", _gait(gait_ocp.GaitSpec(model="SK", cost="Eq4.11", n_intervals=3, degree=2))),
+    (gait_ocp.FORMULATION, "MSK DT", _gait(gait_ocp.GaitSpec(model="MSK", cost="DT", n_intervals=3, degree=2))),
+    (gait_ocp.FORMULATION, "NMSK Eq5.55", _gait(gait_ocp.GaitSpec(model="NMSK", cost="Eq5.55", n_intervals=3, degree=2))),
+    (gait_ocp.FORMULATION, "SK DT + effect", _gait(gait_ocp.GaitSpec(model="SK", cost="DT", n_intervals=3, degree=2,
                                                           effects=(("body_mass", None),)))),
-    (tr.FORMULATION, "contact (b)", _gait(ci.spec_b(3, 2))),
+    (gait_ocp.FORMULATION, "contact (b)", _gait(ci.spec_b(3, 2))),
     (gsolve.FORMULATION, "SK fit", _gap()),
     (jump.FORMULATION, "toeless", _jump("toeless")),
     (jump.FORMULATION, "ellipsoid", _jump("ellipsoid")),
@@ -150,7 +150,7 @@ def test_formulation_is_what_its_version_says(version, name, run, monkeypatch):
 def test_every_cached_formulation_has_a_probe():
     versions = {v for v, _, _ in PROBES}
     # contact (b)/(c) are gait problems with their own starts: probed as "contact (b)"
-    assert {tr.FORMULATION, gsolve.FORMULATION, jump.FORMULATION, ci.TRAJOPT_FORMULATION} <= versions
+    assert {gait_ocp.FORMULATION, gsolve.FORMULATION, jump.FORMULATION, ci.TRAJOPT_FORMULATION} <= versions
 
 
 def test_a_key_depends_on_the_formulation_version_not_the_source_text():
@@ -172,5 +172,5 @@ def test_a_key_reads_no_source_file(monkeypatch):
 
     monkeypatch.setattr(Path, "read_bytes", spy)
     cache._file_digest.cache_clear()
-    cache.key({"kind": "test"}, tr.FORMULATION, identified=("ch4_child",))
+    cache.key({"kind": "test"}, gait_ocp.FORMULATION, identified=("ch4_child",))
     assert read and not [f for f in read if f.suffix == ".py"], read

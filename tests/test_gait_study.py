@@ -10,7 +10,7 @@ import pytest
 
 from gaitlib import cli
 from gaitlib import conventions as cv
-from gaitlib import transcription as tr
+from gaitlib.problems import gait as gait_ocp
 from gaitlib.model import ChildModel
 from gaitlib.studies import gait
 
@@ -49,7 +49,7 @@ def test_coarse_sk_data_tracking_converges(coarse):
 
 def test_implicit_dynamics_hold_when_reevaluated_independently(coarse):
     _, out, _ = coarse
-    sol = tr.GaitSolution.load(out)
+    sol = gait_ocp.GaitSolution.load(out)
     model = ChildModel()
     X = sol.solution.phase("cycle").states
     U = sol.solution.phase("cycle").controls
@@ -71,7 +71,7 @@ def test_implicit_dynamics_hold_when_reevaluated_independently(coarse):
     # periodic: end state = start state, pelvis advanced by one stride
     gd = sol.spec
     x0, xf = X.iloc[0], X.iloc[-1]
-    stride = tr.build(gd).ref.gait.speed * (X.index[-1] - X.index[0])
+    stride = gait_ocp.build(gd).ref.gait.speed * (X.index[-1] - X.index[0])
     assert xf["pelvis_tx"] - x0["pelvis_tx"] == pytest.approx(stride, abs=1e-6)
     for c in X.columns:
         if c != "pelvis_tx":
@@ -86,7 +86,7 @@ def test_reload_reproduces_frames_and_cache_serves_the_same_solution(coarse):
     _, out, root = coarse
     import pandas as pd
 
-    sol = tr.GaitSolution.load(out)
+    sol = gait_ocp.GaitSolution.load(out)
     q_csv = pd.read_csv(out / "q.csv", index_col=0)
     np.testing.assert_allclose(sol.q.to_numpy(), q_csv.to_numpy(), rtol=1e-8, atol=1e-10)
     cached = gait.solve_cached(sol.spec, root=root)

@@ -9,8 +9,8 @@ import pytest
 
 from gaitlib import data as data_mod
 from gaitlib import ocp
-from gaitlib import transcription as tr
-from gaitlib.gap import effects as fx
+from gaitlib.problems import gait as gait_ocp
+from gaitlib import effects
 from gaitlib.gap import io as gio
 from gaitlib.gap import locate as L
 
@@ -78,7 +78,7 @@ def test_resels_of_smooth_and_rough_curves():
 # -------------------------------------------------------------------------- effects
 
 def _nlp_at_guess(spec):
-    gp = tr.build(spec)
+    gp = gait_ocp.build(spec)
     # an unexpanded MX graph: the NLP's functions without the (slow) expanded solver build
     T = ocp.transcribe(gp.problem, gp.mesh, ocp.SolverOptions(graph="mx", expand=False))
     w0 = T.initial_point(gp.guess)
@@ -94,28 +94,28 @@ def test_effects_at_null_leave_the_problem_unchanged():
     optimum); a magnitude fixed at 0 drops the effect. SK for the effects that apply to it,
     MSK for the muscle-level ones."""
     ref = {}
-    for name, e in fx.EFFECTS.items():
+    for name, e in effects.EFFECTS.items():
         if not e.resolve:
             continue
         model = "SK" if "SK" in e.models else "MSK"
         base = dict(model=model, cost="DT", **TINY)
         if model not in ref:
-            ref[model] = _nlp_at_guess(tr.GaitSpec(**base))
+            ref[model] = _nlp_at_guess(gait_ocp.GaitSpec(**base))
         _, T0, f0, g0 = ref[model]
-        gp, T, f1, g1 = _nlp_at_guess(tr.GaitSpec(**base, effects=((name, None),)))
-        assert [p.name for p in gp.problem.parameters] == [f"fx.{name}.{q.name}" for q in e.params]
+        gp, T, f1, g1 = _nlp_at_guess(gait_ocp.GaitSpec(**base, effects=((name, None),)))
+        assert [p.name for p in gp.problem.parameters] == [f"effects.{name}.{q.name}" for q in e.params]
         assert f1 == pytest.approx(f0, rel=1e-12, abs=1e-12), name
         if e.path is None:
             assert np.allclose(g1, g0, atol=1e-9), name
         else:  # co-contraction at c = 0: a_flex ≥ 0 and a_ext ≥ 0 — inactive for the guess
             assert len(g1) > len(g0) and T.n_constraints > T0.n_constraints
-        fixed0 = fx.bind(tr.GaitSpec(**base, effects=((name, 0.0),)), None)
+        fixed0 = effects.bind(gait_ocp.GaitSpec(**base, effects=((name, 0.0),)), None)
         assert fixed0.items == [] and fixed0.parameters == []
 
 
 def test_effects_registry_documented():
-    assert len(fx.EFFECTS) >= 6
-    for name, e in fx.EFFECTS.items():
+    assert len(effects.EFFECTS) >= 6
+    for name, e in effects.EFFECTS.items():
         assert e.name == name and e.n_params >= 1 and len(e.doc) > 200
         assert "Parameters" in e.doc and all(p.unit for p in e.params)
         for p in e.params:
@@ -123,17 +123,17 @@ def test_effects_registry_documented():
         for m in e.twin_magnitudes:
             assert e.magnitude.lower <= m <= e.magnitude.upper
     with pytest.raises(ValueError, match="unknown effect"):
-        tr.GaitSpec(effects=(("gravity_off", 1.0),))
+        gait_ocp.GaitSpec(effects=(("gravity_off", 1.0),))
     with pytest.raises(ValueError, match="applies to models"):
-        tr.GaitSpec(model="SK", effects=(("co_contraction", 0.2),))
+        gait_ocp.GaitSpec(model="SK", effects=(("co_contraction", 0.2),))
     with pytest.raises(ValueError, match="outside"):
-        tr.GaitSpec(effects=(("hat_com", 5.0),))
-    s = tr.GaitSpec(effects=[("hat_com", 0.02), ["friction", None]])
-    assert tr.GaitSpec.from_dict(s.to_dict()) == s
+        gait_ocp.GaitSpec(effects=(("hat_com", 5.0),))
+    s = gait_ocp.GaitSpec(effects=[("hat_com", 0.02), ["friction", None]])
+    assert gait_ocp.GaitSpec.from_dict(s.to_dict()) == s
 
 
 def _named_x(values: dict):
-    names = tr._states(tr.GaitSpec())
+    names = gait_ocp._states(gait_ocp.GaitSpec())
     v = np.zeros(len(names))
     for k, val in values.items():
         v[names.index(k)] = val
@@ -142,10 +142,10 @@ def _named_x(values: dict):
 
 def test_hat_com_offset_static_moment():
     """Upright HAT at rest: the offset's extra moment about the hip is m_HAT g d, no force."""
-    spec = tr.GaitSpec(**TINY, effects=(("hat_com", 0.03),))
-    gp = tr.build(spec)
-    ctx = fx.Context(spec, gp.model, gp.ref, gp.ref.gait.cycle_time, gp.p_body, gp.p_contact)
-    w = np.asarray(fx.EFFECTS["hat_com"].root_load(_named_x({}), {"d": 0.03}, ctx), float).ravel()
+    spec = gait_ocp.GaitSpec(**TINY, effects=(("hat_com", 0.03),))
+    gp = gait_ocp.build(spec)
+    ctx = effects.Context(spec, gp.model, gp.ref, gp.ref.gait.cycle_time, gp.p_body, gp.p_contact)
+    w = np.asarray(effects.EFFECTS["hat_com"].root_load(_named_x({}), {"d": 0.03}, ctx), float).ravel()
     m = gp.p_body[gp.model.p_body_names.index("mass_hat")]
     assert w == pytest.approx([0.0, 0.0, m * 9.81 * 0.03], abs=1e-12)
 
@@ -153,16 +153,16 @@ def test_hat_com_offset_static_moment():
 def test_arm_swing_antiphase_cancels_horizontal_force_and_moment():
     """Antiphase arms (contralateral hips moving symmetrically about their means): the two
     arms' horizontal forces and pitch moments cancel exactly, their vertical forces add."""
-    spec = tr.GaitSpec(**TINY, effects=(("arm_swing", 1.0),))
-    gp = tr.build(spec)
-    ctx = fx.Context(spec, gp.model, gp.ref, gp.ref.gait.cycle_time, gp.p_body, gp.p_contact)
+    spec = gait_ocp.GaitSpec(**TINY, effects=(("arm_swing", 1.0),))
+    gp = gait_ocp.build(spec)
+    ctx = effects.Context(spec, gp.model, gp.ref, gp.ref.gait.cycle_time, gp.p_body, gp.p_contact)
     cr, cl = float(np.mean(gp.ref.q["hip_r"])), float(np.mean(gp.ref.q["hip_l"]))
     a, ad, add = 0.3, 1.1, -4.0
     x = _named_x({"hip_r": cr + a, "qd_hip_r": ad, "qdd_hip_r": add,
                   "hip_l": cl - a, "qd_hip_l": -ad, "qdd_hip_l": -add})
-    w = np.asarray(fx.EFFECTS["arm_swing"].root_load(x, {"G": 1.0}, ctx), float).ravel()
+    w = np.asarray(effects.EFFECTS["arm_swing"].root_load(x, {"G": 1.0}, ctx), float).ravel()
     assert abs(w[0]) < 1e-12 and abs(w[2]) < 1e-12
-    m, lc = fx.ARM["mass"], fx.ARM["com"]
+    m, lc = effects.ARM["mass"], effects.ARM["com"]
     # each arm's COM rises by lc (1 − cos φ); vertical force = 2 m d²/dt² of it, here with φ = a
     phi, phid, phidd = a, ad, add
     ydd = lc * (phidd * np.sin(phi) + phid**2 * np.cos(phi))
@@ -172,13 +172,13 @@ def test_arm_swing_antiphase_cancels_horizontal_force_and_moment():
 def test_left_shift_reference_is_the_fourier_shift(real):
     """The symbolic left-leg reference at δ equals data.fourier_shift of the right leg at
     shift + δ (order 5) on the data grid; δ = 0 gives the data's own left leg."""
-    spec = tr.GaitSpec(**TINY, effects=(("left_shift", None),))
-    gp = tr.build(spec)
-    frame = tr.tracking_frame(spec, gp.ref)
+    spec = gait_ocp.GaitSpec(**TINY, effects=(("left_shift", None),))
+    gp = gait_ocp.build(spec)
+    frame = gait_ocp.tracking_frame(spec, gp.ref)
     delta = ca.SX.sym("delta")
     names = list(frame.columns)
     dsym = ca.SX.sym("d", len(names))
-    over = fx.EFFECTS["left_shift"].reference(ocp.Named(dsym, names, "data"), {"delta": delta}, None, None)
+    over = effects.EFFECTS["left_shift"].reference(ocp.Named(dsym, names, "data"), {"delta": delta}, None, None)
     f = ca.Function("f", [dsym, delta], [over["ref_knee_l"], over["ref_grf_y_l"]])
     g = real.gait
     for dv in (0.0, 0.02, -0.035):
@@ -189,7 +189,7 @@ def test_left_shift_reference_is_the_fourier_shift(real):
         ref_kn = data_mod.fourier_shift(g.mean["knee_r"].to_numpy(), g.left_shift + dv, 5)
         ref_gy = data_mod.fourier_shift(g.mean["grf_y_r"].to_numpy(), g.left_shift + dv, 5)
         assert np.allclose(kn, ref_kn, atol=1e-9) and np.allclose(gy, ref_gy, atol=1e-7)
-    assert fx.left_generated(g)
+    assert effects.left_generated(g)
 
 
 # -------------------------------------------------------------------------- IO and twins
@@ -232,16 +232,16 @@ def test_twin_round_trip_through_the_tidy_reader(tmp_path, real):
     made of (both legs; RSS ≈ 0); with noise, RSS ≈ N_points / n (SD/√n noise)."""
     from gaitlib.gap import twin
 
-    spec = tr.GaitSpec(model="SK", cost="DT", n_intervals=4, degree=2, max_iter=40)
-    gp = tr.build(spec)
+    spec = gait_ocp.GaitSpec(model="SK", cost="DT", n_intervals=4, degree=2, max_iter=40)
+    gp = gait_ocp.build(spec)
     # any state/control trajectory will do for the round trip: the data-based guess
-    sol = tr.postprocess(gp, ocp.transcribe(gp.problem, gp.mesh, ocp.SolverOptions(max_iter=0)).solve(gp.guess))
+    sol = gait_ocp.postprocess(gp, ocp.transcribe(gp.problem, gp.mesh, ocp.SolverOptions(max_iter=0)).solve(gp.guess))
     clean = twin.twin_frame(sol, real, seed=None, noise=False)
     assert set(clean["side"]) == {"R", "L", "ipsilateral"} and set(clean["source"]) == {"twin(schwartz2008)"}
     p = tmp_path / "twin.csv"
     clean.to_csv(p, index=False, float_format="%.12g")
     ds = gio.read_data(p)
-    assert not fx.left_generated(ds.gait)
+    assert not effects.left_generated(ds.gait)
     loc = L.locate(sol, ds)
     assert loc.rss < 1e-12
     rss = []
@@ -281,7 +281,7 @@ def test_baseline_fit_keeps_the_best_converged_start(tmp_path, real, monkeypatch
     objective, naming its start; a mesh no finer than the coarse one has no coarse start."""
     from gaitlib.gap import diagnose as D
 
-    spec = tr.GaitSpec(model="SK", cost="DT", n_intervals=4, degree=2)
+    spec = gait_ocp.GaitSpec(model="SK", cost="DT", n_intervals=4, degree=2)
     monkeypatch.setattr(D, "COARSE_MESH", (2, 2))
     root = tmp_path / "sol"
     warm = D.solve_many({"w": (spec, [("w", real.gait, None)])}, root=root, serial=True, progress=False)["w"]
@@ -307,7 +307,7 @@ def test_grf_weighted_scales_only_the_grf_sds(real):
 
     g = real.gait
     w = D.grf_weighted(g, 0.1)
-    grf = list(tr.GRF_CHANNELS)
+    grf = list(gait_ocp.GRF_CHANNELS)
     other = [c for c in g.sd.columns if c not in grf]
     np.testing.assert_array_equal(w.sd[grf].to_numpy(), 0.1 * g.sd[grf].to_numpy())
     np.testing.assert_array_equal(w.sd[other].to_numpy(), g.sd[other].to_numpy())
@@ -331,7 +331,7 @@ def test_needs_retry_on_failure_or_a_nested_fit_worse_than_the_baseline():
     from gaitlib.gap import diagnose as D
 
     base = _S("Solve_Succeeded", 10.0)
-    nested = next(n for n, e in fx.EFFECTS.items() if D._nested(e))
+    nested = next(n for n, e in effects.EFFECTS.items() if D._nested(e))
     assert D.needs_retry(nested, None, base)
     assert D.needs_retry(nested, _S("Maximum_Iterations_Exceeded", 1.0), base)
     assert D.needs_retry(nested, _S("Solve_Succeeded", 10.5), base)
@@ -347,7 +347,7 @@ def test_candidate_retry_keeps_the_best_start(tmp_path, real):
 
     # 4 x 3: at 3 x 2 whether a baseline start converges depends on the CPU's last bits (both
     # stopped at the iteration limit on an AVX2-only EPYC)
-    spec = tr.GaitSpec(model="SK", cost="DT", n_intervals=4, degree=3)
+    spec = gait_ocp.GaitSpec(model="SK", cost="DT", n_intervals=4, degree=3)
     root = tmp_path / "sol"
     det = D.baseline_fits(spec, {"d": real}, None, root=root, detail=True, starts=("cold", "dt"), serial=True,
                           progress=False)
@@ -361,7 +361,7 @@ def test_candidate_retry_keeps_the_best_start(tmp_path, real):
     low = copy.copy(base)
     low.stats = dict(base.stats, objective=-1.0)
     name = "friction"
-    assert D._nested(fx.EFFECTS[name])
+    assert D._nested(effects.EFFECTS[name])
     fits = D.candidate_fits(spec, {"d": real}, {"d": low}, [name], root=root, alternates=alts, serial=True,
                             progress=False)["d"]
     f = fits[name]
@@ -448,7 +448,7 @@ def test_cli_gap_on_a_hand_written_csv(tmp_path):
     rk = {r["effect"]: r for r in j["ranking"]}
     assert set(rk) == {"friction", "hat_com", "segment_inertia"}
     for name, r in rk.items():
-        e = fx.EFFECTS[name]
+        e = effects.EFFECTS[name]
         assert r["n_params"] == e.n_params and set(r["parameters"]) == {q.name for q in e.params}
         assert r["rss_before"] == pytest.approx(loc["summary"]["rss"])
         assert r["start"] in ("baseline", "null") + D.BASELINE_STARTS and r["nests_baseline"]

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from gaitlib import data as data_mod
-from gaitlib import transcription as tr
+from gaitlib.problems import gait as gait_ocp
 from gaitlib.gap import diagnose as D
-from gaitlib.gap import effects as fx
+from gaitlib import effects
 from gaitlib.gap import io as gio
 from gaitlib.gap import locate as L
 
@@ -27,7 +27,7 @@ def test_every_nlp_candidate_nests_the_baseline():
     """Every NLP-identified effect has its null value inside its bounds (the baseline model is
     a member); profiled effects are fitted on grids without the null value and are stated
     as not nesting."""
-    for n, e in fx.EFFECTS.items():
+    for n, e in effects.EFFECTS.items():
         nests, why = D.nesting(n)
         assert why
         if e.identify == "nlp":
@@ -44,18 +44,18 @@ def test_null_start_reproduces_the_baseline_point(real):
     from gaitlib.gap import nullstart as N
     from gaitlib.gap.solve import Runner
 
-    spec = tr.GaitSpec(model="SK", cost="DT", n_intervals=4, degree=3)
+    spec = gait_ocp.GaitSpec(model="SK", cost="DT", n_intervals=4, degree=3)
     r0 = Runner(spec)
     # any point will do: the data-based guess after 0 iterations, as a "solution"
     T0 = ocp.transcribe(r0.problem, r0.gp.mesh, ocp.SolverOptions(max_iter=0))
-    base = tr.postprocess(r0.gp, T0.solve(r0.data_guess(real.gait), data={"cycle": r0.frame(real.gait)}))
+    base = gait_ocp.postprocess(r0.gp, T0.solve(r0.data_guess(real.gait), data={"cycle": r0.frame(real.gait)}))
     for name in ("friction", "arm_swing", "hat_com"):
         r1 = N._NullRunner(D._with_effects(spec, ((name, None),)))
         T1 = ocp.transcribe(r1.problem, r1.gp.mesh, ocp.SolverOptions(max_iter=0))
         w1 = T1.initial_point(N.null_guess(base))
-        p = [f"fx.{name}.{q.name}" for q in fx.EFFECTS[name].params]
+        p = [f"effects.{name}.{q.name}" for q in effects.EFFECTS[name].params]
         ip = [T1.ip[T1.problem.parameter_names.index(k)] for k in p]
-        assert np.all(w1[ip] == [q.null for q in fx.EFFECTS[name].params])
+        assert np.all(w1[ip] == [q.null for q in effects.EFFECTS[name].params])
         s1 = T1.solve(N.null_guess(base), data={"cycle": r1.frame(real.gait)})
         assert s1.objective == pytest.approx(base.solution.objective, rel=1e-12, abs=1e-14), name
 
@@ -78,7 +78,7 @@ def test_nested_candidate_above_the_baseline_is_resolved_or_reported(tmp_path, r
     re-solved from the null start and ends at or below the baseline's objective; it is
     ranked with a % closed ≥ −100 RETRY_MARGIN. If the null start fails too (forced), the
     candidate is a failed search: not ranked, no % closed, counted in diagnosis.json."""
-    spec = tr.GaitSpec(model="SK", cost="DT", n_intervals=4, degree=3)
+    spec = gait_ocp.GaitSpec(model="SK", cost="DT", n_intervals=4, degree=3)
     root = tmp_path / "sol"
     base = D.solve_many({"b": (spec, [("b", real.gait, None)])}, root=root, serial=True, progress=False)["b"]
     assert D._status(base)[1]
@@ -125,7 +125,7 @@ def test_nested_fit_with_a_located_gap_above_the_baseline_is_not_ranked(tmp_path
     """A nested candidate whose fit is no failed search by the objective but whose located
     RSS is above the baseline's is not ranked (its % closed would be negative although its
     model contains the baseline); a non-nesting candidate keeps its negative % closed."""
-    spec = tr.GaitSpec(model="SK", cost="DT", n_intervals=4, degree=3, max_iter=5)
+    spec = gait_ocp.GaitSpec(model="SK", cost="DT", n_intervals=4, degree=3, max_iter=5)
     root = tmp_path / "sol"
     rough = D.solve_many({"b": (spec, [("b", real.gait, None)])}, root=root, serial=True, progress=False)["b"]
     good = D.solve_many({"b": (dataclasses.replace(spec, max_iter=1000), [("b", real.gait, None)])}, root=root,

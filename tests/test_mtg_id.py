@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from gaitlib import mtg
-from gaitlib import transcription as tr
+from gaitlib.problems import gait as gait_ocp
 from gaitlib.studies import mtg_id
 
 COARSE = dict(n_intervals=8, degree=3, body_params="default")  # adult joint dampers: a large push-off deficit
@@ -98,7 +98,7 @@ def test_thesis_tolerance_stops_at_a_worse_point(coarse):
 
 def test_parameter_file_round_trip(coarse, tmp_path):
     path = mtg_id.save_params(coarse, tmp_path / "p.json")
-    back = tr.load_mtg_params(path)
+    back = gait_ocp.load_mtg_params(path)
     assert back == coarse.params  # JSON floats round-trip exactly
     doc = json.loads(path.read_text())
     assert doc["provenance"]["status"] == coarse.stats["status"]
@@ -111,13 +111,13 @@ def test_parameter_file_round_trip(coarse, tmp_path):
 
 def test_parameter_file_errors(tmp_path):
     with pytest.raises(FileNotFoundError, match="nothere.json"):
-        tr.load_mtg_params(tmp_path / "nothere.json")
+        gait_ocp.load_mtg_params(tmp_path / "nothere.json")
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps({"params": {"hip_ext": {"s_tau": 1.0}}, "provenance": {}}))
     with pytest.raises(ValueError, match=r"bad\.json.*hip_ext"):
-        tr.load_mtg_params(bad)
+        gait_ocp.load_mtg_params(bad)
     with pytest.raises(ValueError, match="mtg_params"):
-        tr.GaitSpec(model="MSK", cost="Eq5.33", mtg_params="adult")
+        gait_ocp.GaitSpec(model="MSK", cost="Eq5.33", mtg_params="adult")
 
 
 def test_committed_ch5_file():
@@ -129,11 +129,11 @@ def test_committed_ch5_file():
     prov = doc["provenance"]
     assert prov["success"] and prov["status"] == "Solve_Succeeded"
     assert prov["spec"] == json.loads(json.dumps(dataclasses.asdict(mtg_id.chapter_spec())))
-    p = tr.mtg_params_of(tr.GaitSpec(model="MSK", cost="Eq5.33", mtg_params="ch5"))
+    p = gait_ocp.mtg_params_of(gait_ocp.GaitSpec(model="MSK", cost="Eq5.33", mtg_params="ch5"))
     assert set(p) == set(mtg.GENERATORS)
-    assert p == tr.load_mtg_params(mtg_id.PARAMS_FILE)
-    assert tr.mtg_params_of("default") is None
-    assert tr.mtg_params_of("thesis")["ankle_ext"] == mtg.THESIS_PARAMS["ankle_ext"]
+    assert p == gait_ocp.load_mtg_params(mtg_id.PARAMS_FILE)
+    assert gait_ocp.mtg_params_of("default") is None
+    assert gait_ocp.mtg_params_of("thesis")["ankle_ext"] == mtg.THESIS_PARAMS["ankle_ext"]
 
 
 def test_gait_spec_mtg_params_reach_the_msk_dynamics():
@@ -145,8 +145,8 @@ def test_gait_spec_mtg_params_reach_the_msk_dynamics():
     from gaitlib import conventions as cv
     from gaitlib.ocp import Named
 
-    spec = tr.GaitSpec(model="MSK", cost="Eq5.33", mtg_params="thesis", n_intervals=4, degree=3)
-    gp = tr.build(spec)
+    spec = gait_ocp.GaitSpec(model="MSK", cost="Eq5.33", mtg_params="thesis", n_intervals=4, degree=3)
+    gp = gait_ocp.build(spec)
     ph = gp.problem.phases[0]
     g = gp.guess.phases["cycle"]
     i = 40

@@ -12,40 +12,40 @@ import pytest
 
 from gaitlib import activation, metabolics, ocp
 from gaitlib import conventions as cv
-from gaitlib import transcription as tr
+from gaitlib.problems import gait as gait_ocp
 from gaitlib.ocp import Named
 
 
 def test_nmsk_cost_functions_match_thesis_tables():
     # Table 5.9 (Eq 5.55)
-    assert tr.COST_FUNCTIONS["NMSK"]["Eq5.55"] == {"Trq": 0.25, "GRF": 0.25, "Q": 0.25, "Jrk": 0.025,
+    assert gait_ocp.COST_FUNCTIONS["NMSK"]["Eq5.55"] == {"Trq": 0.25, "GRF": 0.25, "Q": 0.25, "Jrk": 0.025,
                                                    "Act": 0.01, "Rsd": 0.25, "Imp": 0.025, "Mtb": 0.2}
     # Table 6.2 NMSK rows
-    assert tr.COST_FUNCTIONS["NMSK"]["DT"] == {"Jrk": 0.025, "Rsd": 0.25, "Imp": 0.025, "HAT": 0.25, "Act": 0.01,
+    assert gait_ocp.COST_FUNCTIONS["NMSK"]["DT"] == {"Jrk": 0.025, "Rsd": 0.25, "Imp": 0.025, "HAT": 0.25, "Act": 0.01,
                                                "Mtb": 0.2, "Trq": 0.25, "Ang": 0.25, "GRF": 0.25}
-    assert tr.COST_FUNCTIONS["NMSK"]["SP1"] == {"Jrk": 0.025, "Rsd": 0.1, "Imp": 0.05, "HAT": 0.5, "Act": 0.01,
+    assert gait_ocp.COST_FUNCTIONS["NMSK"]["SP1"] == {"Jrk": 0.025, "Rsd": 0.1, "Imp": 0.05, "HAT": 0.5, "Act": 0.01,
                                                 "Mtb": 0.2, "GRF": 0.25}
-    assert tr.COST_FUNCTIONS["NMSK"]["FP"] == {"Jrk": 0.025, "Rsd": 0.1, "Imp": 0.25, "HAT": 1.0, "Act": 0.01,
+    assert gait_ocp.COST_FUNCTIONS["NMSK"]["FP"] == {"Jrk": 0.025, "Rsd": 0.1, "Imp": 0.25, "HAT": 1.0, "Act": 0.01,
                                                "Mtb": 0.2}
-    assert tr.COST_FUNCTIONS["NMSK"]["SDT3"]["Imp"] == 0.05 and "GRF" not in tr.COST_FUNCTIONS["NMSK"]["SDT3"]
-    assert set(tr.COST_FUNCTIONS["NMSK"]) == {"Eq5.55", "DT", "SDT1", "SDT2", "SDT3", "SP1", "SP2", "SP3", "FP"}
+    assert gait_ocp.COST_FUNCTIONS["NMSK"]["SDT3"]["Imp"] == 0.05 and "GRF" not in gait_ocp.COST_FUNCTIONS["NMSK"]["SDT3"]
+    assert set(gait_ocp.COST_FUNCTIONS["NMSK"]) == {"Eq5.55", "DT", "SDT1", "SDT2", "SDT3", "SP1", "SP2", "SP3", "FP"}
     # the muscle order is the activation module's (right leg first)
-    assert tr.NMSK_MUSCLES == activation.EXCITATIONS
+    assert gait_ocp.NMSK_MUSCLES == activation.EXCITATIONS
     # Mtb is defined for NMSK only (Sec 6.1)
     with pytest.raises(ValueError, match="not defined for model MSK"):
-        tr.build(tr.GaitSpec(model="MSK", weights=(("Mtb", 0.2),), n_intervals=2, degree=2))
+        gait_ocp.build(gait_ocp.GaitSpec(model="MSK", weights=(("Mtb", 0.2),), n_intervals=2, degree=2))
     with pytest.raises(ValueError, match="NMSK model only"):
-        tr.GaitSpec(model="MSK", free_activation=True)
+        gait_ocp.GaitSpec(model="MSK", free_activation=True)
 
 
 def test_nmsk_problem_builds_with_expected_dimensions():
-    gp = tr.build(tr.GaitSpec(model="NMSK", cost="DT", n_intervals=4, degree=3))
+    gp = gait_ocp.build(gait_ocp.GaitSpec(model="NMSK", cost="DT", n_intervals=4, degree=3))
     ph = gp.problem.phases[0]
     assert len(ph.states) == 33 + 16 and len(ph.controls) == 11 + 3 + 2 + 16 + 1  # + lifted Ė (Mtb)
     assert ph.controls[-1] == "edot_rest" and [c.name for c in ph.path_constraints] == ["dynamics", "metabolic_rate"]
     assert {g.name for g in ph.goals} == {"Jrk", "Rsd", "Imp", "HAT", "Act", "Mtb", "Trq", "Ang", "GRF"}
     assert gp.problem.parameter_names == ()  # Table 5.10 identified values fixed (Ch 6)
-    assert all(ph.bounds[f"ed_{m}"] == (0.0, 0.8) for m in tr.NMSK_MUSCLES)  # Sec 5.3.4
+    assert all(ph.bounds[f"ed_{m}"] == (0.0, 0.8) for m in gait_ocp.NMSK_MUSCLES)  # Sec 5.3.4
     assert set(ph.periodic.states) == set(ph.states)  # neural activations periodic too
     g = gp.guess.phases["cycle"]
     assert set(g.states) == set(ph.states) and set(g.controls) == set(ph.controls)
@@ -57,7 +57,7 @@ def test_nmsk_problem_builds_with_expected_dimensions():
     np.testing.assert_allclose(g.states["u_VM_r"][:-1], u_sim, atol=1e-9)
     assert 0.0 < min(gp.t_stim) and max(gp.t_stim) < gp.ref.gait.cycle_time
 
-    gf = tr.build(tr.GaitSpec(model="NMSK", cost="Eq5.55", free_activation=True, tf_bounds=(0.9, 1.1),
+    gf = gait_ocp.build(gait_ocp.GaitSpec(model="NMSK", cost="Eq5.55", free_activation=True, tf_bounds=(0.9, 1.1),
                               n_intervals=4, degree=3))
     assert gf.problem.parameter_names == ("t_f", "act.tau_act", "act.c3", "act.s1", "act.s2")
     p = {q.name: q for q in gf.problem.parameters}
@@ -70,7 +70,7 @@ def test_activation_dynamics_collocation_reproduces_simulate_activation():
     """The NMSK phase's own dynamics, transcribed on the LGR mesh with the delayed
     excitations fixed to e(t − d), give the neural activations of an independent
     exponential-step integration of Eq 5.34 with the 50 ms delay."""
-    gp = tr.build(tr.GaitSpec(model="NMSK", n_intervals=10, degree=4))
+    gp = gait_ocp.build(gait_ocp.GaitSpec(model="NMSK", n_intervals=10, degree=4))
     ph, mesh = gp.problem.phases[0], gp.mesh
     T = gp.ref.gait.cycle_time
     rng = np.random.default_rng(3)
@@ -83,13 +83,13 @@ def test_activation_dynamics_collocation_reproduces_simulate_activation():
     tc = mesh.tau_colloc * T
     ed = e(tc - activation.DELAY)  # the controls are the delayed excitations
     bounds = dict(ph.bounds)
-    for i, m in enumerate(tr.NMSK_MUSCLES):
+    for i, m in enumerate(gait_ocp.NMSK_MUSCLES):
         bounds[f"ed_{m}"] = (ed[:, i], ed[:, i])
     for c in ph.controls:
         if not c.startswith("ed_"):
             bounds[c] = (0.0, 0.0)
     only_act = dataclasses.replace(ph, path_constraints=(), endpoint_constraints=(), goals=(),
-                                   periodic=ocp.Periodic(tr.NEURAL_STATES + tuple(cv.COORDS)))
+                                   periodic=ocp.Periodic(gait_ocp.NEURAL_STATES + tuple(cv.COORDS)))
     only_act = dataclasses.replace(only_act, bounds=bounds)
     sol = ocp.solve(ocp.Problem((only_act,)), mesh, ocp.SolverOptions(tol=1e-10, constr_viol_tol=1e-12))
     assert sol.success, sol.status
@@ -99,12 +99,12 @@ def test_activation_dynamics_collocation_reproduces_simulate_activation():
     U, A = activation.simulate_activation(tf, e(tf), delay=activation.DELAY, periodic=True, period=T, substeps=4)
     ts = X.index.to_numpy()
     err = max(np.max(np.abs(X[f"u_{m}"].to_numpy() - np.interp(ts, tf, U[:, i], period=T)))
-              for i, m in enumerate(tr.NMSK_MUSCLES))
+              for i, m in enumerate(gait_ocp.NMSK_MUSCLES))
     assert err < 2e-4
     # the delay matters at this precision: without it the activations differ by far more
     U0, _ = activation.simulate_activation(tf, e(tf), delay=0.0, periodic=True, period=T, substeps=4)
     err0 = max(np.max(np.abs(X[f"u_{m}"].to_numpy() - np.interp(ts, tf, U0[:, i], period=T)))
-               for i, m in enumerate(tr.NMSK_MUSCLES))
+               for i, m in enumerate(gait_ocp.NMSK_MUSCLES))
     assert err0 > 100 * err
 
 
@@ -120,25 +120,25 @@ def _eval_integrand(gp, goal_name, x, u, p):
 def test_mtb_and_act_integrands_equal_independent_evaluation():
     """Eq 6.7 / 5.56 at one node with a free final time, against metabolics.nmsk_metabolic_rate
     evaluated numerically (numpy path) and the thesis's normalisation written out."""
-    gp = tr.build(tr.GaitSpec(model="NMSK", cost="DT", tf_bounds=(0.8, 1.2), n_intervals=4, degree=3))
+    gp = gait_ocp.build(gait_ocp.GaitSpec(model="NMSK", cost="DT", tf_bounds=(0.8, 1.2), n_intervals=4, degree=3))
     ph = gp.problem.phases[0]
     g = gp.guess.phases["cycle"]
     k = 60  # a node of the data-based guess, perturbed so that no quantity is special
     rng = np.random.default_rng(7)
     xv = {s: float(np.asarray(g.states[s])[k]) for s in ph.states}
     uv = {c: float(np.asarray(g.controls[c])[k]) for c in ph.controls}
-    for m in tr.NMSK_MUSCLES:
+    for m in gait_ocp.NMSK_MUSCLES:
         xv[f"u_{m}"] = rng.uniform(0.05, 0.6)
         uv[f"ed_{m}"] = rng.uniform(0.0, 0.8)
     uv["tau_mtp_r"], uv["tau_mtp_l"] = 3.0, -2.0
     xv["qd_mtp_r"], xv["qd_mtp_l"] = 1.5, -0.7
     t_f = 1.07
     c3 = activation.ACTIVATION_IDENTIFIED["c3"]
-    act = {m: activation.neural_to_muscle_activation(xv[f"u_{m}"], c3) for m in tr.NMSK_MUSCLES}
+    act = {m: activation.neural_to_muscle_activation(xv[f"u_{m}"], c3) for m in gait_ocp.NMSK_MUSCLES}
     r = metabolics.nmsk_metabolic_rate(
         {j: xv[j] for j in cv.JOINTS}, {j: xv[f"qd_{j}"] for j in cv.JOINTS},
-        {m: uv[f"ed_{m}"] for m in tr.NMSK_MUSCLES}, act, s1=0.25, s2=0.25,
-        mtp_torques={"mtp_r": 3.0, "mtp_l": -2.0}, t_stim=dict(zip(tr.NMSK_MUSCLES, gp.t_stim)))
+        {m: uv[f"ed_{m}"] for m in gait_ocp.NMSK_MUSCLES}, act, s1=0.25, s2=0.25,
+        mtp_torques={"mtp_r": 3.0, "mtp_l": -2.0}, t_stim=dict(zip(gait_ocp.NMSK_MUSCLES, gp.t_stim)))
     edot = float(r["total"])
     rest = float(r["activation"] + r["maintenance"] + r["shortening"] + r["work"])
     # the lifted Ė: the path constraint ties edot_rest to Ȧ + Ṁ + Ṡ + Ẇ ...
@@ -169,7 +169,7 @@ def test_mtb_and_act_integrands_equal_independent_evaluation():
 
 @pytest.fixture(scope="module")
 def coarse_nmsk():
-    return tr.solve(tr.GaitSpec(model="NMSK", cost="DT", n_intervals=8, degree=3, max_iter=1500))
+    return gait_ocp.solve(gait_ocp.GaitSpec(model="NMSK", cost="DT", n_intervals=8, degree=3, max_iter=1500))
 
 
 def test_coarse_nmsk_data_tracking_converges(coarse_nmsk):
@@ -180,7 +180,7 @@ def test_coarse_nmsk_data_tracking_converges(coarse_nmsk):
     # the inverse dynamics of the solved motion; the reported net torques add the joint
     # spring-dampers
     from gaitlib import mtg
-    gp = tr.build(s.spec)
+    gp = gait_ocp.build(s.spec)
     X = s.solution.phase("cycle").interpolate(s.q.index.to_numpy())
     q = X[list(cv.COORDS)].to_numpy().T
     qd = X[[f"qd_{c}" for c in cv.COORDS]].to_numpy().T
@@ -189,7 +189,7 @@ def test_coarse_nmsk_data_tracking_converges(coarse_nmsk):
     tau_id, _ = gp.model.function("inverse_dynamics").map(n)(q, qd, qdd, np.tile(gp.p_body[:, None], n),
                                                              np.tile(gp.p_contact[:, None], n))
     pas = np.asarray(gp.model.function("passive").map(n)(q, qd, np.tile(gp.p_body[:, None], n)))
-    am = {m: s.muscle_activations[m].to_numpy() for m in tr.NMSK_MUSCLES}
+    am = {m: s.muscle_activations[m].to_numpy() for m in gait_ocp.NMSK_MUSCLES}
     for side in cv.SIDES:
         ag = activation.generator_activations(am, 0.25, 0.25, side=side)
         for j in ("hip", "knee", "ankle"):
@@ -202,10 +202,10 @@ def test_coarse_nmsk_data_tracking_converges(coarse_nmsk):
     # excitations within the thesis's bounds; neural activations periodic
     assert s.excitations.to_numpy().min() >= -1e-8 and s.excitations.to_numpy().max() <= 0.8 + 1e-8
     st = s.solution.phase("cycle").states
-    for m in tr.NMSK_MUSCLES:
+    for m in gait_ocp.NMSK_MUSCLES:
         assert st[f"u_{m}"].iloc[-1] == pytest.approx(st[f"u_{m}"].iloc[0], abs=1e-6)
     # metabolic rate: never below the basal rate minus the smooth clip's ε/2 (0.05 W)
-    basal = sum(metabolics.basal_rate(m) for m in tr.NMSK_MUSCLES)
+    basal = sum(metabolics.basal_rate(m) for m in gait_ocp.NMSK_MUSCLES)
     assert s.metabolic["basal"].to_numpy() == pytest.approx(basal)
     assert s.metabolic["total"].min() >= basal - 0.05 - 1e-9
     assert np.isfinite(s.stats["COT"]) and s.stats["COT"] > 0
@@ -225,13 +225,13 @@ def test_bounded_final_time_sk_solve():
     """t_f free within ±10 % of the data's cycle time, warm-started from the fixed-time
     solution (from the data-based guess IPOPT's path depends on the CPU's last bits: on an
     AVX2-only EPYC it stopped at 1500 iterations, elsewhere it converged)."""
-    spec0 = tr.GaitSpec(model="SK", cost="DT", n_intervals=8, degree=3)
-    gp0 = tr.build(spec0)
+    spec0 = gait_ocp.GaitSpec(model="SK", cost="DT", n_intervals=8, degree=3)
+    gp0 = gait_ocp.build(spec0)
     T = gp0.ref.gait.cycle_time
     lo, hi = 0.9 * T, 1.1 * T
-    s0 = tr.solve(spec0)
+    s0 = gait_ocp.solve(spec0)
     assert s0.success
-    s = tr.solve(tr.GaitSpec(model="SK", cost="DT", n_intervals=8, degree=3, tf_bounds=(lo, hi), max_iter=1500),
+    s = gait_ocp.solve(gait_ocp.GaitSpec(model="SK", cost="DT", n_intervals=8, degree=3, tf_bounds=(lo, hi), max_iter=1500),
                  guess=s0)
     assert s.stats["status"] == "Solve_Succeeded" and s.success
     tf = s.stats["tf_s"]

@@ -273,7 +273,7 @@ def test_both_legs_and_coarse_uniform_grid_are_accepted(tmp_path, good):
 @pytest.fixture
 def no_solve(monkeypatch):
     """Any attempt to build a problem or start the diagnosis fails the test."""
-    from gaitlib import transcription as tr
+    from gaitlib.problems import gait as gait_ocp
     from gaitlib.gap import diagnose as D
 
     def boom(*a, **k):

@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from gaitlib import data
-from gaitlib import transcription as tr
+from gaitlib.problems import gait as gait_ocp
 from gaitlib.studies import gait as sg
 from gaitlib.studies import predictive as pr
 
@@ -31,7 +31,7 @@ def test_specs_follow_tables_6_2_and_7_1(base):
     assert list(s6) == [f"MSK {c}" for c in pr.CH6_COSTS]
     fp = s6["MSK FP"].term_weights
     assert not {"Trq", "Ang", "GRF", "Q"} & set(fp) and fp["HAT"] == 1 / 4 and fp["Imp"] == 1 / 4
-    assert s6["MSK DT"].term_weights == tr.COST_FUNCTIONS["MSK"]["DT"]
+    assert s6["MSK DT"].term_weights == gait_ocp.COST_FUNCTIONS["MSK"]["DT"]
     s7 = pr.ch7_specs("MSK", base, **MESH)
     for name, sp in s7.items():
         assert sp.cost == "DT" and sp.track_class == "Free" and sp.speed_class == name.split()[1]
@@ -43,7 +43,7 @@ def test_thesis_guess_keeps_only_hat_mtp_and_activations(base):
     ph = g.phase("cycle")
     assert set(ph.states.columns) == {f"{p}{c}" for p in ("", "qd_", "qdd_")
                                       for c in ("pelvis_tx", "pelvis_ty", "pelvis_tilt", "mtp_r", "mtp_l")}
-    assert set(ph.controls.columns) == set(tr.MTG_CONTROLS) | {"tau_mtp_r", "tau_mtp_l"}
+    assert set(ph.controls.columns) == set(gait_ocp.MTG_CONTROLS) | {"tau_mtp_r", "tau_mtp_l"}
     assert g.parameters == {}
 
 
@@ -79,7 +79,7 @@ def test_full_guess_scales_every_state_and_control_consistently(base):
     np.testing.assert_allclose(ph.controls["jerk_knee_r"], src.controls["jerk_knee_r"] / k**3)
     np.testing.assert_allclose(ph.controls["jerk_pelvis_tx"], src.controls["jerk_pelvis_tx"] / k**3 * stride / s0)
     np.testing.assert_allclose(ph.states["qd_knee_r"], src.states["qd_knee_r"] / k)
-    for c in ("tau_mtp_r", "R_y", tr.MTG_CONTROLS[0]):
+    for c in ("tau_mtp_r", "R_y", gait_ocp.MTG_CONTROLS[0]):
         np.testing.assert_array_equal(ph.controls[c], src.controls[c])
     assert pr.GUESS_POLICY == {"MSK": "thesis", "NMSK": "ch5"}
     # guesses derived differently from one solution are cached under different keys

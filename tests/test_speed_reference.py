@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from gaitlib import data
-from gaitlib import transcription as tr
+from gaitlib.problems import gait as gait_ocp
 from gaitlib.studies import gait as sg
 
 COARSE = dict(model="SK", cost="DT", n_intervals=8, degree=3)
@@ -28,15 +28,15 @@ def test_time_scaled_keeps_magnitudes_and_takes_target_timing():
 @pytest.fixture(scope="module")
 def coarse_sk(tmp_path_factory):
     root = tmp_path_factory.mktemp("sol")
-    sol = sg.solve_cached(tr.GaitSpec(**COARSE), root=root)
+    sol = sg.solve_cached(gait_ocp.GaitSpec(**COARSE), root=root)
     assert sol.stats["status"] == "Solve_Succeeded"
     return sol, root
 
 
 def test_hat_reference_reproduces_the_solution_hat(coarse_sk):
     sol, _ = coarse_sk
-    h = tr.hat_reference_of(sol)
-    gp = tr.build(tr.GaitSpec(**COARSE, hat_reference=h))
+    h = gait_ocp.hat_reference_of(sol)
+    gp = gait_ocp.build(gait_ocp.GaitSpec(**COARSE, hat_reference=h))
     T = gp.ref.gait.cycle_time
     t = sol.q.index.to_numpy()
     ref = gp.ref.q
@@ -48,14 +48,14 @@ def test_hat_reference_reproduces_the_solution_hat(coarse_sk):
     np.testing.assert_allclose(d["ref_pelvis_ty"].to_numpy(), ref["pelvis_ty"].to_numpy())
     assert np.isclose(d.index[-1], ref.index[-1] / T)
     # JSON round trip keeps the key
-    sp = tr.GaitSpec(**COARSE, hat_reference=h)
-    assert tr.GaitSpec.from_dict(sp.to_dict()).key() == sp.key()
+    sp = gait_ocp.GaitSpec(**COARSE, hat_reference=h)
+    assert gait_ocp.GaitSpec.from_dict(sp.to_dict()).key() == sp.key()
 
 
 def test_track_class_solves_at_the_target_timing_on_scaled_data(coarse_sk):
     _, root = coarse_sk
-    sp = tr.GaitSpec(**COARSE, speed_class="Slow", track_class="Free")
-    gp = tr.build(sp)
+    sp = gait_ocp.GaitSpec(**COARSE, speed_class="Slow", track_class="Free")
+    gp = gait_ocp.build(sp)
     slow, free = data.load_gait_data("Slow"), data.load_gait_data("Free")
     # tracked: Free's knee torque on normalised time; never Slow's
     d = gp.problem.phases[0].data
@@ -71,4 +71,4 @@ def test_track_class_solves_at_the_target_timing_on_scaled_data(coarse_sk):
     v_mean = (x.iloc[-1] - x.iloc[0]) / (x.index[-1] - x.index[0])
     assert abs(v_mean - slow.speed) < 0.25 * slow.speed
     with pytest.raises(ValueError):
-        tr.GaitSpec(**COARSE, track_class="Jogging")
+        gait_ocp.GaitSpec(**COARSE, track_class="Jogging")

@@ -17,20 +17,20 @@ import numpy as np
 import pytest
 
 from gaitlib import sweep as sw
-from gaitlib import transcription as tr
+from gaitlib.problems import gait as gait_ocp
 
 COARSE = dict(model="SK", cost="DT", n_intervals=8, degree=3)
 SPECS = {
-    "SK_DT_Slow": tr.GaitSpec(**COARSE, speed_class="Slow"),
-    "SK_DT_Fast": tr.GaitSpec(**COARSE, speed_class="Fast"),
+    "SK_DT_Slow": gait_ocp.GaitSpec(**COARSE, speed_class="Slow"),
+    "SK_DT_Fast": gait_ocp.GaitSpec(**COARSE, speed_class="Fast"),
     # stopped after 3 iterations: a run that does not converge, to be reported as such
-    "SK_DT_Free_3it": tr.GaitSpec(**COARSE, speed_class="Free", max_iter=3),
+    "SK_DT_Free_3it": gait_ocp.GaitSpec(**COARSE, speed_class="Free", max_iter=3),
 }
 pytestmark = pytest.mark.filterwarnings("ignore::gaitlib.ocp.SolveFailedWarning")  # the 3-iteration run
 FRAMES = ("q", "qd", "torques", "torques_active", "residuals", "grf", "ellipsoids")
 
 
-def _bitwise_equal(a: tr.GaitSolution, b: tr.GaitSolution) -> None:
+def _bitwise_equal(a: gait_ocp.GaitSolution, b: gait_ocp.GaitSolution) -> None:
     assert a.stats["objective"] == b.stats["objective"]
     assert a.stats["status"] == b.stats["status"] and a.stats["iterations"] == b.stats["iterations"]
     for f in FRAMES:

@@ -13,7 +13,7 @@ import pytest
 from gaitlib import cache
 
 from gaitlib import ocp
-from gaitlib import transcription as tr
+from gaitlib.problems import gait as gait_ocp
 from gaitlib.studies import contact_id, msk, predictive
 from gaitlib.studies import performance as perf
 

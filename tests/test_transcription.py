@@ -7,33 +7,33 @@ import numpy as np
 import pytest
 
 from gaitlib import conventions as cv
-from gaitlib import transcription as tr
+from gaitlib.problems import gait as gait_ocp
 
 
 def test_cost_function_weights_match_thesis_tables():
     # Table 4.8 (Eq 4.11) and Sec 4.4 (w5 = w6 = 1/4)
-    assert tr.COST_FUNCTIONS["SK"]["Eq4.11"] == {"Trq": 0.25, "GRF": 0.25, "Q": 0.25, "Jrk": 0.025}
-    assert tr.COST_FUNCTIONS["SK"]["Eq4.13"]["Imp"] == 0.25 and tr.COST_FUNCTIONS["SK"]["Eq4.13"]["Rsd"] == 0.25
+    assert gait_ocp.COST_FUNCTIONS["SK"]["Eq4.11"] == {"Trq": 0.25, "GRF": 0.25, "Q": 0.25, "Jrk": 0.025}
+    assert gait_ocp.COST_FUNCTIONS["SK"]["Eq4.13"]["Imp"] == 0.25 and gait_ocp.COST_FUNCTIONS["SK"]["Eq4.13"]["Rsd"] == 0.25
     # Table 5.3
-    assert tr.COST_FUNCTIONS["MSK"]["Eq5.33"]["Act"] == 0.01 and tr.COST_FUNCTIONS["MSK"]["Eq5.33"]["Imp"] == 0.025
+    assert gait_ocp.COST_FUNCTIONS["MSK"]["Eq5.33"]["Act"] == 0.01 and gait_ocp.COST_FUNCTIONS["MSK"]["Eq5.33"]["Imp"] == 0.025
     # Table 6.2 MSK rows: SP1 and FP
-    assert tr.COST_FUNCTIONS["MSK"]["SP1"] == {"Jrk": 0.025, "Rsd": 0.1, "Imp": 1 / 3, "HAT": 0.5, "Act": 0.01, "GRF": 0.25}
-    assert "Trq" not in tr.COST_FUNCTIONS["MSK"]["FP"] and "Ang" not in tr.COST_FUNCTIONS["MSK"]["FP"]
+    assert gait_ocp.COST_FUNCTIONS["MSK"]["SP1"] == {"Jrk": 0.025, "Rsd": 0.1, "Imp": 1 / 3, "HAT": 0.5, "Act": 0.01, "GRF": 0.25}
+    assert "Trq" not in gait_ocp.COST_FUNCTIONS["MSK"]["FP"] and "Ang" not in gait_ocp.COST_FUNCTIONS["MSK"]["FP"]
 
 
 def test_spec_validation_and_key():
     with pytest.raises(ValueError, match="unknown cost"):
-        tr.GaitSpec(model="SK", cost="SP9")
+        gait_ocp.GaitSpec(model="SK", cost="SP9")
     with pytest.raises(ValueError, match="unknown cost term"):
-        tr.GaitSpec(weights=(("Jerk", 1.0),))
-    a, b = tr.GaitSpec(), tr.GaitSpec(n_intervals=10)
-    assert a.key() == tr.GaitSpec().key() and a.key() != b.key()
+        gait_ocp.GaitSpec(weights=(("Jerk", 1.0),))
+    a, b = gait_ocp.GaitSpec(), gait_ocp.GaitSpec(n_intervals=10)
+    assert a.key() == gait_ocp.GaitSpec().key() and a.key() != b.key()
 
 
 @pytest.mark.parametrize("model", ["SK", "MSK"])
 def test_gait_problem_builds_with_expected_dimensions(model):
     cost = "DT"
-    gp = tr.build(tr.GaitSpec(model=model, cost=cost, n_intervals=4, degree=3))
+    gp = gait_ocp.build(gait_ocp.GaitSpec(model=model, cost=cost, n_intervals=4, degree=3))
     ph = gp.problem.phases[0]
     assert len(ph.states) == 33
     n_act = 8 if model == "SK" else 2 + 12
@@ -45,7 +45,7 @@ def test_gait_problem_builds_with_expected_dimensions(model):
 
 
 def test_reference_hat_height_carries_the_data_vertical_load():
-    gp = tr.build(tr.GaitSpec(n_intervals=4, degree=3))
+    gp = gait_ocp.build(gait_ocp.GaitSpec(n_intervals=4, degree=3))
     ref, model = gp.ref, gp.model
     # the pelvis reference advances at the data's speed
     t = ref.q.index.to_numpy()
@@ -73,19 +73,19 @@ def test_reference_hat_height_carries_the_data_vertical_load():
 
 
 def test_height_for_load_reports_an_impossible_load():
-    gp = tr.build(tr.GaitSpec(n_intervals=4, degree=3))
+    gp = gait_ocp.build(gait_ocp.GaitSpec(n_intervals=4, degree=3))
     from gaitlib import kinematics
     with pytest.raises(ValueError, match="row 0"):
         kinematics.height_for_load(gp.model, gp.ref.q.to_numpy()[:1], [1e7], below=0.01)
 
 
 def test_spec_round_trip():
-    s = tr.GaitSpec(model="MSK", cost="SDT2", weights=(("Jrk", 0.1),), residual_bounds=(2.0, 2.0, 0.2))
-    assert tr.GaitSpec.from_dict(s.to_dict()) == s and tr.GaitSpec.from_dict(s.to_dict()).key() == s.key()
+    s = gait_ocp.GaitSpec(model="MSK", cost="SDT2", weights=(("Jrk", 0.1),), residual_bounds=(2.0, 2.0, 0.2))
+    assert gait_ocp.GaitSpec.from_dict(s.to_dict()) == s and gait_ocp.GaitSpec.from_dict(s.to_dict()).key() == s.key()
 
 
 def test_failed_gait_solve_is_reported_as_failed():
     with pytest.warns(UserWarning, match="FAILED"):
-        gs = tr.solve(tr.GaitSpec(n_intervals=3, degree=3, max_iter=2))
+        gs = gait_ocp.solve(gait_ocp.GaitSpec(n_intervals=3, degree=3, max_iter=2))
     assert not gs.success and gs.stats["status"] == "Maximum_Iterations_Exceeded"
     assert gs.stats["iterations"] == 2

@@ -48,7 +48,7 @@ import matplotlib.pyplot as plt
 
 from gaitlib import conventions as cv, data, marks, mtg, params, plots
 from gaitlib.model import P_BODY_NAMES
-from gaitlib import transcription as tr
+from gaitlib.problems import gait as gait_ocp
 from gaitlib.studies import gait, msk, mtg_id
 
 pd.set_option("display.precision", 4)
@@ -152,7 +152,7 @@ print(f"• The identification ran with body set '{spec_id.body_params}': knee /
       + ("; so NOT under the thesis's ≈ 0 dampers" if max(bk, ba) > 10 * max(tk, ta, 0.05) else "") + ").")
 
 # %%
-stored = tr.load_mtg_params(mtg_id.PARAMS_FILE)
+stored = gait_ocp.load_mtg_params(mtg_id.PARAMS_FILE)
 prov = json.loads(mtg_id.PARAMS_FILE.read_text())["provenance"]
 dev = max(abs(getattr(stored[g], k) - getattr(ident.params[g], k)) for g in mtg.GENERATORS for k in mtg_id.GAMMA)
 same_spec = prov["spec"] == json.loads(json.dumps(ident.spec.__dict__))

@@ -2,7 +2,7 @@
 
 Modules (one-way flow): :mod:`gaitlib.data` → :mod:`gaitlib.model` →
 :mod:`gaitlib.contact` / :mod:`gaitlib.mtg` / :mod:`gaitlib.metabolics` →
-:mod:`gaitlib.transcription` → :mod:`gaitlib.studies` → the book's notebooks.
+:mod:`gaitlib.problems.gait` → :mod:`gaitlib.studies` → the book's notebooks.
 Units, axes and sign conventions: :mod:`gaitlib.conventions`.
 """
 

@@ -8,7 +8,7 @@ A key is the SHA-256 of
   the warm start's identity …);
 - the **formulation version(s)** the solution was computed with — a string such as
   ``"gait-1"`` that the module defining the formulation declares
-  (:data:`gaitlib.transcription.FORMULATION`, :data:`gaitlib.gap.solve.FORMULATION`, …) and
+  (:data:`gaitlib.problems.gait.FORMULATION`, :data:`gaitlib.gap.solve.FORMULATION`, …) and
   bumps whenever a change alters the problem that is solved (equations, bounds, initial
   guess, solver options). ``tests/test_formulation_versions.py`` evaluates every
   formulation's NLP on a small mesh and fails when the numbers change under an unchanged
@@ -118,7 +118,7 @@ def _solver_version() -> str:
 
 def _formulations(formulation) -> list[str]:
     if formulation is None:
-        raise TypeError("cache: a formulation version is required (e.g. gaitlib.transcription.FORMULATION)")
+        raise TypeError("cache: a formulation version is required (e.g. gaitlib.problems.gait.FORMULATION)")
     return [formulation] if isinstance(formulation, str) else list(formulation)
 
 

@@ -267,14 +267,14 @@ def _cmd_sweep(args) -> int:
     import pandas as pd
 
     from . import sweep as sw
-    from . import transcription as tr
+    from .problems import gait as gait_ocp
     from .studies import gait
 
     costs, speeds = _split(args.costs), _split(args.speeds)
     if not costs or not speeds:
         raise CLIError("--costs and --speeds need at least one comma-separated name each")
     kw = dict(n_intervals=args.intervals, degree=args.degree, max_iter=args.max_iter)
-    specs = {f"{args.model}_{c}_{s}": tr.GaitSpec(model=args.model, cost=c, speed_class=s, **kw)
+    specs = {f"{args.model}_{c}_{s}": gait_ocp.GaitSpec(model=args.model, cost=c, speed_class=s, **kw)
              for c in costs for s in speeds}
     root = check_cache(args.cache, not args.no_cache)
     out = Path(args.out)

@@ -4,7 +4,7 @@ The thesis identifies the 39 contact parameters and the 25 body/joint parameters
 model once (Ch 4, Sec 4.4, "the third approach") and uses them, fixed, in every later
 simulation. The book does the same on its own data: the Ch 4 study
 (:mod:`gaitlib.studies.contact_id`) writes its identified values of approach (c) to
-``data/identified/ch4_child.json``; a :class:`gaitlib.transcription.GaitSpec` with
+``data/identified/ch4_child.json``; a :class:`gaitlib.problems.gait.GaitSpec` with
 ``contact_params="ch4"`` / ``body_params="ch4"`` reads them through :func:`load_identified`.
 
 File format (JSON, SI units)

@@ -24,7 +24,7 @@ Where the runs go
 Every run is wrapped on the worker: an exception becomes a record with ``ok=False``,
 ``status="error"`` and the traceback; a lost worker likewise. A run's ``status`` is the
 IPOPT return status when the function returns a solution (an object with
-``stats["status"]``, e.g. :class:`~gaitlib.transcription.GaitSolution`, or with a
+``stats["status"]``, e.g. :class:`~gaitlib.problems.gait.GaitSolution`, or with a
 ``status`` string, e.g. :class:`~gaitlib.ocp.Solution`); ``ok`` is then True only for
 ``Solve_Succeeded`` and ``Solved_To_Acceptable_Level``. A mapping of solutions (a group
 of solves) has their statuses (one if shared, else their counts), ``ok`` only if every
@@ -283,8 +283,8 @@ def _solve_spec(arg):
 
 def solve_specs(specs: Mapping[str, Any], *, guesses: Mapping[str, Any] | None = None, use_cache: bool = True,
                 cache_root=None, **sweep_kw) -> dict[str, RunRecord]:
-    """Solve (or reload from the cache) named :class:`~gaitlib.transcription.GaitSpec` s as one
-    sweep; ``value`` of each record is the :class:`~gaitlib.transcription.GaitSolution`.
+    """Solve (or reload from the cache) named :class:`~gaitlib.problems.gait.GaitSpec` s as one
+    sweep; ``value`` of each record is the :class:`~gaitlib.problems.gait.GaitSolution`.
 
     Parameters
     ----------
@@ -304,7 +304,7 @@ def solve_specs(specs: Mapping[str, Any], *, guesses: Mapping[str, Any] | None =
     ``Solved_To_Acceptable_Level``. Cached failures come back as failures.
     """
     from . import cache
-    from .transcription import GaitSpec
+    from .problems.gait import GaitSpec
 
     guesses = dict(guesses or {})
     unknown = sorted(set(guesses) - set(specs))

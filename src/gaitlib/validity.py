@@ -1,6 +1,6 @@
 """Physical validity gates: is a solved motion a physically plausible child gait (or jump)?
 
-:func:`check` reads a solution — a gait solution (:class:`gaitlib.transcription.GaitSolution`,
+:func:`check` reads a solution — a gait solution (:class:`gaitlib.problems.gait.GaitSolution`,
 SK/MSK/NMSK, data tracking or predictive), a jump (``gaitlib.studies.jump.JumpSolution``)
 or a contact identification (``gaitlib.studies.contact_id.ApproachResult``) — and returns
 :class:`Gates`: a table of named checks, each with the measured value, its threshold, unit,
@@ -81,7 +81,7 @@ The checks (thresholds are the module constants below, with their sources)
                    Free speed, +7.1° at Very Fast), since an angle the children show is
                    within their range. The thesis states no other joint range; its gait
                    bounds are "based on the standard deviation" of its data (Sec 4.3.2;
-                   ours: mean ± 3 SD ± 15°, :func:`gaitlib.transcription.build`), which
+                   ours: mean ± 3 SD ± 15°, :func:`gaitlib.problems.gait.build`), which
                    every solution meets by construction. :data:`ROM_TOL_DEG` allows for
                    IPOPT's bound tolerance.
 ``periodicity``    (gait) max over the 11 coordinates of |q(t_f) − q(0) − offset| (m or rad;
@@ -489,15 +489,15 @@ def _gait_periodicity(sol, stride: float) -> tuple[float, str]:
 
 
 def _check_gait(sol, kind, data, name) -> Gates:
-    from . import transcription as tr
+    from .problems import gait as gait_ocp
 
     spec = sol.spec
     kind = kind or _gait_kind(spec)
     events, shift, stride, rom = _tracked_data(spec, data)
     if spec.model == "SK":
-        params, src = tr.mtg_params_of(SK_STRENGTH_PARAMS), f"SK: MTG envelope, '{SK_STRENGTH_PARAMS}' set"
+        params, src = gait_ocp.mtg_params_of(SK_STRENGTH_PARAMS), f"SK: MTG envelope, '{SK_STRENGTH_PARAMS}' set"
     else:
-        params, src = tr.mtg_params_of(spec), f"{spec.model}: its MTG set '{spec.mtg_params}'"
+        params, src = gait_ocp.mtg_params_of(spec), f"{spec.model}: its MTG set '{spec.mtg_params}'"
     torques = sol.torques_active if sol.torques_active is not None else sol.torques
     per, per_note = _gait_periodicity(sol, stride)
     return check_frames(status=sol.stats["status"], q=sol.q[list(cv.JOINTS)], torques=torques, grf=sol.grf,
@@ -508,7 +508,7 @@ def _check_gait(sol, kind, data, name) -> Gates:
 
 
 def _check_contact_a(res, name) -> Gates:
-    from . import transcription as tr
+    from .problems import gait as gait_ocp
 
     g = _gait_data("Free")
 
@@ -516,7 +516,7 @@ def _check_contact_a(res, name) -> Gates:
                         "(no converged local solve meets Eq 4.4)",
                         q=res.q[list(cv.JOINTS)], torques=res.torques, grf=res.grf, residuals=res.residuals,
                         tf=g.cycle_time, kind="tracking", events=g.events, left_shift=g.left_shift,
-                        strength=strength_limits(tr.mtg_params_of(SK_STRENGTH_PARAMS)),
+                        strength=strength_limits(gait_ocp.mtg_params_of(SK_STRENGTH_PARAMS)),
                         strength_source=f"SK: MTG envelope, '{SK_STRENGTH_PARAMS}' set; net inverse-dynamics torques",
                         com_height=_com_height(res.q), periodicity=None, rom_data=data_rom(g), name=name,
                         notes={"periodicity": "kinematics fixed to the data's periodic Fourier fit"})
@@ -548,7 +548,7 @@ def _check_jump(sol, name) -> Gates:
 def check(solution, *, kind: str | None = None, data=None, name: str = "") -> Gates:
     """The validity gates of a solution (module docstring).
 
-    ``solution``: a :class:`~gaitlib.transcription.GaitSolution`, a jump solution (has
+    ``solution``: a :class:`~gaitlib.problems.gait.GaitSolution`, a jump solution (has
     ``trajectory`` and ``jump_height``) or a contact-identification result (has
     ``p_contact`` and ``key``; (b)/(c) are checked through their gait solution).
     ``kind``: ``"tracking"`` or ``"predictive"`` for a gait (default: tracking when the cost

@@ -1,6 +1,6 @@
 """Where the model misses reality: the sim-to-real gap diagnosis (issue 7).
 
-``gaitlib.gap.EFFECTS``            the registry of candidate unmodelled effects (:mod:`.effects`)
+``gaitlib.gap.EFFECTS``            the registry of candidate unmodelled effects (:mod:`gaitlib.effects`)
 ``gaitlib.gap.locate(sol, data)``  SD-standardised residual by channel and gait phase (:mod:`.locate`)
 ``gaitlib.gap.diagnose(data, …)``  re-solve with each effect, rank, shrink (:mod:`.diagnose`)
 ``gaitlib.gap.make_twin(…)``       synthetic data with a known effect (:mod:`.twin`)
@@ -16,7 +16,8 @@ from __future__ import annotations
 import importlib
 
 _LAZY = {
-    "EFFECTS": ("effects", "EFFECTS"), "TWIN_EFFECTS": ("effects", "TWIN_EFFECTS"), "Effect": ("effects", "Effect"),
+    "EFFECTS": ("gaitlib.effects", "EFFECTS"), "TWIN_EFFECTS": ("gaitlib.effects", "TWIN_EFFECTS"),
+    "Effect": ("gaitlib.effects", "Effect"),
     "locate": ("locate", "locate"), "Located": ("locate", "Located"),
     "diagnose": ("diagnose", "diagnose"), "Diagnosis": ("diagnose", "Diagnosis"),
     "make_twin": ("twin", "make_twin"), "write_twin": ("twin", "write_twin"),
@@ -29,5 +30,5 @@ __all__ = list(_LAZY)
 def __getattr__(name):
     if name in _LAZY:
         mod, attr = _LAZY[name]
-        return getattr(importlib.import_module(f".{mod}", __name__), attr)
+        return getattr(importlib.import_module(mod if "." in mod else f".{mod}", __name__ if "." not in mod else None), attr)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -15,16 +15,16 @@ def _base(args, speed_class: str) -> dict:
 
 def _spec(base: dict):
     """The baseline spec (its options checked before any solve)."""
-    from .. import transcription as tr
+    from ..problems import gait as gait_ocp
 
-    return tr.GaitSpec(**base)
+    return gait_ocp.GaitSpec(**base)
 
 
 def effect_names(text: str | None) -> list | None:
     """``--effects`` as a list of known effect names (None: all); ``CLIError`` naming the
     known ones otherwise."""
     from ..cli import CLIError
-    from .effects import EFFECTS
+    from ..effects import EFFECTS
 
     if text is None:
         return None
@@ -81,10 +81,10 @@ def cmd_gap(args) -> int:
 
 def twin_effects(args) -> tuple:
     """``--effect/--magnitude`` (and ``--effect2/--magnitude2``) as ((name, magnitude), …),
-    checked against the effect registry and its bounds (:func:`gaitlib.gap.effects.validate`)
+    checked against the effect registry and its bounds (:func:`gaitlib.effects.validate`)
     before any solve; ``CLIError`` otherwise."""
     from ..cli import CLIError
-    from .effects import EFFECTS, validate
+    from ..effects import EFFECTS, validate
 
     pairs = []
     for opt, eff, mag in (("", args.effect, args.magnitude), ("2", args.effect2, args.magnitude2)):
@@ -137,7 +137,7 @@ def _common(p, mesh=(10, 3)):
 
 def add_parsers(sub) -> None:
     from ..cli import finite_float, int_at_least
-    from .effects import EFFECTS
+    from ..effects import EFFECTS
 
     g = sub.add_parser("gap", help="sim-to-real gap diagnosis of a tidy data CSV (diagnosis.json + figures)")
     g.add_argument("--data", required=True, help="tidy CSV (gaitlib.data format)")

@@ -11,7 +11,7 @@ GaitData) and a baseline model, and
    locates its gap
    (:func:`gaitlib.gap.locate.locate`); if no start converged it stops
    (:class:`BaselineFailed`): a gap located on a non-converged fit is not a result;
-2. re-solves with every applicable candidate effect (:data:`gaitlib.gap.effects.EFFECTS`),
+2. re-solves with every applicable candidate effect (:data:`gaitlib.effects.EFFECTS`),
    warm-started from the baseline fit, through :func:`gaitlib.sweep.sweep`:
    ``identify="nlp"`` effects with their parameters free in the NLP; ``"profile"`` effects
    (signature in EMG only) on a grid of fixed magnitudes, keeping the one with the smallest
@@ -63,9 +63,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .. import transcription as tr
+from ..problems import gait as gait_ocp
 from ..ocp import _json_default  # the same JSON encoding as saved solutions
-from . import effects as fx
+from .. import effects
 from . import io as gio
 from . import locate as L
 from .nullstart import null_start_many
@@ -86,12 +86,12 @@ DEFAULT_BASE = dict(model="SK", cost="DT", n_intervals=10, degree=3)
 EXPLAINED_PCT = 50.0
 
 
-def base_spec(base=None) -> tr.GaitSpec:
-    if isinstance(base, tr.GaitSpec):
+def base_spec(base=None) -> gait_ocp.GaitSpec:
+    if isinstance(base, gait_ocp.GaitSpec):
         if base.effects:
             raise ValueError("the baseline spec must have no effects")
         return base
-    return tr.GaitSpec(**dict(DEFAULT_BASE if base is None else base))
+    return gait_ocp.GaitSpec(**dict(DEFAULT_BASE if base is None else base))
 
 
 def as_dataset(data, like=None, fill_from=None, n_subjects=None) -> gio.DataSet:
@@ -107,15 +107,15 @@ def as_dataset(data, like=None, fill_from=None, n_subjects=None) -> gio.DataSet:
     raise TypeError(f"data must be a CSV path, DataSet or GaitData, got {type(data).__name__}")
 
 
-def candidates(spec0: tr.GaitSpec, gait, effects=None) -> tuple[list, dict]:
+def candidates(spec0: gait_ocp.GaitSpec, gait, effects=None) -> tuple[list, dict]:
     """(applicable effect names, {name: reason} of those left out)."""
-    names = list(fx.EFFECTS) if effects is None else list(effects)
+    names = list(effects.EFFECTS) if effects is None else list(effects)
     ok, skipped = [], {}
     for n in names:
-        e = fx.EFFECTS[n]
+        e = effects.EFFECTS[n]
         if spec0.model not in e.models:
             skipped[n] = f"not applicable to the {spec0.model} model (signature: {e.signature})"
-        elif n == "left_shift" and not fx.left_generated(gait):
+        elif n == "left_shift" and not effects.left_generated(gait):
             skipped[n] = "the data's left leg is measured, not generated from the right one"
         elif e.identify == "profile" and e.resolve and n not in PROFILE_GRID:
             skipped[n] = "no profile grid"
@@ -217,7 +217,7 @@ class Diagnosis:
     """The result of :func:`diagnose` (see the module docstring)."""
 
     data: gio.DataSet
-    spec: tr.GaitSpec
+    spec: gait_ocp.GaitSpec
     objective: str
     baseline: object
     located: L.Located
@@ -257,7 +257,7 @@ class Diagnosis:
             "summary": self.summary(),
             "effects": {n: {"title": e.title, "n_params": e.n_params, "identify": e.identify,
                             "params": [p.__dict__ for p in e.params], "nests_baseline": nesting(n)[0],
-                            "nesting": nesting(n)[1]} for n, e in fx.EFFECTS.items()},
+                            "nesting": nesting(n)[1]} for n, e in effects.EFFECTS.items()},
             "settings": self.settings,
         }
         if self.solution_located is not None:
@@ -331,7 +331,7 @@ ABOVE_LOCATED = "located gap above the baseline's"
 
 def nesting(name: str) -> tuple[bool, str]:
     """(whether the candidate's kept fit can always reproduce the baseline, why)."""
-    e = fx.EFFECTS[name]
+    e = effects.EFFECTS[name]
     if not e.resolve:
         return True, "comparison on the baseline solution; the null value is kept unless a value does better"
     if _nested(e):
@@ -355,7 +355,7 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
     n_eff = loc0.n_eff
     rows = []
     for name, f in fits.items():
-        e = fx.EFFECTS[name]
+        e = effects.EFFECTS[name]
         nests, _ = nesting(name)
         row = {"effect": name, "title": e.title, "n_params": f.n_params, "identify": f.identify,
                "parameters": f.thetas.get(name, {}), "status": f.status, "ok": f.ok, "start": f.start,
@@ -393,7 +393,7 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
     shrink, intervals = {}, {}
     tops = [r["effect"] for _, r in ranking.iterrows() if r["ok"] and np.isfinite(r["dBIC"])][:top]
     rng = np.random.default_rng(seed)
-    generated = fx.left_generated(ds.gait)
+    generated = effects.left_generated(ds.gait)
     shift0 = float(ds.gait.left_shift)
     fns = _noise_fns([loc0] + [fits[k].located for k in tops], rng, resamples) if resamples and tops else None
     r0 = _resampled_rss(loc0, ds, fns, shift0, generated) if fns else None
@@ -466,9 +466,9 @@ def grf_weighted(gait, factor: float = GRF_SD_FACTOR):
     import dataclasses
 
     sd = gait.sd.copy()
-    cols = [c for c in tr.GRF_CHANNELS if c in sd.columns]
+    cols = [c for c in gait_ocp.GRF_CHANNELS if c in sd.columns]
     if not cols:
-        raise ValueError("grf_weighted: the data set has no GRF channels " + repr(list(tr.GRF_CHANNELS)))
+        raise ValueError("grf_weighted: the data set has no GRF channels " + repr(list(gait_ocp.GRF_CHANNELS)))
     sd[cols] = sd[cols] * float(factor)
     return dataclasses.replace(gait, sd=sd)
 
@@ -540,7 +540,7 @@ def _nested(e) -> bool:
 
 
 def _nlp_fit(n: str, sol, ds, error: bool = False) -> Fit:
-    e = fx.EFFECTS[n]
+    e = effects.EFFECTS[n]
     st, ok = _status(sol)
     if sol is None and error:
         st = "error"
@@ -556,7 +556,7 @@ def needs_retry(n: str, sol, base_sol) -> bool:
     contains."""
     if sol is None or not _status(sol)[1]:
         return True
-    if not _nested(fx.EFFECTS[n]) or base_sol is None:
+    if not _nested(effects.EFFECTS[n]) or base_sol is None:
         return False
     f0, f1 = float(base_sol.stats["objective"]), float(sol.stats["objective"])
     return f1 > f0 + RETRY_MARGIN * abs(f0)
@@ -582,7 +582,7 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
     (:func:`assemble` does not rank it)."""
     groups = {}
     for n in names:
-        e = fx.EFFECTS[n]
+        e = effects.EFFECTS[n]
         if not e.resolve:
             continue
         if e.identify == "nlp":
@@ -600,7 +600,7 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
     retry = {}
     if alternates:
         for n in names:
-            e = fx.EFFECTS[n]
+            e = effects.EFFECTS[n]
             if not (e.resolve and e.identify == "nlp"):
                 continue
             spec = _with_effects(spec0, ((n, None),))
@@ -623,7 +623,7 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
     null = {}
     if null_start:
         for n in names:
-            e = fx.EFFECTS[n]
+            e = effects.EFFECTS[n]
             if not (e.resolve and _nested(e)):
                 continue
             jobs = [(f"{k}|{n}|null", ds.gait, bases[k]) for k, ds in datasets.items()
@@ -636,7 +636,7 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
     for k, ds in datasets.items():
         fits = {}
         for n in names:
-            e = fx.EFFECTS[n]
+            e = effects.EFFECTS[n]
             if not e.resolve:
                 fits[n] = _comparison_fit(n, bases[k], ds)
             elif e.identify == "nlp":
@@ -680,7 +680,7 @@ def alternates_of(detail: dict) -> dict:
             for k, per in detail.items()}
 
 
-def _with_effects(spec0, effects) -> tr.GaitSpec:
+def _with_effects(spec0, effects) -> gait_ocp.GaitSpec:
     import dataclasses
 
     return dataclasses.replace(spec0, effects=tuple(effects))
@@ -690,7 +690,7 @@ def _comparison_fit(name: str, base_sol, ds) -> Fit:
     """Comparison-only effect: bounded scalar search of the gap on the baseline solution."""
     from scipy.optimize import minimize_scalar
 
-    e = fx.EFFECTS[name]
+    e = effects.EFFECTS[name]
     p = e.magnitude
     sim = L.sim_channels(base_sol, ds.gait.source)
 
@@ -722,7 +722,7 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
     ----------
     data : a tidy CSV (``gaitlib.data`` format; read by :func:`gaitlib.gap.io.read_data`),
         a :class:`~gaitlib.gap.io.DataSet` or a :class:`~gaitlib.data.GaitData`.
-    base : baseline :class:`~gaitlib.transcription.GaitSpec` or its fields (default
+    base : baseline :class:`~gaitlib.problems.gait.GaitSpec` or its fields (default
         :data:`DEFAULT_BASE`: SK, DT, 10 × 3 LGR); its speed class must match the data's
         speed and cycle time.
     effects : candidate names (default: every applicable effect of :data:`EFFECTS`).

@@ -50,7 +50,7 @@ from scipy.stats import norm
 
 from .. import activation
 from .. import conventions as cv
-from .. import transcription as tr
+from ..problems import gait as gait_ocp
 
 __all__ = ["PHASES", "PHASE_NAMES", "N_GRID", "phase_edges", "phase_of", "sim_channels", "Located", "locate",
            "resels", "tracking_view", "ALPHA", "SD_FLOOR"]
@@ -89,7 +89,7 @@ def _emg_map(source: str) -> dict:
     return {m: d[source] for m, d in activation.EMG_CHANNELS.items() if d.get(source)}
 
 
-def sim_channels(sol: "tr.GaitSolution", source: str = "schwartz2008") -> pd.DataFrame:
+def sim_channels(sol: "gait_ocp.GaitSolution", source: str = "schwartz2008") -> pd.DataFrame:
     """The solution's channels on normalised time τ = t / t_f (index, one period, sorted):
     angles ``hip_r`` …, net torques ``tau_hip_r`` …, GRFs ``grf_x_r`` …, pelvis tilt and,
     for NMSK (excitations) or MSK (generator activations), ``emg_<stem>_<side>`` on the
@@ -97,10 +97,10 @@ def sim_channels(sol: "tr.GaitSolution", source: str = "schwartz2008") -> pd.Dat
     tf = float(sol.stats["tf_s"])
     t = sol.q.index.to_numpy(float)
     out = {}
-    for j in tr.LEG_JOINTS:
+    for j in gait_ocp.LEG_JOINTS:
         out[j] = sol.q[j].to_numpy()
         out[f"tau_{j}"] = sol.torques[j].to_numpy()
-    for g in tr.GRF_CHANNELS:
+    for g in gait_ocp.GRF_CHANNELS:
         out[g] = sol.grf[g].to_numpy()
     out["pelvis_tilt"] = sol.q["pelvis_tilt"].to_numpy()
     for m, stem in _emg_map(source).items():
@@ -144,8 +144,8 @@ def resels(z: np.ndarray) -> float:
 def _channels(gait, sim_cols, exclude=()) -> tuple[list, list]:
     """(included, excluded) channel descriptors: dict(id, kind, name, side, col)."""
     inc, exc = [], []
-    cand = [("angle", j, j) for j in tr.LEG_JOINTS] + [("torque", j, f"tau_{j}") for j in tr.LEG_JOINTS] \
-        + [("grf", g, g) for g in tr.GRF_CHANNELS]
+    cand = [("angle", j, j) for j in gait_ocp.LEG_JOINTS] + [("torque", j, f"tau_{j}") for j in gait_ocp.LEG_JOINTS] \
+        + [("grf", g, g) for g in gait_ocp.GRF_CHANNELS]
     emg_cols = sorted(c for c in sim_cols if c.startswith("emg_"))
     cand += [("emg", c[4:], c) for c in emg_cols]
     for kind, name, col in cand:
@@ -214,10 +214,10 @@ def locate(sim, ds, thetas: dict | None = None, exclude=()) -> Located:
 
     ``thetas``: effect → parameter values of the solution's effects, for the data-model
     effects (left-leg shift, EMG timing) that change how the data are read
-    (:func:`gaitlib.gap.effects.adjust_data`). ``exclude``: model channels not to count
+    (:func:`gaitlib.effects.adjust_data`). ``exclude``: model channels not to count
     (default: those a DataSet filled from another data set).
     """
-    from . import effects as fx
+    from .. import effects
     from .io import DataSet, filled_channels
 
     n = 1
@@ -229,7 +229,7 @@ def locate(sim, ds, thetas: dict | None = None, exclude=()) -> Located:
     if not isinstance(sim, pd.DataFrame):
         sim = sim_channels(sim, gait.source)
     if thetas:
-        gait = fx.adjust_data(gait, thetas)
+        gait = effects.adjust_data(gait, thetas)
     view = tracking_view(gait)
     tau = np.arange(N_GRID) / N_GRID
     t_data = np.asarray(view.time, float) / float(view.cycle_time)

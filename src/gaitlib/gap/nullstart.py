@@ -1,7 +1,7 @@
 """The null start: re-solve a nested candidate from the baseline fit itself.
 
 A candidate effect *nests* the baseline when its null parameter values reproduce the
-baseline model exactly (every NLP-identified effect of :data:`gaitlib.gap.effects.EFFECTS`:
+baseline model exactly (every NLP-identified effect of :data:`gaitlib.effects.EFFECTS`:
 body and contact parameters scaled by 1 + 0 or shifted by 0, root loads that vanish at 0,
 the left leg's Fourier terms multiplied by cos 0 − 1 and sin 0). The baseline fit, with the
 effect's parameters at their null values, is then a feasible point of the candidate's NLP
@@ -9,9 +9,9 @@ with exactly the baseline's objective.
 
 :func:`null_start_many` starts IPOPT at that point: the baseline solution's own states,
 controls and parameters on the same mesh (:meth:`gaitlib.ocp.Guess.from_solution`; the
-ordinary warm start, :func:`gaitlib.transcription.warm_start`, passes them through the
+ordinary warm start, :func:`gaitlib.problems.gait.warm_start`, passes them through the
 data-based guess's time grid, which is not exact on the collocation nodes) and the
-effect's parameters at their NLP initial values, which :func:`gaitlib.gap.effects.bind`
+effect's parameters at their NLP initial values, which :func:`gaitlib.effects.bind`
 sets to the null values. IPOPT's initial barrier parameter and bound pushes are made small
 (:data:`NULL_START_IPOPT`) so that the start is not moved into the interior of the bounds
 (the ordinary warm start uses ``mu_init`` 1e-4 and IPOPT's default pushes of 1e-2, which
@@ -33,7 +33,7 @@ from pathlib import Path
 
 from .. import cache
 from .. import ocp
-from .. import transcription as tr
+from ..problems import gait as gait_ocp
 from .solve import FORMULATION as FIT_FORMULATION
 from .solve import Lazy, Runner, _check_same_cycle, guess_signature, solve_or_load, sweep_groups
 
@@ -53,7 +53,7 @@ def null_guess(base) -> ocp.Guess:
     """The baseline solution (GaitSolution or ocp.Solution) as an exact NLP start: its
     states, controls and parameters on its own mesh; parameters it does not have (an
     effect's) keep their NLP initial values."""
-    sol = base.solution if isinstance(base, tr.GaitSolution) else base
+    sol = base.solution if isinstance(base, gait_ocp.GaitSolution) else base
     return ocp.Guess.from_solution(sol)
 
 
@@ -62,12 +62,12 @@ def _where(spec, gait, base, root, objective) -> Path:
 
     desc = {"kind": "gap-null-start", "spec": spec.to_dict(), "data": signature(gait),
             "guess": guess_signature(base), "objective": objective, "ipopt": dict(NULL_START_IPOPT)}
-    return cache.lookup("gap", desc, root, formulation=(tr.FORMULATION, FIT_FORMULATION, FORMULATION),
+    return cache.lookup("gap", desc, root, formulation=(gait_ocp.FORMULATION, FIT_FORMULATION, FORMULATION),
                         identified=spec.identified_sets())
 
 
 def _mesh_of(sol) -> str | None:
-    info = (sol.solution.info if isinstance(sol, tr.GaitSolution) else sol.info) or {}
+    info = (sol.solution.info if isinstance(sol, gait_ocp.GaitSolution) else sol.info) or {}
     return (info.get("meshes") or {}).get("cycle")
 
 
@@ -81,7 +81,7 @@ class _NullRunner(Runner):
             self._T["null"] = ocp.transcribe(self.problem, self.gp.mesh, opts)
         return self._T["null"]
 
-    def solve_null(self, gait, base) -> tr.GaitSolution:
+    def solve_null(self, gait, base) -> gait_ocp.GaitSolution:
         _check_same_cycle(self.gp, gait)
         T = self.null_transcription()
         mesh = _mesh_of(base)
@@ -90,14 +90,14 @@ class _NullRunner(Runner):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ocp.SolveFailedWarning)
             sol = T.solve(null_guess(base), data={"cycle": self.frame(gait)})
-        out = tr.postprocess(self.gp, sol)
+        out = gait_ocp.postprocess(self.gp, sol)
         out.stats["from_cache"] = False
         out.stats["objective_kind"] = self.objective
         return out
 
 
-def null_start_on(spec: tr.GaitSpec, gait, base, *, root=None, use_cache: bool = True, objective: str = "fit",
-                  runner=None) -> tr.GaitSolution:
+def null_start_on(spec: gait_ocp.GaitSpec, gait, base, *, root=None, use_cache: bool = True, objective: str = "fit",
+                  runner=None) -> gait_ocp.GaitSolution:
     """Solve ``spec`` (the baseline spec plus free effects) tracking ``gait`` from the
     baseline solution ``base`` with the effects at their null values, or reload it."""
     runner = runner or Lazy(lambda: _NullRunner(spec, objective))

@@ -11,7 +11,7 @@ than by range-normalised costs, which otherwise pull parameters to their bounds 
 gap grows. ``objective="cost"`` keeps the spec's own cost function.
 
 A :class:`Runner` builds a spec's NLP once and re-solves it on other data sets: the
-references are NLP parameters (:func:`gaitlib.transcription.tracking_frame`), so a twin or
+references are NLP parameters (:func:`gaitlib.problems.gait.tracking_frame`), so a twin or
 a resampled data set needs no rebuild. The normalising ranges of the cost terms, the state
 bounds and the data-based part of the initial guess stay those of the spec's own data set
 (``speed_class``/``source``), which must have the same speed and cycle time; so does the
@@ -20,7 +20,7 @@ cannot be computed for every synthetic GRF).
 
 Solutions are cached under ``<root>/gap/<key>``, the key hashing the spec, the data set's
 numbers (:func:`gaitlib.gap.io.signature`), the warm start, and the formulation versions
-(:data:`gaitlib.transcription.FORMULATION` and this module's :data:`FORMULATION`).
+(:data:`gaitlib.problems.gait.FORMULATION` and this module's :data:`FORMULATION`).
 Failed solves are cached and returned as failed (their IPOPT status is the result).
 """
 
@@ -34,7 +34,7 @@ import numpy as np
 
 from .. import cache
 from .. import ocp
-from .. import transcription as tr
+from ..problems import gait as gait_ocp
 
 __all__ = ["Runner", "Lazy", "solve_on", "solve_or_load", "solve_many", "guess_signature", "FORMULATION", "OBJECTIVES", "FIT_WEIGHT",
            "fit_problem"]
@@ -50,7 +50,7 @@ REG_FACTOR = 0.1
 _KEEP = ("Jrk", "Rsd", "Imp", "Act", "Mtb")
 
 #: Version of the gap's re-solve formulation (the Fit objective, the Runner's parameters and
-#: warm starts) on top of :data:`gaitlib.transcription.FORMULATION`: part of every gap cache
+#: warm starts) on top of :data:`gaitlib.problems.gait.FORMULATION`: part of every gap cache
 #: key. Bump it when a change alters what is solved (tests/test_formulation_versions.py).
 FORMULATION = "gap-fit-1"
 
@@ -58,7 +58,7 @@ FORMULATION = "gap-fit-1"
 def guess_signature(guess) -> str | None:
     if guess is None:
         return None
-    if isinstance(guess, tr.GaitSolution):
+    if isinstance(guess, gait_ocp.GaitSolution):
         guess = guess.solution
     if isinstance(guess, ocp.Solution):
         sig = f"solution:{guess.status}:{guess.objective:.12g}:{guess.iterations}"
@@ -69,12 +69,12 @@ def guess_signature(guess) -> str | None:
     raise TypeError(f"warm start must be a GaitSolution or ocp.Solution, got {type(guess).__name__}")
 
 
-def _where(spec: tr.GaitSpec, gait, guess, root, objective="fit") -> Path:
+def _where(spec: gait_ocp.GaitSpec, gait, guess, root, objective="fit") -> Path:
     from .io import signature
 
     desc = {"kind": "gap-solve", "spec": spec.to_dict(), "data": signature(gait), "guess": guess_signature(guess),
             "objective": objective}
-    return cache.lookup("gap", desc, root, formulation=(tr.FORMULATION, FORMULATION),
+    return cache.lookup("gap", desc, root, formulation=(gait_ocp.FORMULATION, FORMULATION),
                         identified=spec.identified_sets())
 
 
@@ -86,9 +86,9 @@ def _check_same_cycle(gp, gait):
 
 
 def _fit_channels():
-    ch = [(j, "x", j) for j in tr.LEG_JOINTS]
-    ch += [(f"tau_{j}", "tau_net", tr.cv.JOINTS.index(j)) for j in tr.LEG_JOINTS]
-    ch += [(g, "grf", i) for i, g in enumerate(tr.GRF_CHANNELS)]
+    ch = [(j, "x", j) for j in gait_ocp.LEG_JOINTS]
+    ch += [(f"tau_{j}", "tau_net", gait_ocp.cv.JOINTS.index(j)) for j in gait_ocp.LEG_JOINTS]
+    ch += [(g, "grf", i) for i, g in enumerate(gait_ocp.GRF_CHANNELS)]
     return ch
 
 
@@ -137,11 +137,11 @@ def fit_problem(gp) -> ocp.Problem:
 class Runner:
     """A spec built (and transcribed, on first use) once; :meth:`solve` on any data set."""
 
-    def __init__(self, spec: tr.GaitSpec, objective: str = "fit"):
+    def __init__(self, spec: gait_ocp.GaitSpec, objective: str = "fit"):
         if objective not in OBJECTIVES:
             raise ValueError(f"objective must be one of {OBJECTIVES}, got {objective!r}")
         self.spec, self.objective = spec, objective
-        self.gp = tr.build(spec)
+        self.gp = gait_ocp.build(spec)
         self.problem = fit_problem(self.gp) if objective == "fit" else self.gp.problem
         self._T = {}
 
@@ -166,59 +166,59 @@ class Runner:
             raise ValueError("data set's time grid differs from the spec's data (load it with gaitlib.gap.io)")
         Q = kinematics.pose_from_data(self.gp.model, gait, t, self.gp.p_contact, penetration=0.002, thigh="lab")
         q = base.q.copy()
-        for c in tr.cv.JOINTS:
-            q[c] = Q[:, tr.cv.COORDS.index(c)]
-        tau = gait.mean[[f"tau_{j}" for j in tr.LEG_JOINTS]].copy()
-        tau.columns = list(tr.LEG_JOINTS)
-        grf = gait.mean[list(tr.GRF_CHANNELS)].copy()
+        for c in gait_ocp.cv.JOINTS:
+            q[c] = Q[:, gait_ocp.cv.COORDS.index(c)]
+        tau = gait.mean[[f"tau_{j}" for j in gait_ocp.LEG_JOINTS]].copy()
+        tau.columns = list(gait_ocp.LEG_JOINTS)
+        grf = gait.mean[list(gait_ocp.GRF_CHANNELS)].copy()
         deriv = dict(base.deriv)
         T = float(gait.cycle_time)
-        for c in tr.cv.JOINTS:
-            deriv[c] = tr._fourier_derivatives(q[c].to_numpy(), T, 12)
+        for c in gait_ocp.cv.JOINTS:
+            deriv[c] = gait_ocp._fourier_derivatives(q[c].to_numpy(), T, 12)
         return dataclasses.replace(base, gait=gait, q=q, tau=tau, grf=grf, deriv=deriv)
 
     def data_guess(self, gait) -> ocp.Guess:
         """The data-based initial guess (thesis Sec 4.3.2) built from ``gait``'s own curves
         (HAT: the spec's reference)."""
         gp = self.gp
-        g = tr.initial_guess(self.spec, gp.model, self.reference(gait), gp.p_body, gp.p_contact)
+        g = gait_ocp.initial_guess(self.spec, gp.model, self.reference(gait), gp.p_body, gp.p_contact)
         ph0 = gp.problem.phases[0]
         if "edot_rest" in ph0.controls:
-            g = tr._with_edot_rest_guess(g, ph0.states, ph0.controls, gp.problem.parameters, gp.functions["edot"],
+            g = gait_ocp._with_edot_rest_guess(g, ph0.states, ph0.controls, gp.problem.parameters, gp.functions["edot"],
                                          gp.t_stim)
         return g
 
     def frame(self, gait):
-        frame = tr.tracking_frame(self.spec, self.reference(gait))
+        frame = gait_ocp.tracking_frame(self.spec, self.reference(gait))
         if self.objective == "fit":
             for k, v in sd_columns(gait, frame.index.to_numpy(float)).items():
                 frame[k] = v
         return frame
 
-    def solve(self, gait, guess=None) -> tr.GaitSolution:
+    def solve(self, gait, guess=None) -> gait_ocp.GaitSolution:
         """Solve on ``gait``: from its data-based guess (``guess=None``) or warm-started
         (IPOPT ``mu_init`` :data:`MU_WARM`) from a solution."""
         _check_same_cycle(self.gp, gait)
-        g = self.data_guess(gait) if guess is None else tr.warm_start(self.gp, guess)
+        g = self.data_guess(gait) if guess is None else gait_ocp.warm_start(self.gp, guess)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ocp.SolveFailedWarning)
             sol = self.transcription(guess is not None).solve(g, data={"cycle": self.frame(gait)})
-        out = tr.postprocess(self.gp, sol)
+        out = gait_ocp.postprocess(self.gp, sol)
         out.stats["from_cache"] = False
         out.stats["objective_kind"] = self.objective
         return out
 
 
-def _load(found: Path, objective: str) -> tr.GaitSolution:
+def _load(found: Path, objective: str) -> gait_ocp.GaitSolution:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ocp.SolveFailedWarning)
-        sol = tr.GaitSolution.load(found)
+        sol = gait_ocp.GaitSolution.load(found)
     sol.stats["from_cache"] = True
     sol.stats["objective_kind"] = objective
     return sol
 
 
-def solve_or_load(where: Path, solve, *, use_cache: bool = True, objective: str = "fit") -> tr.GaitSolution:
+def solve_or_load(where: Path, solve, *, use_cache: bool = True, objective: str = "fit") -> gait_ocp.GaitSolution:
     """The solution cached at ``where`` (a :func:`gaitlib.cache.lookup` result), or
     ``solve()``'s, then stored there (atomically, :func:`gaitlib.cache.save`)."""
     found = cache.find(where, "spec.json") if use_cache else None
@@ -243,8 +243,8 @@ class Lazy:
         return getattr(self._obj, name)
 
 
-def solve_on(spec: tr.GaitSpec, gait, guess=None, *, root=None, use_cache: bool = True,
-             runner: Runner | None = None, objective: str = "fit") -> tr.GaitSolution:
+def solve_on(spec: gait_ocp.GaitSpec, gait, guess=None, *, root=None, use_cache: bool = True,
+             runner: Runner | None = None, objective: str = "fit") -> gait_ocp.GaitSolution:
     """Solve ``spec`` tracking ``gait`` (a GaitData) with ``objective``, warm-started from
     ``guess``, or reload it from the cache."""
     runner = runner or Lazy(lambda: Runner(spec, objective))

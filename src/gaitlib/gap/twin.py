@@ -30,10 +30,10 @@ import pandas as pd
 
 from .. import conventions as cv
 from .. import data as data_mod
-from .. import transcription as tr
+from ..problems import gait as gait_ocp
 from . import io as gio
 from . import locate as L
-from .effects import EFFECTS
+from ..effects import EFFECTS
 
 __all__ = ["NOISE_LENGTH", "smooth_noise", "twin_spec", "twin_frame", "make_twin", "write_twin", "DEFAULT_BASE"]
 
@@ -64,17 +64,17 @@ def smooth_noise(rng: np.random.Generator, n_curves: int, length: float = NOISE_
     return f
 
 
-def twin_spec(effects: tuple, base: dict | None = None) -> tr.GaitSpec:
+def twin_spec(effects: tuple, base: dict | None = None) -> gait_ocp.GaitSpec:
     """The spec that generates a twin: the baseline with ``effects`` ((name, magnitude), …)."""
     base = dict(DEFAULT_BASE if base is None else base)
-    return tr.GaitSpec(**base, effects=tuple(effects))
+    return gait_ocp.GaitSpec(**base, effects=tuple(effects))
 
 
 _ANGLE_Q = {"hip": "hip_flexion", "knee": "knee_flexion", "ankle": "ankle_dorsiflexion"}
 _MOMENT_Q = {"hip": "hip_extensor_moment", "knee": "knee_extensor_moment", "ankle": "ankle_plantarflexor_moment"}
 
 
-def twin_frame(sol: tr.GaitSolution, real: gio.DataSet, seed: int | None, *, noise: bool = True,
+def twin_frame(sol: gait_ocp.GaitSolution, real: gio.DataSet, seed: int | None, *, noise: bool = True,
                length: float = NOISE_LENGTH) -> pd.DataFrame:
     """The tidy rows of a twin from a solved model (both legs, sides ``R``/``L``; 51 points;
     data units and signs).
@@ -199,7 +199,7 @@ def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), 
 
     effects = tuple(effects or TWIN_EFFECTS_DEFAULT())
     base = dict(DEFAULT_BASE if base is None else base)
-    spec0 = tr.GaitSpec(**base)
+    spec0 = gait_ocp.GaitSpec(**base)
     real = real or gio.load_real(spec0.speed_class, spec0.source)
     mags = {e: tuple(magnitudes[e]) if magnitudes and e in magnitudes else EFFECTS[e].twin_magnitudes for e in effects}
     # 1. generate: one solve per (effect, magnitude) and the effect-free one
@@ -278,7 +278,7 @@ def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), 
 
 
 def TWIN_EFFECTS_DEFAULT():
-    from .effects import TWIN_EFFECTS
+    from ..effects import TWIN_EFFECTS
 
     return TWIN_EFFECTS
 

@@ -48,7 +48,7 @@ from .. import cache
 from .. import conventions as cv
 from .. import data as data_mod
 from .. import ocp
-from .. import transcription as tr
+from ..problems import gait as gait_ocp
 
 __all__ = ["COLUMNS", "VERDICTS", "REL_TOL", "ABS_TOL", "RULE", "verdict", "Row", "StoredGait", "stored_gait",
            "gate", "build", "counts", "write", "PHYSIOLOGICAL_JUMP_RISE_M"]
@@ -166,13 +166,13 @@ _FRAMES = ("q", "qd", "torques", "torques_active", "residuals", "grf", "ellipsoi
 class StoredGait:
     """A stored gait solution read from its entry (``spec.json``, ``summary.json``, the frames
     and the raw ``ocp/`` solution) without rebuilding the NLP: the attributes of
-    :class:`gaitlib.transcription.GaitSolution` the card and the gates read (``spec``,
+    :class:`gaitlib.problems.gait.GaitSolution` the card and the gates read (``spec``,
     ``stats``, ``solution``, ``q``, ``torques``, ``grf``, ``rmse`` …; frames absent from the
     entry are None). ``path``: the entry."""
 
     def __init__(self, path: Path):
         self.path = Path(path)
-        self.spec = tr.GaitSpec.from_dict(json.loads((self.path / "spec.json").read_text()))
+        self.spec = gait_ocp.GaitSpec.from_dict(json.loads((self.path / "spec.json").read_text()))
         summary = json.loads((self.path / "summary.json").read_text())
         self.stats = summary["stats"]
         self.solution = ocp.Solution.load(self.path / "ocp")

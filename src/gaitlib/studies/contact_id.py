@@ -68,7 +68,7 @@ from .. import conventions as cv
 from .. import data as data_mod
 from .. import ocp
 from .. import params as params_mod
-from .. import transcription as tr
+from ..problems import gait as gait_ocp
 from ..model import P_BODY_NAMES, P_BODY_UNITS, ChildModel
 from . import gait
 
@@ -86,7 +86,7 @@ __all__ = [
 #: Version of approach (a)'s trajectory-optimisation problem (:class:`InverseDynamicsID`, its
 #: multistart and solver options): part of its cache keys.
 TRAJOPT_FORMULATION = "contact-trajopt-1"
-#: Version of approaches (b)/(c) on top of :data:`gaitlib.transcription.FORMULATION` (their
+#: Version of approaches (b)/(c) on top of :data:`gaitlib.problems.gait.FORMULATION` (their
 #: starts, guesses and continuation): part of their cache keys. Bump either when a change
 #: alters what is solved (tests/test_formulation_versions.py).
 FORMULATION = "contact-id-1"
@@ -255,7 +255,7 @@ class InverseDynamicsID:
         self.spec = spec
         self.model = ChildModel()
         self.gait = data_mod.load_gait_data(spec.speed_class, spec.source)
-        self.ref = tr.reference(self.gait, self.model, contact_mod.default_params())
+        self.ref = gait_ocp.reference(self.gait, self.model, contact_mod.default_params())
         T = self.gait.cycle_time
         N = spec.n_time
         self.t = np.arange(N) * T / N
@@ -265,10 +265,10 @@ class InverseDynamicsID:
         self.QDD = np.array([d[c][2] for c in cv.COORDS])
         self.p_body = self.model.default_p_body()
         g = self.gait
-        self.tau_data = np.array([np.interp(self.t, g.time, g.mean[f"tau_{j}"]) for j in tr.LEG_JOINTS])
-        self.grf_data = np.array([np.interp(self.t, g.time, g.mean[c]) for c in tr.GRF_CHANNELS])
-        self.tau_range = np.array([self.ref.ranges[f"tau_{j}"] for j in tr.LEG_JOINTS])
-        self.grf_range = np.array([self.ref.ranges[c] for c in tr.GRF_CHANNELS])
+        self.tau_data = np.array([np.interp(self.t, g.time, g.mean[f"tau_{j}"]) for j in gait_ocp.LEG_JOINTS])
+        self.grf_data = np.array([np.interp(self.t, g.time, g.mean[c]) for c in gait_ocp.GRF_CHANNELS])
+        self.tau_range = np.array([self.ref.ranges[f"tau_{j}"] for j in gait_ocp.LEG_JOINTS])
+        self.grf_range = np.array([self.ref.ranges[c] for c in gait_ocp.GRF_CHANNELS])
         self.lo, self.hi = contact_mod.bounds()
         self.log = np.zeros(39, bool)
         for e in cv.ELLIPSOIDS:
@@ -308,7 +308,7 @@ class InverseDynamicsID:
         ct = dict(zip(self.model.function("contact").name_out(), f_ct(self.Q, self.QD, P)))
         grf = ca.vertcat(ct["grf_x"][0, :], ct["grf_y"][0, :], ct["grf_x"][1, :], ct["grf_y"][1, :])
         net = tau + f_pas(self.Q, self.QD, self.p_body)
-        rows = [cv.JOINTS.index(j) for j in tr.LEG_JOINTS]
+        rows = [cv.JOINTS.index(j) for j in gait_ocp.LEG_JOINTS]
         e_tau = (net[rows, :] - ca.DM(self.tau_data)) / ca.repmat(ca.DM(self.tau_range), 1, N)
         e_grf = (grf - ca.DM(self.grf_data)) / ca.repmat(ca.DM(self.grf_range), 1, N)
         j_trq = ca.sumsqr(e_tau) / N
@@ -401,7 +401,7 @@ class InverseDynamicsID:
         q = pd.DataFrame(self.Q.T, index=idx, columns=list(cv.COORDS))
         torques = pd.DataFrame(net.T, index=idx, columns=list(cv.JOINTS))
         residuals = pd.DataFrame(R.T, index=idx, columns=list(cv.RESIDUALS))
-        grf_f = pd.DataFrame(grf.T, index=idx, columns=list(tr.GRF_CHANNELS))
+        grf_f = pd.DataFrame(grf.T, index=idx, columns=list(gait_ocp.GRF_CHANNELS))
         ell = {}
         for i, lab in enumerate(ELLIPSOID_LABELS):
             ell[f"fn_{lab}"] = fn[i]
@@ -427,11 +427,11 @@ class ApproachResult:
     q, torques, residuals, grf, ellipsoids : frames indexed by time (s): coordinates,
         net joint torques (N·m), pelvis residual loads (N, N, N·m), foot forces (N),
         per-ellipsoid normal and friction forces (N).
-    rmse : RMSE per channel (format of :attr:`gaitlib.transcription.GaitSolution.rmse`).
+    rmse : RMSE per channel (format of :attr:`gaitlib.problems.gait.GaitSolution.rmse`).
     stats : ``status``, ``success``, ``iterations``, ``wall_s`` (build + solve),
         ``solve_s``, ``time_per_iteration_s``, ``objective``, ``eq4_5`` (the Eq 4.5 part:
         ¼ Trq + ¼ GRF), ``from_cache``; (a) also ``n_local``, ``n_trial``, ``best_start``.
-    solution : the :class:`~gaitlib.transcription.GaitSolution` of (b)/(c), else None.
+    solution : the :class:`~gaitlib.problems.gait.GaitSolution` of (b)/(c), else None.
     starts : (a) one row per local solve (start, score at start, cost, status, iterations, s).
     stages : (b)/(c) one row per solve on the way (continuation stages, then the problem
         itself): residual bounds, cost terms, status, iterations, times.
@@ -447,7 +447,7 @@ class ApproachResult:
     ellipsoids: pd.DataFrame
     rmse: pd.DataFrame
     stats: dict
-    solution: tr.GaitSolution | None = None
+    solution: gait_ocp.GaitSolution | None = None
     starts: pd.DataFrame | None = None
     stages: pd.DataFrame | None = None
 
@@ -466,12 +466,12 @@ class ApproachResult:
         for c in cv.JOINTS:
             out[c] = self.q[c]
             out[f"tau_{c}"] = self.torques[c]
-        for g in tr.GRF_CHANNELS:
+        for g in gait_ocp.GRF_CHANNELS:
             out[g] = self.grf[g]
         return out
 
 
-def _result_from_gait(key: str, sol: tr.GaitSolution) -> ApproachResult:
+def _result_from_gait(key: str, sol: gait_ocp.GaitSolution) -> ApproachResult:
     gp_spec = sol.spec
     pars = sol.solution.parameters
     pc = np.array([pars[f"c.{n}"] for n in contact_mod.param_names()])
@@ -540,7 +540,7 @@ def _result_a(prob: InverseDynamicsID, rec: dict, from_cache: bool) -> ApproachR
     best = min(pool, key=lambda i: rows[i]["cost"])
     p = np.array(rows[best]["p"])
     fr = prob.frames(p)
-    rmse = tr._rmse_table(fr["q"], fr["torques"], fr["grf"], prob.ref)
+    rmse = gait_ocp._rmse_table(fr["q"], fr["torques"], fr["grf"], prob.ref)
     c = prob.cost_function(p)
     its = int(sum(r["iterations"] for r in rows))
     solve_s = float(sum(r["time (s)"] for r in rows))
@@ -555,20 +555,20 @@ def _result_a(prob: InverseDynamicsID, rec: dict, from_cache: bool) -> ApproachR
                           fr["ellipsoids"], rmse, stats, starts=starts)
 
 
-def spec_b(n_intervals: int = 20, degree: int = 5, contact_bounds: str = "table4.7", **kw) -> tr.GaitSpec:
+def spec_b(n_intervals: int = 20, degree: int = 5, contact_bounds: str = "table4.7", **kw) -> gait_ocp.GaitSpec:
     """Approach (b): SK, Eq 4.11 (Table 4.8 weights), 39 contact parameters free within
     Table 4.7 verbatim and Eq 4.4; Eq 4.8 residual bounds; thesis mesh 20 × 5 LGR."""
-    return tr.GaitSpec(model="SK", cost="Eq4.11", free_contact=True, contact_bounds=contact_bounds,
+    return gait_ocp.GaitSpec(model="SK", cost="Eq4.11", free_contact=True, contact_bounds=contact_bounds,
                        n_intervals=n_intervals, degree=degree, **kw)
 
 
-def spec_c(n_intervals: int = 20, degree: int = 5, contact_bounds: str = "table4.7", **kw) -> tr.GaitSpec:
+def spec_c(n_intervals: int = 20, degree: int = 5, contact_bounds: str = "table4.7", **kw) -> gait_ocp.GaitSpec:
     """Approach (c): (b) + the 25 body/joint parameters free (Table 4.14), per-ellipsoid
     normal force ≥ 0 (Sec 4.4.1), cost Eq 4.13 (Eq 4.11 + Imp Eq 4.12 + Rsd Eq 4.13,
     w5 = w6 = 1/4). ``contact_bounds="widened"``: Table 4.7 widened to contain the thesis's
     own (c) values (Table 4.17, five of which lie outside Table 4.7 — the bounds the thesis
     must have used in Sec 4.4, unreported)."""
-    return tr.GaitSpec(model="SK", cost="Eq4.13", free_contact=True, free_body=True,
+    return gait_ocp.GaitSpec(model="SK", cost="Eq4.13", free_contact=True, free_body=True,
                        normal_force_constraint=True, contact_bounds=contact_bounds,
                        n_intervals=n_intervals, degree=degree, **kw)
 
@@ -578,8 +578,8 @@ def spec_c(n_intervals: int = 20, degree: int = 5, contact_bounds: str = "table4
 GUESS_METHOD = "data-based guess of the spec (states, jerks, data torques, zero residuals) + start parameters (v1)"
 
 
-def _solve_gait_cached(spec: tr.GaitSpec, start: dict, warm: tr.GaitSolution | None, use_cache: bool, root,
-                       progress: bool = False) -> tr.GaitSolution:
+def _solve_gait_cached(spec: gait_ocp.GaitSpec, start: dict, warm: gait_ocp.GaitSolution | None, use_cache: bool, root,
+                       progress: bool = False) -> gait_ocp.GaitSolution:
     """Solve ``spec`` from the data-based guess with the parameters ``start`` (name → value)
     or warm-started from ``warm``; cached on spec + start + warm start's identity + code."""
     desc = {"kind": "contact_id_gait", **spec.to_dict(), "guess": GUESS_METHOD,
@@ -588,20 +588,20 @@ def _solve_gait_cached(spec: tr.GaitSpec, start: dict, warm: tr.GaitSolution | N
         ws = warm.solution
         desc["warm_start"] = {"spec": warm.spec.to_dict(), "status": ws.status,
                               "objective": float(f"{ws.objective:.12g}"), "iterations": ws.iterations}
-    where = cache.lookup("contact_id", desc, root, formulation=(tr.FORMULATION, FORMULATION),
+    where = cache.lookup("contact_id", desc, root, formulation=(gait_ocp.FORMULATION, FORMULATION),
                          identified=spec.identified_sets())
     sol = gait.load_cached(where) if use_cache else None
     if sol is not None:
         return sol
-    gp = tr.build(spec)
+    gp = gait_ocp.build(spec)
     if warm is not None:
-        g = tr.warm_start(gp, warm)
+        g = gait_ocp.warm_start(gp, warm)
         guess = ocp.Guess(phases=g.phases, parameters={**dict(g.parameters), **start})
     else:
         guess = ocp.Guess(phases=gp.guess.phases, parameters=dict(start))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ocp.SolveFailedWarning)
-        sol = tr.solve(gp, guess=guess, progress=progress)
+        sol = gait_ocp.solve(gp, guess=guess, progress=progress)
     if use_cache:
         cache.save(where, sol.save)
     sol.stats["from_cache"] = False
@@ -614,12 +614,12 @@ def _solve_gait_cached(spec: tr.GaitSpec, start: dict, warm: tr.GaitSolution | N
 CONTINUATION = ((1000.0, 1000.0, 100.0), (100.0, 100.0, 10.0), (10.0, 10.0, 1.0))
 
 
-def _stage_spec(spec: tr.GaitSpec, bounds) -> tr.GaitSpec:
+def _stage_spec(spec: gait_ocp.GaitSpec, bounds) -> gait_ocp.GaitSpec:
     w = tuple(spec.weights) if "Rsd" in spec.term_weights else tuple(spec.weights) + (("Rsd", 0.25),)
     return dataclasses.replace(spec, residual_bounds=tuple(float(b) for b in bounds), weights=w)
 
 
-def _continuation(spec: tr.GaitSpec, start: dict, warm, stages, use_cache, root, progress):
+def _continuation(spec: gait_ocp.GaitSpec, start: dict, warm, stages, use_cache, root, progress):
     """Solve the ``stages`` (residual bounds) then ``spec`` itself, each warm-started from the
     previous solution (whatever its status: every stage's status is kept and reported)."""
     sols = []
@@ -632,7 +632,7 @@ def _continuation(spec: tr.GaitSpec, start: dict, warm, stages, use_cache, root,
     return final, sols
 
 
-def _stages_frame(stages: list, final: tr.GaitSolution) -> pd.DataFrame:
+def _stages_frame(stages: list, final: gait_ocp.GaitSolution) -> pd.DataFrame:
     rows = []
     for s in list(stages) + [final]:
         st = s.stats
@@ -658,7 +658,7 @@ def _with_stages(res: ApproachResult, stages: list) -> ApproachResult:
     return res
 
 
-def optimal_control(spec: tr.GaitSpec | None = None, start=None, stages=CONTINUATION, *, use_cache: bool = True,
+def optimal_control(spec: gait_ocp.GaitSpec | None = None, start=None, stages=CONTINUATION, *, use_cache: bool = True,
                     root=None, progress: bool = False) -> ApproachResult:
     """Approach (b) (Sec 4.3.2): :func:`spec_b` from the data-based guess (Sec 4.3.2) with
     the contact parameters starting at ``start`` (39,) SI (default :func:`neutral_start`),
@@ -672,7 +672,7 @@ def optimal_control(spec: tr.GaitSpec | None = None, start=None, stages=CONTINUA
     return _with_stages(_result_from_gait("b", final), sols)
 
 
-def optimal_control_body(spec: tr.GaitSpec | None = None, warm: ApproachResult | None = None, start=None, *,
+def optimal_control_body(spec: gait_ocp.GaitSpec | None = None, warm: ApproachResult | None = None, start=None, *,
                          use_cache: bool = True, root=None, progress: bool = False) -> ApproachResult:
     """Approach (c) (Sec 4.4): :func:`spec_c`, warm-started from (b)'s solution ``warm``
     (states, controls, contact parameters; body parameters from their Sec 4.1.1 values), or
@@ -712,7 +712,7 @@ def _kinematics(res: ApproachResult):
     t = res.q.index.to_numpy(dtype=float)
     if res.solution is None:  # (a): the fixed reference kinematics of the problem
         gait = data_mod.load_gait_data("Free")
-        ref = tr.reference(gait, ChildModel(), contact_mod.default_params())
+        ref = gait_ocp.reference(gait, ChildModel(), contact_mod.default_params())
         d = {c: ref.deriv[c](t) for c in cv.COORDS}
         return t, *(np.array([d[c][k] for c in cv.COORDS]) for k in range(3))
     X = res.solution.solution.phase("cycle").interpolate(t)
@@ -829,9 +829,9 @@ def grf_fit(results: dict[str, ApproachResult]) -> pd.DataFrame:
     for k, res in results.items():
         r = res.rmse.set_index("channel")["rmse"]
         row = {"approach": APPROACHES[k]}
-        for g in tr.GRF_CHANNELS:
+        for g in gait_ocp.GRF_CHANNELS:
             row[f"{g} (N)"] = float(r[g])
-        row["mean GRF RMSE (N)"] = float(np.mean([r[g] for g in tr.GRF_CHANNELS]))
+        row["mean GRF RMSE (N)"] = float(np.mean([r[g] for g in gait_ocp.GRF_CHANNELS]))
         row["GRF term (Eq 4.5, unweighted)"] = res.stats["goals"].get("GRF", np.nan)
         rows.append(row)
     return pd.DataFrame(rows).set_index("approach")
@@ -975,7 +975,7 @@ def save_identified(res: ApproachResult, path=None) -> Path:
             "data": "Schwartz et al. 2008, Free speed class (data/schwartz2008_curves.csv), both legs",
             "spec": res.solution.spec.to_dict(),
             "gaitlib_version": __version__,
-            "cache_fingerprint": cache.fingerprint((tr.FORMULATION, FORMULATION),
+            "cache_fingerprint": cache.fingerprint((gait_ocp.FORMULATION, FORMULATION),
                                                    identified=res.solution.spec.identified_sets()),
             "spec_key": res.solution.stats.get("spec_key"),
             "ipopt_status": st["status"],

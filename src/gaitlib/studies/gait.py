@@ -2,7 +2,7 @@
 
 Functions
 ---------
-:func:`solve_cached`   solve a :class:`~gaitlib.transcription.GaitSpec`, or reload the
+:func:`solve_cached`   solve a :class:`~gaitlib.problems.gait.GaitSpec`, or reload the
                        solution stored under its key (spec + code + data hash).
 :func:`natural_gait`   the Free-speed data-tracking solve of a model (SK: Eq 4.11 with the
                        contact parameters free, as Sec 4.3.2; MSK: Eq 5.33; NMSK: Eq 5.55).
@@ -25,7 +25,7 @@ import pandas as pd
 from .. import cache
 from .. import conventions as cv
 from .. import ocp
-from .. import transcription as tr
+from ..problems import gait as gait_ocp
 
 __all__ = ["THESIS_RMSE", "solve_cached", "natural_gait", "natural_gait_spec", "rmse_beside_thesis",
            "channels_frame", "sims_and_marks", "write_outputs", "stats_table", "tracking_data"]
@@ -55,17 +55,17 @@ THESIS_TABLE = {"SK": "thesis, Table 4.9 (optimal control)", "MSK": "thesis, Tab
                 "NMSK": "thesis, Table 5.11"}
 
 
-def cache_dir(spec: tr.GaitSpec, *, guess=None, root=None) -> Path:
+def cache_dir(spec: gait_ocp.GaitSpec, *, guess=None, root=None) -> Path:
     """Where :func:`solve_cached` stores (or finds) the solution of ``spec`` from ``guess``:
     keyed by the spec, the warm start's identity, the gait formulation's version and the
     data and identified sets the spec reads."""
     desc = {"kind": "gait", **spec.to_dict()}
     if guess is not None:
         desc["warm_start"] = _guess_signature(guess)
-    return cache.lookup("gait", desc, root, formulation=tr.FORMULATION, identified=spec.identified_sets())
+    return cache.lookup("gait", desc, root, formulation=gait_ocp.FORMULATION, identified=spec.identified_sets())
 
 
-def load_cached(where) -> tr.GaitSolution | None:
+def load_cached(where) -> gait_ocp.GaitSolution | None:
     """The gait solution stored at a :func:`gaitlib.cache.lookup` directory (or the same
     entry in the repository's store), with ``stats["from_cache"] = True``; None if absent.
     A failed solve reloads as failed (its warning silenced: the status is the result)."""
@@ -74,14 +74,14 @@ def load_cached(where) -> tr.GaitSolution | None:
         return None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ocp.SolveFailedWarning)
-        sol = tr.GaitSolution.load(found)
+        sol = gait_ocp.GaitSolution.load(found)
     sol.stats["from_cache"] = True
     sol.stats["cache_path"] = str(found)
     return sol
 
 
-def solve_cached(spec: tr.GaitSpec, *, use_cache: bool = True, root=None, guess=None,
-                 progress: bool = False) -> tr.GaitSolution:
+def solve_cached(spec: gait_ocp.GaitSpec, *, use_cache: bool = True, root=None, guess=None,
+                 progress: bool = False) -> gait_ocp.GaitSolution:
     """Solve ``spec`` or reload it from the cache (never a stale entry: the key hashes the
     spec, the library's sources and the data). Failed solves are stored and reloaded as
     failed — their status is the result. ``guess``: a :class:`~gaitlib.ocp.Guess` or
@@ -91,7 +91,7 @@ def solve_cached(spec: tr.GaitSpec, *, use_cache: bool = True, root=None, guess=
     sol = load_cached(where) if use_cache else None
     if sol is not None:
         return sol
-    sol = tr.solve(spec, guess=guess, progress=progress)
+    sol = gait_ocp.solve(spec, guess=guess, progress=progress)
     if use_cache:
         cache.save(where, sol.save)
     sol.stats["from_cache"] = False
@@ -99,7 +99,7 @@ def solve_cached(spec: tr.GaitSpec, *, use_cache: bool = True, root=None, guess=
 
 
 def _guess_signature(guess) -> str:
-    if isinstance(guess, tr.GaitSolution):
+    if isinstance(guess, gait_ocp.GaitSolution):
         guess = guess.solution
     if isinstance(guess, ocp.Solution):
         sig = f"solution:{guess.status}:{guess.objective:.12g}:{guess.iterations}"
@@ -110,21 +110,21 @@ def _guess_signature(guess) -> str:
     return f"guess:{id(guess)}"
 
 
-def natural_gait_spec(model: str = "SK", cost: str | None = None, speed: str = "Free", **kw) -> tr.GaitSpec:
+def natural_gait_spec(model: str = "SK", cost: str | None = None, speed: str = "Free", **kw) -> gait_ocp.GaitSpec:
     """The natural-gait data-tracking spec: SK → Eq 4.11 (Table 4.8 weights, Sec 4.3.2),
     MSK → Eq 5.33 (Table 5.3), NMSK → Eq 5.55 (Table 5.9), all with the thesis's identified
     contact parameters fixed (Tables 4.17/4.18) unless ``free_contact=True`` (the
     identification of Ch 4)."""
     if cost is None:
         cost = {"SK": "Eq4.11", "MSK": "Eq5.33", "NMSK": "Eq5.55"}.get(model, "Eq5.33")
-    return tr.GaitSpec(model=model, cost=cost, speed_class=speed, **kw)
+    return gait_ocp.GaitSpec(model=model, cost=cost, speed_class=speed, **kw)
 
 
 def tracking_data(gait):
     """The data as the gait problem tracks them: the hip channels become the thigh's angle
     in the laboratory (data hip + data pelvic tilt, model signs; SD unchanged), because the
     model's HAT is upright while the data's pelvis tilts ≈ 11° forward
-    (:mod:`gaitlib.transcription`, :func:`gaitlib.kinematics.pose_from_data`)."""
+    (:mod:`gaitlib.problems.gait`, :func:`gaitlib.kinematics.pose_from_data`)."""
     import dataclasses
 
     mean = gait.mean.copy()
@@ -135,13 +135,13 @@ def tracking_data(gait):
 
 
 def natural_gait(model: str = "SK", cost: str | None = None, speed: str = "Free", *, use_cache: bool = True,
-                 root=None, guess=None, progress: bool = False, **kw) -> tr.GaitSolution:
+                 root=None, guess=None, progress: bool = False, **kw) -> gait_ocp.GaitSolution:
     """Solve (or reload) :func:`natural_gait_spec`; keyword arguments go to the spec."""
     return solve_cached(natural_gait_spec(model, cost, speed, **kw), use_cache=use_cache, root=root,
                         guess=guess, progress=progress)
 
 
-def rmse_beside_thesis(sol: tr.GaitSolution) -> pd.DataFrame:
+def rmse_beside_thesis(sol: gait_ocp.GaitSolution) -> pd.DataFrame:
     """Our RMSE per channel (angles deg, torques N·m, GRFs N) beside the thesis's table
     for the same model (NaN where the thesis did not report a channel)."""
     ref = THESIS_RMSE[sol.spec.model]
@@ -155,14 +155,14 @@ def rmse_beside_thesis(sol: tr.GaitSolution) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def channels_frame(sol: tr.GaitSolution) -> pd.DataFrame:
+def channels_frame(sol: gait_ocp.GaitSolution) -> pd.DataFrame:
     """The solution on the data's channel names (SI, model signs; index time s): joint
     angles ``hip_r`` …, torques ``tau_hip_r`` …, and foot forces ``grf_x_r`` …"""
     out = pd.DataFrame(index=sol.q.index)
     for c in cv.JOINTS:
         out[c] = sol.q[c]
         out[f"tau_{c}"] = sol.torques[c]
-    for g in tr.GRF_CHANNELS:
+    for g in gait_ocp.GRF_CHANNELS:
         out[g] = sol.grf[g]
     out["pelvis_tilt"] = sol.q["pelvis_tilt"]
     return out
@@ -194,7 +194,7 @@ def stats_table(solutions: dict) -> pd.DataFrame:
     return pd.DataFrame(rows).set_index("run")
 
 
-def write_outputs(sol: tr.GaitSolution, out, figures: bool = True) -> Path:
+def write_outputs(sol: gait_ocp.GaitSolution, out, figures: bool = True) -> Path:
     """Write ``sol`` (frames, ``summary.json``, ``rmse_vs_thesis.csv``) and, with
     ``figures``, ``tracking.png`` (angles, torques, GRFs vs the data's ±1 SD bands; a solve
     that did not converge is marked in it, :mod:`gaitlib.marks`)."""

@@ -40,7 +40,7 @@ from .. import data as data_mod
 from .. import metabolics
 from .. import mtg
 from .. import params as params_mod
-from .. import transcription as tr
+from ..problems import gait as gait_ocp
 from . import gait as sg
 
 __all__ = ["EMG_MAP", "THESIS_TABLE_5_10", "THESIS_COT", "THESIS_HOURS", "parameter_sets", "ch5_spec", "solve",
@@ -78,7 +78,7 @@ def parameter_sets() -> dict[str, str]:
             "mtg_params": "ch5"}
 
 
-def ch5_spec(model: str = "MSK", **kw) -> tr.GaitSpec:
+def ch5_spec(model: str = "MSK", **kw) -> gait_ocp.GaitSpec:
     """The Ch 5 data-tracking spec of ``model``: MSK → Eq 5.33 (Table 5.3); NMSK → Eq 5.55
     (Table 5.9) with the activation parameters identified (``free_activation``, Eq 5.53,
     Table 5.10 initial values), the EMG guess (Sec 5.3.4) and at most 3,000 iterations. Parameter sets from
@@ -95,14 +95,14 @@ def ch5_spec(model: str = "MSK", **kw) -> tr.GaitSpec:
 _NMSK_ONLY = ("free_activation", "excitation_guess", "t_stim", "cost", "weights", "max_iter")
 
 
-def solve(model: str = "MSK", *, guess: str = "msk", root=None, progress: bool = False, **kw) -> tr.GaitSolution:
+def solve(model: str = "MSK", *, guess: str = "msk", root=None, progress: bool = False, **kw) -> gait_ocp.GaitSolution:
     """Solve or reload :func:`ch5_spec` (solution cache keyed by spec, code, data and guess).
 
     MSK: from the data-based guess (Sec 5.2.1). NMSK: ``guess="msk"`` (default) — warm
     start from the Ch 5 MSK solution (solved or reloaded first with the same ``kw``): its
     states, jerks, residuals and metatarsal torques, its MTG activations turned into
     excitations through the inverted activation dynamics for GM, VM, SOL and PL, and the
-    delayed Schwartz EMG for RF, BF, GAM and TA (:func:`gaitlib.transcription.warm_start`);
+    delayed Schwartz EMG for RF, BF, GAM and TA (:func:`gaitlib.problems.gait.warm_start`);
     ``guess="data"`` — the thesis's guess (Sec 5.3.4: states from the data, excitations from
     the EMG where we have it). Measured here (2026-11-22, 2 shared cores under load, body
     "thesis", contact "default", MTG "ch5"): from ``"data"`` IPOPT needed 2,093 iterations
@@ -170,7 +170,7 @@ def emg_reference(speed_class: str = "Free") -> dict:
             "gaitutils_scale": k, "gaitutils_kind": kind}
 
 
-def excitation_scores(sol: tr.GaitSolution) -> pd.DataFrame:
+def excitation_scores(sol: gait_ocp.GaitSolution) -> pd.DataFrame:
     """Predicted excitations e(t) (NMSK) against the EMG, per muscle (both legs pooled):
     Pearson correlation of the time courses (shape; for gaitutils's on/off windows, of the
     timing) and mean levels, for each source; the share of the cycle inside the Schwartz
@@ -219,7 +219,7 @@ def excitation_scores(sol: tr.GaitSolution) -> pd.DataFrame:
     return pd.DataFrame(rows).set_index("muscle")
 
 
-def excitation_figure(sol: tr.GaitSolution, side: str = "r"):
+def excitation_figure(sol: gait_ocp.GaitSolution, side: str = "r"):
     """Thesis Fig 5.11: predicted excitations e(t) of one leg's eight muscles, with the
     Schwartz EMG (mean ± 1 SD) where it has the muscle and the scaled gaitutils envelope."""
     import matplotlib.pyplot as plt
@@ -262,13 +262,13 @@ def excitation_figure(sol: tr.GaitSolution, side: str = "r"):
 # --------------------------------------------------------------------------------------
 
 
-def activation_table(sol: tr.GaitSolution) -> pd.DataFrame:
+def activation_table(sol: gait_ocp.GaitSolution) -> pd.DataFrame:
     """τ_act (s), c3, s1, s2: Table 5.10's initial values, ours (identified when the spec
     frees them), the thesis's identified values (labelled), the bounds (Sec 5.3.4) and
     whether ours sit at a bound (within 1 % of the range)."""
     ours = sol.stats["activation_parameters"]
     rows = []
-    for k in tr.ACTIVATION_PARAMS:
+    for k in gait_ocp.ACTIVATION_PARAMS:
         lo, hi = activation.ACTIVATION_BOUNDS[k]
         v = ours[k]
         at = "lower" if v - lo < 0.01 * (hi - lo) else ("upper" if hi - v < 0.01 * (hi - lo) else "")
@@ -278,7 +278,7 @@ def activation_table(sol: tr.GaitSolution) -> pd.DataFrame:
     return pd.DataFrame(rows).set_index("parameter")
 
 
-def synergy_cost_table(sol: tr.GaitSolution | None = None) -> pd.DataFrame:
+def synergy_cost_table(sol: gait_ocp.GaitSolution | None = None) -> pd.DataFrame:
     """Why the synergy weights s1, s2 (Eq 5.54) run to a corner: for a given ankle-extensor
     activation A = s1 a_SOL + s2 a_PL + (1 − s1 − s2) a_GAM, the least Act cost
     a_SOL² + a_PL² + a_GAM² (Eq 5.55's fifth term) is A² / |w|² with w = (s1, s2, 1 − s1 − s2)
@@ -299,23 +299,23 @@ def synergy_cost_table(sol: tr.GaitSolution | None = None) -> pd.DataFrame:
     return pd.DataFrame(out).set_index("weights")
 
 
-def saturation(sol: tr.GaitSolution, level: float = 0.99) -> pd.Series:
+def saturation(sol: gait_ocp.GaitSolution, level: float = 0.99) -> pd.Series:
     """Share of nodes at which each of the 12 generator activations is ≥ ``level``."""
     return (sol.activations >= level).mean()
 
 
-def _recompute_edot(sol: tr.GaitSolution, **kw) -> dict:
+def _recompute_edot(sol: gait_ocp.GaitSolution, **kw) -> dict:
     """Ė (W) of an NMSK solution's trajectory with :func:`gaitlib.metabolics.nmsk_metabolic_rate`
     options ``kw`` (e.g. ``isometric_torque="bhargava"``), at the control nodes."""
     U = sol.solution.phase("cycle").controls
     q = {j: sol.q[j].to_numpy() for j in cv.JOINTS}
     qd = {j: sol.qd[j].to_numpy() for j in cv.JOINTS}
-    ed = {m: U[f"ed_{m}"].to_numpy() for m in tr.NMSK_MUSCLES}
-    am = {m: sol.muscle_activations[m].to_numpy() for m in tr.NMSK_MUSCLES}
+    ed = {m: U[f"ed_{m}"].to_numpy() for m in gait_ocp.NMSK_MUSCLES}
+    am = {m: sol.muscle_activations[m].to_numpy() for m in gait_ocp.NMSK_MUSCLES}
     ap = sol.stats["activation_parameters"]
-    ts = dict(zip(tr.NMSK_MUSCLES, sol.stats["t_stim_s"]))
+    ts = dict(zip(gait_ocp.NMSK_MUSCLES, sol.stats["t_stim_s"]))
     mtp = {f"mtp_{s}": U[f"tau_mtp_{s}"].to_numpy() for s in cv.SIDES}
-    r = metabolics.nmsk_metabolic_rate(q, qd, ed, am, tr.mtg_params_of(sol.spec), s1=ap["s1"], s2=ap["s2"],
+    r = metabolics.nmsk_metabolic_rate(q, qd, ed, am, gait_ocp.mtg_params_of(sol.spec), s1=ap["s1"], s2=ap["s2"],
                                        mtp_torques=mtp, t_stim=ts, **kw)
     return {k: np.asarray(r[k], float) * np.ones(len(sol.q)) for k in
             ("total", "activation", "maintenance", "shortening", "basal", "work")}
@@ -331,7 +331,7 @@ def _cot_of(sol, edot) -> float:
     return metabolics.cost_of_transport(tt, ee, distance=g.speed * g.cycle_time)
 
 
-def cot_breakdown(sol: tr.GaitSolution) -> pd.DataFrame:
+def cot_breakdown(sol: gait_ocp.GaitSolution) -> pd.DataFrame:
     """Cost of transport (Eq 5.57, J kg⁻¹ m⁻¹) of an NMSK solution by term of Eq 5.38
     (each term integrated alone; 'total' includes the clipping of negative non-basal
     power, so the terms need not add up to it), for two readings of the shortening heat:
@@ -347,7 +347,7 @@ def cot_breakdown(sol: tr.GaitSolution) -> pd.DataFrame:
     return df
 
 
-def mtb_scale_table(sol: tr.GaitSolution) -> pd.DataFrame:
+def mtb_scale_table(sol: gait_ocp.GaitSolution) -> pd.DataFrame:
     """How big the Mtb term (Eq 5.55's 8th term, Eq 5.56 normalisation) is: mean Ė, the
     normalising range Ė_max − Ė_min, the factor t_f⁶/(BM² D⁴) with D the stride (our
     reading of the thesis's "d") and with d = 50 ms (the delay, the other symbol named d),
@@ -356,7 +356,7 @@ def mtb_scale_table(sol: tr.GaitSolution) -> pd.DataFrame:
     D = g.speed * g.cycle_time
     tf = float(sol.stats["tf_s"])
     ebar = float(sol.stats["mean_metabolic_rate_W"])
-    de = tr.MTB_COT_N * (tr.MTB_BM_MAX - tr.MTB_BM_MIN) * D / tf
+    de = gait_ocp.MTB_COT_N * (gait_ocp.MTB_BM_MAX - gait_ocp.MTB_BM_MIN) * D / tf
     w = sol.spec.term_weights.get("Mtb", 0.0)
     rows = []
     for lab, d in (("d = stride D (ours)", D), ("d = delay 0.05 s", activation.DELAY)):

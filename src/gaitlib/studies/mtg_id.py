@@ -37,20 +37,20 @@ optimum's. Our default is therefore ``tol=1e-10``, which resolves the optimum of
 Demanded torque. The model's joints carry passive spring–dampers (thesis Table 4.2,
 :meth:`gaitlib.model.ChildModel.function` ``"passive"``) in parallel with the MTGs, and the
 MSK/NMSK problems track the *net* joint torque (MTGs + spring–damper,
-:mod:`gaitlib.transcription`). What the MTG pair must supply is therefore the data's net
+:mod:`gaitlib.problems.gait`). What the MTG pair must supply is therefore the data's net
 torque minus the spring–damper torque, evaluated on the tracked motion:
 ``demand="actuator"`` (default). ``demand="net"`` uses the data's net torque as the
 thesis's text literally reads (its model has the same spring–dampers, so this leaves the
 generators short wherever the damper works against the motion — at push-off the ankle
 damper alone is ≈ 20 N·m). The hip angle is the tracked one (the thigh in the
-laboratory: data hip + pelvic tilt, :func:`gaitlib.transcription.reference`), the angle the
+laboratory: data hip + pelvic tilt, :func:`gaitlib.problems.gait.reference`), the angle the
 MSK model's hip generators see.
 
 Result and file. :func:`identify` returns an :class:`MTGIdentification` (identified
 table beside Table 5.2, IPOPT stats, constraint margins, tracking RMSE, the feasibility
 curves of Figs 5.1–5.2); :func:`save_params` writes ``data/identified/ch5_mtg.json``
 (parameters by generator + provenance: spec, gaitlib version, status, iterations), which
-``GaitSpec(mtg_params="ch5")`` loads (:func:`gaitlib.transcription.mtg_params_of`).
+``GaitSpec(mtg_params="ch5")`` loads (:func:`gaitlib.problems.gait.mtg_params_of`).
 """
 
 from __future__ import annotations
@@ -70,7 +70,7 @@ from .. import conventions as cv
 from .. import data as data_mod
 from .. import mtg
 from .. import ocp
-from .. import transcription as tr
+from ..problems import gait as gait_ocp
 from ..collocation import Mesh
 from ..model import ChildModel
 
@@ -103,7 +103,7 @@ class IdentSpec:
     demand : ``"actuator"`` (net data torque − joint spring–damper; module docstring) or
         ``"net"`` (the data's net torque).
     body_params : the body parameter set whose joint spring–dampers define the actuator
-        demand (see :class:`~gaitlib.transcription.GaitSpec`). Default ``"thesis"`` (Tables
+        demand (see :class:`~gaitlib.problems.gait.GaitSpec`). Default ``"thesis"`` (Tables
         4.15–4.16: the thesis built Ch 5 on its Ch 4 identified body, whose knee and ankle
         dampers are ≈ 0); :func:`chapter_spec` uses ``"ch4"`` (ours) when that file exists.
     """
@@ -169,7 +169,7 @@ def demanded_torques(spec: IdentSpec = IdentSpec(), n: int = 401) -> pd.DataFram
     """
     model = ChildModel()
     gait = data_mod.load_gait_data(spec.speed_class, spec.source)
-    ref = tr.reference(gait, model)
+    ref = gait_ocp.reference(gait, model)
     T = gait.cycle_time
     t = np.linspace(0.0, T, n)
     Q = np.array([ref.deriv[c](t)[0] for c in cv.COORDS])
@@ -269,7 +269,7 @@ def build(spec: IdentSpec = IdentSpec()):
     options = ocp.SolverOptions(tol=spec.tol, max_iter=spec.max_iter)
     # guess: the data (Fourier-fit angles, velocities, accelerations), Γ_initial (Eq 5.22)
     gait = data_mod.load_gait_data(spec.speed_class, spec.source)
-    ref = tr.reference(gait, ChildModel())
+    ref = gait_ocp.reference(gait, ChildModel())
     S = {f"q_{j}": dem[f"q_{j}"].to_numpy() for j in _JOINTS}
     S.update({f"qd_{j}": dem[f"qd_{j}"].to_numpy() for j in _JOINTS})
     C = {f"qdd_{j}": ref.deriv[f"{j}_{spec.side}"](t)[2] for j in _JOINTS}
@@ -418,7 +418,7 @@ def save_params(res: MTGIdentification, path=PARAMS_FILE) -> Path:
 
 def load_params(path=PARAMS_FILE) -> dict[str, mtg.MTGParams]:
     """Read a parameter file written by :func:`save_params` (generator → MTGParams)."""
-    return tr.load_mtg_params(path)
+    return gait_ocp.load_mtg_params(path)
 
 
 # --------------------------------------------------------------------------------------

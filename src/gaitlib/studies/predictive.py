@@ -39,7 +39,7 @@ import pandas as pd
 from .. import conventions as cv
 from .. import data as data_mod
 from .. import ocp
-from .. import transcription as tr
+from ..problems import gait as gait_ocp
 from . import gait as sg
 
 __all__ = ["CH6_COSTS", "CH7_CLASSES", "THESIS_CLASS", "THESIS_HOURS_TABLE_6_3", "THESIS_HOURS_TABLE_7_2",
@@ -80,7 +80,7 @@ def _mesh(n_intervals, degree):
 
 
 def baseline(model: str, *, n_intervals: int = 20, degree: int = 5, root=None, progress: bool = False,
-             **kw) -> tr.GaitSolution:
+             **kw) -> gait_ocp.GaitSolution:
     """The model's Ch 5 natural-gait data-tracking solution (MSK Eq 5.33; NMSK Eq 5.55 with
     the activation parameters identified, warm-started from the MSK one):
     :func:`gaitlib.studies.msk.solve`, solved or reloaded from the cache; ``kw`` override
@@ -109,7 +109,7 @@ GUESS_POLICY = {"MSK": "thesis", "NMSK": "ch5"}
 GUESSES = ("thesis", "ch5")
 
 
-def run_guess(base: tr.GaitSolution, how: str, *, cycle_time: float | None = None,
+def run_guess(base: gait_ocp.GaitSolution, how: str, *, cycle_time: float | None = None,
               stride: float | None = None) -> ocp.Solution:
     """The initial guess of a Ch 6/7 run from its model's Ch 5 solution ``base``:
     ``how="thesis"`` → :func:`thesis_guess`; ``"ch5"`` → all of ``base``'s states and
@@ -119,14 +119,14 @@ def run_guess(base: tr.GaitSolution, how: str, *, cycle_time: float | None = Non
     return thesis_guess(base, cycle_time=cycle_time, stride=stride, full=(how == "ch5"))
 
 
-def thesis_guess(base: tr.GaitSolution, *, cycle_time: float | None = None, stride: float | None = None,
+def thesis_guess(base: gait_ocp.GaitSolution, *, cycle_time: float | None = None, stride: float | None = None,
                  full: bool = False) -> ocp.Solution:
     """The part of a Ch 5 solution the thesis carries into Chs 6–7 as initial guess.
 
     States: HAT coordinates and metatarsal angles with their velocities and accelerations;
     controls: metatarsal torques and, for an MSK source, the 12 MTG activations (Sec 6.1).
     Everything else comes from the target problem's own data-based guess
-    (:func:`gaitlib.transcription.warm_start` overrides by name).
+    (:func:`gaitlib.problems.gait.warm_start` overrides by name).
 
     With ``cycle_time`` (s) the guess is scaled in time to that cycle (Sec 7.1: "scaled
     ... while keeping the magnitudes unchanged"): times × k, k = cycle_time / t_f, with
@@ -144,7 +144,7 @@ def thesis_guess(base: tr.GaitSolution, *, cycle_time: float | None = None, stri
         xs, us = list(ph.states.columns), list(ph.controls.columns)
     else:
         xs = [c for c in ph.states.columns if any(c in (k, f"qd_{k}", f"qdd_{k}") for k in coords)]
-        us = [c for c in ph.controls.columns if c.startswith("tau_mtp_") or c in tr.MTG_CONTROLS]
+        us = [c for c in ph.controls.columns if c.startswith("tau_mtp_") or c in gait_ocp.MTG_CONTROLS]
     X, U = ph.states[xs].copy(), ph.controls[us].copy()
     tf = float(ph.tf)
     if cycle_time is not None:
@@ -177,23 +177,23 @@ def thesis_guess(base: tr.GaitSolution, *, cycle_time: float | None = None, stri
     return replace(sol, phases={"cycle": phase}, parameters={}, info={**(sol.info or {}), "guess_derivation": how})
 
 
-def ch6_specs(model: str, base: tr.GaitSolution, costs=CH6_COSTS, *, n_intervals: int = 20, degree: int = 5,
-              **kw) -> dict[str, tr.GaitSpec]:
+def ch6_specs(model: str, base: gait_ocp.GaitSolution, costs=CH6_COSTS, *, n_intervals: int = 20, degree: int = 5,
+              **kw) -> dict[str, gait_ocp.GaitSpec]:
     """The Ch 6 problems of ``model`` (Table 6.2 weights), HAT reference from ``base``."""
-    hat = tr.hat_reference_of(base)
+    hat = gait_ocp.hat_reference_of(base)
     extra = {"excitation_guess": "emg"} if model == "NMSK" else {}
-    return {f"{model} {c}": tr.GaitSpec(model=model, cost=c, speed_class="Free", hat_reference=hat,
+    return {f"{model} {c}": gait_ocp.GaitSpec(model=model, cost=c, speed_class="Free", hat_reference=hat,
                                         **_mesh(n_intervals, degree), **extra, **kw)
             for c in costs}
 
 
-def ch7_specs(model: str, base: tr.GaitSolution, classes=CH7_CLASSES, *, n_intervals: int = 20, degree: int = 5,
-              **kw) -> dict[str, tr.GaitSpec]:
+def ch7_specs(model: str, base: gait_ocp.GaitSolution, classes=CH7_CLASSES, *, n_intervals: int = 20, degree: int = 5,
+              **kw) -> dict[str, gait_ocp.GaitSpec]:
     """The Ch 7 problems of ``model``: DT (Eqs 7.1–7.2, Table 7.1) per speed class on the
     Free data scaled in time; HAT reference = ``base``'s HAT on normalised time."""
-    hat = tr.hat_reference_of(base)
+    hat = gait_ocp.hat_reference_of(base)
     extra = {"excitation_guess": "emg"} if model == "NMSK" else {}
-    return {f"{model} {c}": tr.GaitSpec(model=model, cost="DT", speed_class=c, track_class="Free",
+    return {f"{model} {c}": gait_ocp.GaitSpec(model=model, cost="DT", speed_class=c, track_class="Free",
                                         hat_reference=hat, **_mesh(n_intervals, degree), **extra, **kw)
             for c in classes}
 
@@ -201,7 +201,7 @@ def ch7_specs(model: str, base: tr.GaitSolution, classes=CH7_CLASSES, *, n_inter
 # ======================================================================================
 # Scoring against a data set (any class), independent of what was tracked
 # ======================================================================================
-def score(sol: tr.GaitSolution, gait: data_mod.GaitData) -> pd.DataFrame:
+def score(sol: gait_ocp.GaitSolution, gait: data_mod.GaitData) -> pd.DataFrame:
     """RMSE and NRMSE (RMSE / data range, thesis Ch 7) of angles, net torques and foot
     forces against ``gait``'s mean, on normalised time (so a solution of another cycle
     time is compared phase by phase). Hip = thigh in the laboratory, as tracked
@@ -214,9 +214,9 @@ def score(sol: tr.GaitSolution, gait: data_mod.GaitData) -> pd.DataFrame:
     tau = sim.index.to_numpy() / float(sol.stats["tf_s"])
     tg = g.time / g.cycle_time
     rows = []
-    chans = [("angle", j, j, 1 / cv.DEG, "deg") for j in tr.LEG_JOINTS]
-    chans += [("torque", j, f"tau_{j}", 1.0, "N*m") for j in tr.LEG_JOINTS]
-    chans += [("grf", f"{ch.split('_')[1]}_{ch[-1]}", ch, 1.0, "N") for ch in tr.GRF_CHANNELS]
+    chans = [("angle", j, j, 1 / cv.DEG, "deg") for j in gait_ocp.LEG_JOINTS]
+    chans += [("torque", j, f"tau_{j}", 1.0, "N*m") for j in gait_ocp.LEG_JOINTS]
+    chans += [("grf", f"{ch.split('_')[1]}_{ch[-1]}", ch, 1.0, "N") for ch in gait_ocp.GRF_CHANNELS]
     for kind, name, col, scale, unit in chans:
         d = np.interp(tau, tg, g.mean[col].to_numpy())
         sd = np.interp(tau, tg, g.sd[col].to_numpy())
@@ -228,7 +228,7 @@ def score(sol: tr.GaitSolution, gait: data_mod.GaitData) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def excitation_score(sol: tr.GaitSolution, gait: data_mod.GaitData) -> pd.DataFrame:
+def excitation_score(sol: gait_ocp.GaitSolution, gait: data_mod.GaitData) -> pd.DataFrame:
     """RMSE and NRMSE of the NMSK excitations e(t) against ``gait``'s EMG envelopes (both
     dimensionless, on normalised time) for the muscles that data set has (mapping
     :data:`gaitlib.studies.msk.EMG_MAP`: e.g. BF ↔ Schwartz's lateral hamstrings)."""
@@ -276,7 +276,7 @@ class StudyResult:
     guess: dict = field(default_factory=dict)  # model → "thesis" | "ch5" (run_guess)
     guesses: dict = field(default_factory=dict, repr=False)  # run → the initial guess used
 
-    def rerun(self, name: str, *, root=None, progress: bool = False, **changes) -> tr.GaitSolution:
+    def rerun(self, name: str, *, root=None, progress: bool = False, **changes) -> gait_ocp.GaitSolution:
         """Run ``name`` again from the same initial guess with spec fields changed (e.g.
         ``max_iter=3000`` to see where a run that hit the iteration limit ends); cached like
         every solve. A separate, labelled result — the study's record keeps its own status."""

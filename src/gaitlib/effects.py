@@ -1,7 +1,7 @@
 """Candidate unmodelled effects: small, documented extensions the gait transcription can
 switch on (``GaitSpec.effects``), each with one magnitude and few parameters.
 
-A :class:`~gaitlib.transcription.GaitSpec` carries ``effects = ((name, magnitude), ...)``:
+A :class:`~gaitlib.problems.gait.GaitSpec` carries ``effects = ((name, magnitude), ...)``:
 ``magnitude`` a float fixes the effect's first parameter (the *magnitude*; its other
 parameters, if any, keep their null values) — this is how :mod:`gaitlib.gap.twin` injects
 an effect; ``None`` makes every parameter of the effect an NLP variable within its bounds
@@ -9,7 +9,7 @@ an effect; ``None`` makes every parameter of the effect an NLP variable within i
 this is how :func:`gaitlib.gap.diagnose` tests it. Magnitude 0 (the null value of every
 effect) reproduces the baseline model exactly.
 
-Where an effect acts (hooks called by :func:`gaitlib.transcription.build`)
+Where an effect acts (hooks called by :func:`gaitlib.problems.gait.build`)
 ---------------------------------------------------------------------------
 ``body``        the 25 body/joint parameters p_body (masses, MOIs, joint K and B)
 ``contact``     the 39 contact parameters p_contact (friction, ellipsoid positions)
@@ -43,7 +43,7 @@ from typing import Any, Callable
 import casadi as ca
 import numpy as np
 
-from .. import conventions as cv
+from . import conventions as cv
 
 __all__ = ["EffectParam", "Effect", "EFFECTS", "TWIN_EFFECTS", "Context", "Bound", "bind", "validate",
            "data_columns", "adjust_data", "theta_of", "ARM"]
@@ -64,7 +64,7 @@ class EffectParam:
 @dataclass(frozen=True)
 class Context:
     """What an effect's hooks may read: the spec, the model, the tracked reference
-    (:class:`gaitlib.transcription.Reference`), the data's cycle time ``T`` (s), and the
+    (:class:`gaitlib.problems.gait.Reference`), the data's cycle time ``T`` (s), and the
     nominal body/contact parameter vectors."""
 
     spec: Any
@@ -129,13 +129,13 @@ class Effect:
 # ======================================================================================
 
 def _idx(name: str) -> int:
-    from ..model import P_BODY_NAMES
+    from .model import P_BODY_NAMES
 
     return P_BODY_NAMES.index(name)
 
 
 def _contact_idx(ell: str, name: str) -> int:
-    from ..contact import param_index
+    from .contact import param_index
 
     return param_index(ell, name)
 
@@ -486,7 +486,7 @@ def regenerate_left(gait, shift: float, emg: bool | None = None):
     by comparing with the right leg shifted by the data's own shift)."""
     import dataclasses
 
-    from .. import data as data_mod
+    from . import data as data_mod
 
     mean, sd = gait.mean.copy(), gait.sd.copy()
     n = len(mean)
@@ -515,7 +515,7 @@ def regenerate_left(gait, shift: float, emg: bool | None = None):
 def left_generated(gait) -> bool:
     """Whether ``gait``'s left-leg angles are the right leg's shifted by ``left_shift``
     (order-5 Fourier, as :func:`gaitlib.data.load_gait_data` generates them)."""
-    from .. import data as data_mod
+    from . import data as data_mod
 
     for stem in ("hip", "knee", "ankle"):
         test = data_mod.fourier_shift(gait.mean[f"{stem}_r"].to_numpy(), gait.left_shift, _FOURIER_ORDER)
@@ -692,7 +692,7 @@ TWIN_EFFECTS = tuple(n for n, e in EFFECTS.items() if "SK" in e.models and e.dat
 
 
 # ======================================================================================
-# Binding effects to a problem (used by gaitlib.transcription.build / postprocess)
+# Binding effects to a problem (used by gaitlib.problems.gait.build / postprocess)
 # ======================================================================================
 
 def validate(effects, model: str) -> tuple:
@@ -793,7 +793,7 @@ class _DataView:
 def bind(spec, ctx: Context) -> Bound:
     """Bind ``spec.effects`` to a problem: NLP parameters for free effects (``fx.<effect>.
     <param>`` within the parameter's bounds, starting at its null value)."""
-    from ..ocp import Parameter
+    from .ocp import Parameter
 
     items = [(EFFECTS[n], m) for n, m in validate(spec.effects, spec.model)]
     # an effect fixed at its null value is the baseline model: leave it out entirely, so the

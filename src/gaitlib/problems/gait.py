@@ -126,16 +126,16 @@ import casadi as ca
 import numpy as np
 import pandas as pd
 
-from . import cache
-from . import contact as contact_mod
-from . import conventions as cv
-from . import data as data_mod
-from . import kinematics
-from . import params as params_mod
-from .collocation import Mesh
-from .model import ChildModel
-from .ocp import Goal, Guess, Named, Parameter, PathConstraint, Periodic, Phase, PhaseGuess, Problem, SolverOptions
-from . import ocp
+from .. import cache
+from .. import contact as contact_mod
+from .. import conventions as cv
+from .. import data as data_mod
+from .. import kinematics
+from .. import params as params_mod
+from ..collocation import Mesh
+from ..model import ChildModel
+from ..ocp import Goal, Guess, Named, Parameter, PathConstraint, Periodic, Phase, PhaseGuess, Problem, SolverOptions
+from .. import ocp
 
 #: Version of the gait formulation (this module with the physics, the collocation engine, the
 #: data references, the effect library, bounds, initial guesses and solver options): part of
@@ -279,7 +279,7 @@ class GaitSpec:
         tuple of ``(name, magnitude)`` pairs: a float fixes the effect's magnitude (its
         first parameter), ``None`` makes its parameters NLP variables ``fx.<name>.<param>``
         (identified with the motion). Magnitude 0 is the baseline model. See
-        :mod:`gaitlib.gap.effects`.
+        :mod:`gaitlib.effects`.
     """
 
     model: str = "SK"
@@ -342,7 +342,7 @@ class GaitSpec:
             if len(self.hat_reference) != 4 or len({len(v) for v in self.hat_reference}) != 1:
                 raise ValueError("hat_reference must be () or four equal-length tuples (tau, dx, y, tilt)")
         if self.effects:
-            from .gap import effects as _fx
+            from .. import effects as _fx
 
             object.__setattr__(self, "effects", _fx.validate(self.effects, self.model))
 
@@ -528,7 +528,7 @@ class GaitProblem:
     constant in the Mtb term; ``functions``: per-node functions of the formulation
     (NMSK ``"edot"``: CasADi (x, u, p, t_stim) → Ė and its components, W; ``"node"``: the
     Python closure (x, u, p) → dict of inverse-dynamics, contact and torque expressions;
-    ``"effects"``: the spec's bound effects, :class:`gaitlib.gap.effects.Bound`, or None).
+    ``"effects"``: the spec's bound effects, :class:`gaitlib.effects.Bound`, or None).
     """
 
     spec: GaitSpec
@@ -571,7 +571,7 @@ def load_mtg_params(path) -> dict:
     """MTG fitting parameters from a JSON file ``{"params": {generator: {Eq 5.9 name: value}},
     "provenance": …}`` (written by :func:`gaitlib.studies.mtg_id.save_params`; Δ^P in rad)
     → generator → :class:`gaitlib.mtg.MTGParams`. Errors name the file and the entry."""
-    from . import mtg
+    from .. import mtg
 
     path = Path(path)
     if not path.is_file():
@@ -600,7 +600,7 @@ def mtg_params_of(spec_or_name) -> dict | None:
     :func:`gaitlib.mtg.joint_torque` takes: None for ``"default"`` (Eq 5.22), else
     generator → MTGParams (``"ch5"``: ``data/identified/ch5_mtg.json``; ``"thesis"``:
     Table 5.2). A missing file is an error (no fallback)."""
-    from . import mtg
+    from .. import mtg
 
     name = spec_or_name.mtg_params if isinstance(spec_or_name, GaitSpec) else spec_or_name
     if name == "default":
@@ -615,7 +615,7 @@ def mtg_params_of(spec_or_name) -> dict | None:
 def activation_values(spec: GaitSpec) -> dict[str, float]:
     """Numeric activation parameters γ (Eq 5.53) of an NMSK spec: Table 5.10's identified
     values, or its initial guesses when ``free_activation`` (then they are NLP variables)."""
-    from . import activation
+    from .. import activation
 
     src = activation.ACTIVATION_INITIAL if spec.free_activation else activation.ACTIVATION_IDENTIFIED
     return {k: float(src[k]) for k in ACTIVATION_PARAMS}
@@ -675,16 +675,16 @@ def build(spec: GaitSpec) -> GaitProblem:
         params.append(Parameter("t_f", float(spec.tf_bounds[0]), float(spec.tf_bounds[1]),
                                 float(np.clip(T, *spec.tf_bounds))))
     if nmsk:
-        from . import activation, metabolics, mtg
+        from .. import activation, metabolics, mtg
 
         act_fixed = activation_values(spec)
         if spec.free_activation:
             for k in ACTIVATION_PARAMS:
                 params.append(Parameter(f"act.{k}", *map(float, activation.ACTIVATION_BOUNDS[k]), act_fixed[k]))
 
-    fx = None  # candidate unmodelled effects (gaitlib.gap.effects)
+    fx = None  # candidate unmodelled effects (gaitlib.effects)
     if spec.effects:
-        from .gap import effects as effects_mod
+        from .. import effects as effects_mod
 
         fx = effects_mod.bind(spec, effects_mod.Context(spec, model, ref, T, p_body, p_contact))
         params += fx.parameters
@@ -726,7 +726,7 @@ def build(spec: GaitSpec) -> GaitProblem:
         if spec.model == "SK":
             tau_in = ca.vertcat(*[u[f"tau_{j}"] for j in cv.JOINTS])
         elif spec.model == "MSK":
-            from . import mtg
+            from .. import mtg
 
             tin = {}
             for s in cv.SIDES:
@@ -737,7 +737,7 @@ def build(spec: GaitSpec) -> GaitProblem:
             tau_in = ca.vertcat(*[tin[j] for j in cv.JOINTS])
             extra["a_gen"] = {k[2:]: u[k] for k in MTG_CONTROLS}
         else:  # NMSK: muscle activations → 12 generator activations (Eq 5.54) → MTGs
-            from . import mtg
+            from .. import mtg
 
             am = muscle_activations(x, p)
             ap = act_of(p)
@@ -754,7 +754,7 @@ def build(spec: GaitSpec) -> GaitProblem:
         R_in = ca.vertcat(*[u[r] for r in cv.RESIDUALS])
         load = fx.root_load(x, p) if fx is not None else None
         if load is not None:
-            R_id = R_id + load  # an effect's extra load on the HAT (gaitlib.gap.effects)
+            R_id = R_id + load  # an effect's extra load on the HAT (gaitlib.effects)
         # net joint torque = actuators + joint spring–dampers: what the data report
         tau_net = tau_in + f_pas(q, qd, pb)
         out = {"tau_id": tau_id, "R_id": R_id, "tau_in": tau_in, "R_in": R_in, "tau_net": tau_net,
@@ -943,7 +943,7 @@ def tracking_frame(spec: GaitSpec, ref: Reference) -> pd.DataFrame:
     dat.update({f"ref_tau_{j}": ref.tau[j].to_numpy() for j in LEG_JOINTS})
     dat.update({f"ref_{g}": ref.grf[g].to_numpy() for g in GRF_CHANNELS})
     if spec.effects:
-        from .gap import effects as effects_mod
+        from .. import effects as effects_mod
 
         dat.update(effects_mod.data_columns(spec, ref, tau_grid))
     return pd.DataFrame(dat, index=tau_grid)
@@ -971,7 +971,7 @@ def initial_guess(spec: GaitSpec, model: ChildModel, ref: Reference, p_body, p_c
         for j in cv.JOINTS:
             C[f"tau_{j}"] = tau.get(j, np.zeros_like(t))
     else:
-        from . import mtg
+        from .. import mtg
 
         for s in cv.SIDES:
             C[f"tau_mtp_{s}"] = np.zeros_like(t)
@@ -989,7 +989,7 @@ def initial_guess(spec: GaitSpec, model: ChildModel, ref: Reference, p_body, p_c
 
 def _invert_muscle_activation(a, c3: float, delta: float = 1e-4):
     """u with neural_to_muscle_activation(u, c3) = a (Eq 5.37 inverted; monotone), 1."""
-    from . import activation
+    from .. import activation
 
     ug = np.linspace(0.0, 1.0, 20001)
     return np.interp(a, activation.neural_to_muscle_activation(ug, c3, delta), ug)
@@ -1018,7 +1018,7 @@ def _nmsk_guess(spec: GaitSpec, ref: Reference, t, a_gen: dict):
     (:func:`gaitlib.activation.simulate_activation`), so the guess satisfies the activation
     dynamics.
     """
-    from . import activation
+    from .. import activation
 
     t = np.asarray(t, float)
     T = ref.gait.cycle_time
@@ -1228,7 +1228,7 @@ def warm_start(gp: GaitProblem, guess) -> Guess:
         if k in names_u:
             C[k] = np.interp(base.time, tc, ph.controls[k])
     if gp.spec.model in ("MSK", "NMSK") and "tau_hip_r" in ph.controls.columns:
-        from . import mtg
+        from .. import mtg
 
         for s_ in cv.SIDES:
             C[f"tau_mtp_{s_}"] = np.interp(base.time, tc, ph.controls[f"tau_mtp_{s_}"])
@@ -1280,7 +1280,7 @@ def postprocess(gp: GaitProblem, sol: ocp.Solution) -> GaitSolution:
     pb = np.array([sol.parameters[f"b.{n}"] for n in model.p_body_names]) if spec.free_body else gp.p_body
     pc = np.array([sol.parameters[f"c.{n}"] for n in contact_mod.param_names()]) if spec.free_contact else gp.p_contact
     if spec.effects:  # effects acting on body/contact parameters, at the solution's values
-        from .gap import effects as effects_mod
+        from .. import effects as effects_mod
 
         ctx = effects_mod.Context(spec, model, gp.ref, gp.ref.gait.cycle_time, gp.p_body, gp.p_contact)
         pb, pc = effects_mod.numeric_body_contact(spec, ctx, sol.parameters, pb, pc)
@@ -1303,7 +1303,7 @@ def postprocess(gp: GaitProblem, sol: ocp.Solution) -> GaitSolution:
         torques = pd.DataFrame({j: U[f"tau_{j}"].to_numpy() for j in cv.JOINTS}, index=q.index)
         acts = None
     elif spec.model == "MSK":
-        from . import mtg
+        from .. import mtg
 
         tq = {}
         for s in cv.SIDES:
@@ -1339,7 +1339,7 @@ def postprocess(gp: GaitProblem, sol: ocp.Solution) -> GaitSolution:
 
 
 def _effects_values(spec: GaitSpec, sol: ocp.Solution) -> dict:
-    from .gap import effects as effects_mod
+    from .. import effects as effects_mod
 
     return effects_mod.theta_of(spec, sol.parameters)
 
@@ -1347,7 +1347,7 @@ def _effects_values(spec: GaitSpec, sol: ocp.Solution) -> dict:
 def _postprocess_nmsk(gp: GaitProblem, sol: ocp.Solution, Xu, U, q, qd):
     """NMSK frames: MTG torques from the states' muscle activations, generator activations,
     excitations e(t) = ẽ(t + d), muscle activations, metabolic rate and COT."""
-    from . import activation, metabolics, mtg
+    from .. import activation, metabolics, mtg
 
     ph = sol.phase("cycle")
     tf = float(ph.tf)
