@@ -26,7 +26,7 @@ def real():
 
 def _data_as_sim(ds) -> pd.DataFrame:
     """The data (as tracked) on the locate grid: a 'solution' with zero residual."""
-    view = L.tracking_view(ds.gait)
+    view = gait_ocp.tracking_data(ds.gait)
     tau = view.time / view.cycle_time
     df = view.mean.copy()
     df.index = pd.Index(tau, name="tau")

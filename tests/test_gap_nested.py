@@ -173,7 +173,7 @@ def test_n_subjects_is_the_datas_own(tmp_path, real):
     ds = gio.read_data(p, like="schwartz2008", n_subjects=24)
     assert (ds.n, ds.n_source, ds.base) == (24, "option", "schwartz2008")
     # the band test uses it: SE = SD*/√24
-    sim = L.tracking_view(ds.gait).mean.copy()
+    sim = gait_ocp.tracking_data(ds.gait).mean.copy()
     sim.index = ds.gait.time / ds.gait.cycle_time
     sim = sim[sim.index < 1]
     sim["knee_r"] += 1.5 * np.maximum(ds.gait.sd["knee_r"].to_numpy()[:-1], 1e-9)

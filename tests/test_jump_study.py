@@ -8,14 +8,13 @@ band, the friction ratio of Eq 3.6 and the bookkeeping of failed solves.
 
 from __future__ import annotations
 
-import math
 import warnings
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from gaitlib import conventions as cv, ocp
+from gaitlib import ocp
 from gaitlib import cache
 from gaitlib.studies import jump as J
 

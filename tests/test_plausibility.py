@@ -7,6 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from gaitlib.problems import gait as gait_ocp
 from gaitlib import data as data_mod
 from gaitlib import plausibility as P
 from gaitlib.gap import io as gio
@@ -244,7 +245,7 @@ def test_without_sd_is_explicit_and_leaves_the_gap(tmp_path, good):
     path = write(_sd_zero(good), tmp_path / "nosd.csv")
     ds = gio.read_data(path, allow_no_sd=True)
     assert ds.notes == ("tracked without SD (left out of the located gap): knee_flexion",)
-    view = L.tracking_view(ds.gait)
+    view = gait_ocp.tracking_data(ds.gait)
     sim = view.mean.copy()
     sim.index = pd.Index(view.time / view.cycle_time, name="tau")
     loc = L.locate(sim[sim.index < 1.0], ds)
@@ -273,14 +274,13 @@ def test_both_legs_and_coarse_uniform_grid_are_accepted(tmp_path, good):
 @pytest.fixture
 def no_solve(monkeypatch):
     """Any attempt to build a problem or start the diagnosis fails the test."""
-    from gaitlib.problems import gait as gait_ocp
     from gaitlib.gap import diagnose as D
 
     def boom(*a, **k):
         raise AssertionError("a problem was built")
 
     monkeypatch.setattr(D, "diagnose", boom)
-    monkeypatch.setattr(tr, "build", boom)
+    monkeypatch.setattr(gait_ocp, "build", boom)
 
 
 def test_multi_class_file_needs_a_speed_class(tmp_path):

@@ -6,14 +6,10 @@ from __future__ import annotations
 
 import math
 
-import casadi
-import numpy as np
 import pytest
 
 from gaitlib import cache
 
-from gaitlib import ocp
-from gaitlib.problems import gait as gait_ocp
 from gaitlib.studies import contact_id, msk, predictive
 from gaitlib.studies import performance as perf
 

@@ -53,7 +53,7 @@ from functools import lru_cache
 from pathlib import Path
 
 __all__ = ["fingerprint", "key", "default_dir", "store_dir", "find", "lookup", "save", "verify", "scan",
-           "clear", "only", "MANIFEST", "CacheWarning", "CorruptEntry", "NotCached"]
+           "clear", "only", "solve_or_load", "MANIFEST", "CacheWarning", "CorruptEntry", "NotCached"]
 
 _PKG = Path(__file__).resolve().parent
 
@@ -250,6 +250,22 @@ def find(where: Path, marker: str, *, to_solve: bool = True) -> Path | None:
     elif to_solve and os.environ.get(ONLY_ENV):
         raise NotCached(f"{where}: not cached or stored ({os.environ[ONLY_ENV]})")
     return found
+
+
+def solve_or_load(where, solve, load, *, marker: str, use_cache: bool = True, write=None):
+    """The one cached-solve path: the entry at ``where`` (a :func:`lookup` directory) loaded
+    by ``load(found)`` when :func:`find` serves it (verified; from the repository's store as
+    a fallback), else ``solve()``'s result, stored there atomically by :func:`save` with
+    ``write(result)`` as the writer (default ``result.save``). ``marker``: a file every
+    complete entry of this kind has. ``use_cache=False`` solves and stores nothing.
+    Failed solves are stored like any other: their status is the result."""
+    found = find(where, marker) if use_cache else None
+    if found is not None:
+        return load(found)
+    result = solve()
+    if use_cache:
+        save(where, (write or (lambda r: r.save))(result))
+    return result
 
 
 def save(where, write) -> Path:

@@ -106,6 +106,21 @@ SPEED_CLASS_LABELS = {
 
 DEG = math.pi / 180.0
 
+
+def thigh_in_lab(hip, pelvis_tilt):
+    """The thigh's angle in the laboratory from the data's hip angle (relative to the pelvis)
+    and the pelvic tilt, both in model signs (rad or deg alike; scalars or arrays).
+
+    The model's HAT is upright while the data's pelvis tilts about 11 deg forward, so the
+    gait problem's hip coordinate is the thigh in the laboratory: ``hip + pelvis_tilt``
+    (inverse: :func:`hip_from_thigh`)."""
+    return hip + pelvis_tilt
+
+
+def hip_from_thigh(thigh, pelvis_tilt):
+    """Inverse of :func:`thigh_in_lab`: the hip angle relative to the pelvis."""
+    return thigh - pelvis_tilt
+
 #: Sign applied when mapping a data channel to the model channel (see module docstring).
 DATA_SIGN = {
     "pelvis_tilt": -1.0,

@@ -104,7 +104,7 @@ def pose_from_data(model, gait_data, times, p_contact=None, penetration: float =
     for j in cv.JOINTS:
         q[:, cv.COORDS.index(j)] = ang[j].to_numpy()
         if thigh == "lab" and j.startswith("hip_"):
-            q[:, cv.COORDS.index(j)] += ang["pelvis_tilt"].to_numpy()
+            q[:, cv.COORDS.index(j)] = cv.thigh_in_lab(q[:, cv.COORDS.index(j)], ang["pelvis_tilt"].to_numpy())
     for i in range(times.size):
         q[i, 1] = 0.0
         low = ellipsoid_bottoms(model, q[i], p_contact).min()

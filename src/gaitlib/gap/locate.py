@@ -53,7 +53,7 @@ from .. import conventions as cv
 from ..problems import gait as gait_ocp
 
 __all__ = ["PHASES", "PHASE_NAMES", "N_GRID", "phase_edges", "phase_of", "sim_channels", "Located", "locate",
-           "resels", "tracking_view", "ALPHA", "SD_FLOOR"]
+           "resels", "ALPHA", "SD_FLOOR"]
 
 PHASES = ("LR", "MSt/TSt", "PSw", "ISw", "MSw", "TSw")
 PHASE_NAMES = {"LR": "loading response", "MSt/TSt": "mid/terminal stance", "PSw": "pre-swing",
@@ -112,13 +112,6 @@ def sim_channels(sol: "gait_ocp.GaitSolution", source: str = "schwartz2008") -> 
     df = pd.DataFrame(out, index=pd.Index(np.mod(t / tf, 1.0), name="tau"))
     df = df[~df.index.duplicated(keep="first")].sort_index()
     return df
-
-
-def tracking_view(gait):
-    """Data as tracked: hip = data hip + data pelvic tilt (:func:`gaitlib.studies.gait.tracking_data`)."""
-    from ..studies.gait import tracking_data
-
-    return tracking_data(gait)
 
 
 def _periodic(tau_src, y, tau):
@@ -230,7 +223,7 @@ def locate(sim, ds, thetas: dict | None = None, exclude=()) -> Located:
         sim = sim_channels(sim, gait.source)
     if thetas:
         gait = effects.adjust_data(gait, thetas)
-    view = tracking_view(gait)
+    view = gait_ocp.tracking_data(gait)
     tau = np.arange(N_GRID) / N_GRID
     t_data = np.asarray(view.time, float) / float(view.cycle_time)
     inc, exc = _channels(view, set(sim.columns), exclude)

@@ -35,7 +35,7 @@ from .. import cache
 from .. import ocp
 from ..problems import gait as gait_ocp
 from .solve import FORMULATION as FIT_FORMULATION
-from .solve import Lazy, Runner, _check_same_cycle, guess_signature, solve_or_load, sweep_groups
+from .solve import Lazy, Runner, _check_same_cycle, solve_or_load, sweep_groups
 
 __all__ = ["NULL_START_IPOPT", "FORMULATION", "null_start_on", "null_start_many", "null_guess"]
 
@@ -61,7 +61,7 @@ def _where(spec, gait, base, root, objective) -> Path:
     from .io import signature
 
     desc = {"kind": "gap-null-start", "spec": spec.to_dict(), "data": signature(gait),
-            "guess": guess_signature(base), "objective": objective, "ipopt": dict(NULL_START_IPOPT)}
+            "guess": gait_ocp.guess_signature(base), "objective": objective, "ipopt": dict(NULL_START_IPOPT)}
     return cache.lookup("gap", desc, root, formulation=(gait_ocp.FORMULATION, FIT_FORMULATION, FORMULATION),
                         identified=spec.identified_sets())
 

@@ -36,7 +36,7 @@ from .. import cache
 from .. import ocp
 from ..problems import gait as gait_ocp
 
-__all__ = ["Runner", "Lazy", "solve_on", "solve_or_load", "solve_many", "guess_signature", "FORMULATION", "OBJECTIVES", "FIT_WEIGHT",
+__all__ = ["Runner", "Lazy", "solve_on", "solve_or_load", "solve_many", "FORMULATION", "OBJECTIVES", "FIT_WEIGHT",
            "fit_problem"]
 
 OBJECTIVES = ("fit", "cost")
@@ -55,24 +55,10 @@ _KEEP = ("Jrk", "Rsd", "Imp", "Act", "Mtb")
 FORMULATION = "gap-fit-1"
 
 
-def guess_signature(guess) -> str | None:
-    if guess is None:
-        return None
-    if isinstance(guess, gait_ocp.GaitSolution):
-        guess = guess.solution
-    if isinstance(guess, ocp.Solution):
-        sig = f"solution:{guess.status}:{guess.objective:.12g}:{guess.iterations}"
-        # a guess derived from a solution (e.g. studies.predictive.thesis_guess) says how;
-        # two derivations of one solution must not share a key
-        der = (getattr(guess, "info", None) or {}).get("guess_derivation")
-        return sig if der is None else f"{sig}:{der}"
-    raise TypeError(f"warm start must be a GaitSolution or ocp.Solution, got {type(guess).__name__}")
-
-
 def _where(spec: gait_ocp.GaitSpec, gait, guess, root, objective="fit") -> Path:
     from .io import signature
 
-    desc = {"kind": "gap-solve", "spec": spec.to_dict(), "data": signature(gait), "guess": guess_signature(guess),
+    desc = {"kind": "gap-solve", "spec": spec.to_dict(), "data": signature(gait), "guess": gait_ocp.guess_signature(guess),
             "objective": objective}
     return cache.lookup("gap", desc, root, formulation=(gait_ocp.FORMULATION, FORMULATION),
                         identified=spec.identified_sets())
@@ -94,9 +80,9 @@ def _fit_channels():
 
 def sd_columns(gait, tau_grid) -> dict:
     """``sd_<channel>`` columns (SD* of :mod:`gaitlib.gap.locate`) on ``tau_grid``."""
-    from .locate import SD_FLOOR, tracking_view
+    from .locate import SD_FLOOR
 
-    view = tracking_view(gait)
+    view = gait_ocp.tracking_data(gait)
     t = np.asarray(view.time, float) / float(view.cycle_time)
     out = {}
     for name, _, _ in _fit_channels():
@@ -209,25 +195,11 @@ class Runner:
         return out
 
 
-def _load(found: Path, objective: str) -> gait_ocp.GaitSolution:
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ocp.SolveFailedWarning)
-        sol = gait_ocp.GaitSolution.load(found)
-    sol.stats["from_cache"] = True
-    sol.stats["objective_kind"] = objective
-    return sol
-
-
 def solve_or_load(where: Path, solve, *, use_cache: bool = True, objective: str = "fit") -> gait_ocp.GaitSolution:
-    """The solution cached at ``where`` (a :func:`gaitlib.cache.lookup` result), or
-    ``solve()``'s, then stored there (atomically, :func:`gaitlib.cache.save`)."""
-    found = cache.find(where, "spec.json") if use_cache else None
-    if found is not None:
-        return _load(found, objective)
-    sol = solve()
-    if use_cache:
-        cache.save(where, sol.save)
-    return sol
+    """:func:`gaitlib.cache.solve_or_load` for a gap re-solve: the solution cached at
+    ``where`` (tagged with its ``objective`` kind), or ``solve()``'s, then stored there."""
+    return cache.solve_or_load(where, solve, lambda found: gait_ocp.GaitSolution.from_cache(found, objective_kind=objective),
+                               marker="spec.json", use_cache=use_cache)
 
 
 class Lazy:

@@ -29,7 +29,6 @@ import numpy as np
 import pandas as pd
 
 from .. import conventions as cv
-from .. import data as data_mod
 from ..problems import gait as gait_ocp
 from . import io as gio
 from . import locate as L
@@ -104,7 +103,7 @@ def twin_frame(sol: gait_ocp.GaitSolution, real: gio.DataSet, seed: int | None, 
         for stem, q in stems:
             v = at(f"{stem}_{s_}")
             if stem == "hip":  # q_hip is the thigh in the laboratory; the data's hip is relative to the pelvis
-                v = v - pelvis_model
+                v = cv.hip_from_thigh(v, pelvis_model)
             values[(q, side)] = gio.model_to_data_units(stem, v, gait.body_mass)
             sd[(q, side)] = np.abs(gio.model_to_data_units(stem, real_sd(f"{stem}_{s_}"), gait.body_mass))
         for c in sim.columns:

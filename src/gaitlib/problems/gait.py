@@ -118,9 +118,7 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import asdict, dataclass, field, replace
-from functools import cached_property
 from pathlib import Path
-from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -675,7 +673,7 @@ def build(spec: GaitSpec) -> GaitProblem:
         params.append(Parameter("t_f", float(spec.tf_bounds[0]), float(spec.tf_bounds[1]),
                                 float(np.clip(T, *spec.tf_bounds))))
     if nmsk:
-        from .. import activation, metabolics, mtg
+        from .. import activation, metabolics
 
         act_fixed = activation_values(spec)
         if spec.free_activation:
@@ -1152,6 +1150,19 @@ class GaitSolution:
         spec = GaitSpec.from_dict(json.loads((path / "spec.json").read_text()))
         return postprocess(build(spec), ocp.Solution.load(path / "ocp"))
 
+    @classmethod
+    def from_cache(cls, path, **stats) -> "GaitSolution":
+        """:meth:`load` of a cache entry, with ``stats["from_cache"] = True``, its path and
+        ``stats`` added; a failed solve reloads as failed without a warning (its status is
+        the result)."""
+        import warnings
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ocp.SolveFailedWarning)
+            sol = cls.load(path)
+        sol.stats.update(from_cache=True, cache_path=str(path), **stats)
+        return sol
+
 
 def _rmse_table(sol_q, torques, grf, ref: Reference, time_scale: float = 1.0) -> pd.DataFrame:
     """RMSE per channel; the data are read at ``time_scale`` × the solution's times (T / t_f
@@ -1404,3 +1415,72 @@ def _postprocess_nmsk(gp: GaitProblem, sol: ocp.Solution, Xu, U, q, qd):
     }
     frames = {"excitations": exc, "muscle_activations": mus, "metabolic": metab}
     return torques, acts, frames, stats
+
+
+def tracking_data(gait):
+    """The data as the gait problem tracks them: the hip channels become the thigh's angle
+    in the laboratory (:func:`gaitlib.conventions.thigh_in_lab`: data hip + data pelvic tilt,
+    model signs; SD unchanged), because the model's HAT is upright while the data's pelvis
+    tilts forward (:func:`gaitlib.kinematics.pose_from_data`)."""
+    mean = gait.mean.copy()
+    for s in cv.SIDES:
+        mean[f"hip_{s}"] = cv.thigh_in_lab(mean[f"hip_{s}"], mean["pelvis_tilt"])
+    return replace(gait, mean=mean, notes=tuple(getattr(gait, "notes", ()) or ()) +
+                   ("hip = thigh in the laboratory (data hip + pelvic tilt)",))
+
+
+def guess_signature(guess) -> str | None:
+    """The identity of a warm start, as it enters a cache key (None for no warm start).
+
+    A solution (:class:`GaitSolution` or :class:`~gaitlib.ocp.Solution`) is named by its
+    status, objective and iterations, plus the ``guess_derivation`` its ``info`` records when
+    the guess was derived from it (part of it, time-scaled …), so that two derivations of one
+    solution never share a key. An :class:`~gaitlib.ocp.Guess` built from arrays is named by
+    the SHA-256 of its content."""
+    if guess is None:
+        return None
+    if isinstance(guess, GaitSolution):
+        guess = guess.solution
+    if isinstance(guess, ocp.Solution):
+        sig = f"solution:{guess.status}:{guess.objective:.12g}:{guess.iterations}"
+        derived = (getattr(guess, "info", None) or {}).get("guess_derivation")
+        return f"{sig}:{derived}" if derived else sig
+    if isinstance(guess, ocp.Guess):
+        return "guess:" + _content_digest(guess)
+    raise TypeError(f"warm start must be a GaitSolution, ocp.Solution or ocp.Guess, got {type(guess).__name__}")
+
+
+def _content_digest(obj) -> str:
+    """SHA-256 (16 hex digits) of a guess's numbers: frames, arrays, mappings, scalars."""
+    import hashlib
+
+    h = hashlib.sha256()
+
+    def feed(o):
+        if o is None or isinstance(o, (str, bool, int, float)):
+            h.update(repr(o).encode())
+        elif isinstance(o, pd.DataFrame):
+            feed(list(map(str, o.columns)))
+            feed(o.index.to_numpy(float))
+            feed(o.to_numpy(float))
+        elif isinstance(o, np.ndarray) or isinstance(o, (list, tuple)) and all(
+                isinstance(v, (int, float)) for v in o):
+            a = np.ascontiguousarray(np.asarray(o, float))
+            h.update(repr(a.shape).encode())
+            h.update(a.tobytes())
+        elif isinstance(o, dict) or hasattr(o, "items"):
+            for k in sorted(o, key=str):
+                feed(str(k))
+                feed(o[k])
+        elif isinstance(o, (list, tuple)):
+            for v in o:
+                feed(v)
+        elif hasattr(o, "__dataclass_fields__"):
+            for k in o.__dataclass_fields__:
+                feed(k)
+                feed(getattr(o, k))
+        else:
+            raise TypeError(f"cannot fingerprint a {type(o).__name__} in a warm start")
+
+    feed(obj)
+    return h.hexdigest()[:16]

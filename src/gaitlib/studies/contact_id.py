@@ -53,7 +53,7 @@ import datetime as _dt
 import json
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 
@@ -70,7 +70,6 @@ from .. import ocp
 from .. import params as params_mod
 from ..problems import gait as gait_ocp
 from ..model import P_BODY_NAMES, P_BODY_UNITS, ChildModel
-from . import gait
 
 __all__ = [
     "APPROACHES", "THESIS_RMSE", "THESIS_GEOMETRY", "THESIS_CONTACT", "THESIS_TIME",
@@ -503,13 +502,20 @@ def trajectory_optimization(spec: TrajOptSpec = TrajOptSpec(), *, use_cache: boo
     desc = {"kind": "contact_id_a", **spec.to_dict()}
     # fixed kinematics, the model's default body parameters: no identified set is read
     where = cache.lookup("contact_id", desc, root, formulation=TRAJOPT_FORMULATION, identified=())
-    prob = problem
-    found = cache.find(where, "result.json") if use_cache else None
-    if found is not None:
-        rec = json.loads((found / "result.json").read_text())
-        prob = prob or InverseDynamicsID(spec)
-        return _result_a(prob, rec, from_cache=True)
-    prob = prob or InverseDynamicsID(spec)
+    prob = problem or InverseDynamicsID(spec)  # cheap: the solver is built on first use
+
+    def write(rec_and_flag):
+        return lambda d: (d / "result.json").write_text(json.dumps(rec_and_flag[0], indent=1))
+
+    rec, from_cache = cache.solve_or_load(
+        where, lambda: (_multistart_a(spec, prob), False),
+        lambda found: (json.loads((found / "result.json").read_text()), True),
+        marker="result.json", use_cache=use_cache, write=write)
+    return _result_a(prob, rec, from_cache=from_cache)
+
+
+def _multistart_a(spec, prob: "InverseDynamicsID") -> dict:
+    """Approach (a)'s search itself (:func:`identify_a`): the record of every local solve."""
     t_wall = time.perf_counter()
     t0 = time.perf_counter()
     _ = prob.solver  # symbolic Hessian, IPOPT set-up
@@ -528,9 +534,7 @@ def trajectory_optimization(spec: TrajOptSpec = TrajOptSpec(), *, use_cache: boo
                      "Eq 4.4 violation": r["ratio_violation"], "p": [float(v) for v in r["p"]]})
     rec = {"rows": rows, "build_s": build_s, "wall_s": time.perf_counter() - t_wall,
            "trial_scores": [float(s) for s in scores], "spec": spec.to_dict()}
-    if use_cache:
-        cache.save(where, lambda d: (d / "result.json").write_text(json.dumps(rec, indent=1)))
-    return _result_a(prob, rec, from_cache=False)
+    return rec
 
 
 def _result_a(prob: InverseDynamicsID, rec: dict, from_cache: bool) -> ApproachResult:
@@ -590,22 +594,22 @@ def _solve_gait_cached(spec: gait_ocp.GaitSpec, start: dict, warm: gait_ocp.Gait
                               "objective": float(f"{ws.objective:.12g}"), "iterations": ws.iterations}
     where = cache.lookup("contact_id", desc, root, formulation=(gait_ocp.FORMULATION, FORMULATION),
                          identified=spec.identified_sets())
-    sol = gait.load_cached(where) if use_cache else None
-    if sol is not None:
+
+    def solve():
+        gp = gait_ocp.build(spec)
+        if warm is not None:
+            g = gait_ocp.warm_start(gp, warm)
+            guess = ocp.Guess(phases=g.phases, parameters={**dict(g.parameters), **start})
+        else:
+            guess = ocp.Guess(phases=gp.guess.phases, parameters=dict(start))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ocp.SolveFailedWarning)
+            sol = gait_ocp.solve(gp, guess=guess, progress=progress)
+        sol.stats["from_cache"] = False
         return sol
-    gp = gait_ocp.build(spec)
-    if warm is not None:
-        g = gait_ocp.warm_start(gp, warm)
-        guess = ocp.Guess(phases=g.phases, parameters={**dict(g.parameters), **start})
-    else:
-        guess = ocp.Guess(phases=gp.guess.phases, parameters=dict(start))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ocp.SolveFailedWarning)
-        sol = gait_ocp.solve(gp, guess=guess, progress=progress)
-    if use_cache:
-        cache.save(where, sol.save)
-    sol.stats["from_cache"] = False
-    return sol
+
+    return cache.solve_or_load(where, solve, gait_ocp.GaitSolution.from_cache, marker="spec.json",
+                               use_cache=use_cache)
 
 
 #: Continuation towards approach (b) from a start far from dynamic consistency (our device):

@@ -16,7 +16,6 @@ class) and appear only in columns labelled with their table.
 from __future__ import annotations
 
 import json
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -24,8 +23,8 @@ import pandas as pd
 
 from .. import cache
 from .. import conventions as cv
-from .. import ocp
 from ..problems import gait as gait_ocp
+from ..problems.gait import tracking_data
 
 __all__ = ["THESIS_RMSE", "solve_cached", "natural_gait", "natural_gait_spec", "rmse_beside_thesis",
            "channels_frame", "sims_and_marks", "write_outputs", "stats_table", "tracking_data"]
@@ -61,7 +60,7 @@ def cache_dir(spec: gait_ocp.GaitSpec, *, guess=None, root=None) -> Path:
     data and identified sets the spec reads."""
     desc = {"kind": "gait", **spec.to_dict()}
     if guess is not None:
-        desc["warm_start"] = _guess_signature(guess)
+        desc["warm_start"] = gait_ocp.guess_signature(guess)
     return cache.lookup("gait", desc, root, formulation=gait_ocp.FORMULATION, identified=spec.identified_sets())
 
 
@@ -70,14 +69,7 @@ def load_cached(where) -> gait_ocp.GaitSolution | None:
     entry in the repository's store), with ``stats["from_cache"] = True``; None if absent.
     A failed solve reloads as failed (its warning silenced: the status is the result)."""
     found = cache.find(where, "spec.json")
-    if found is None:
-        return None
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ocp.SolveFailedWarning)
-        sol = gait_ocp.GaitSolution.load(found)
-    sol.stats["from_cache"] = True
-    sol.stats["cache_path"] = str(found)
-    return sol
+    return None if found is None else gait_ocp.GaitSolution.from_cache(found)
 
 
 def solve_cached(spec: gait_ocp.GaitSpec, *, use_cache: bool = True, root=None, guess=None,
@@ -87,27 +79,13 @@ def solve_cached(spec: gait_ocp.GaitSpec, *, use_cache: bool = True, root=None, 
     failed — their status is the result. ``guess``: a :class:`~gaitlib.ocp.Guess` or
     another :class:`~gaitlib.ocp.Solution` (warm start; part of the cache key via its
     objective and status only if given, so warm-started runs are cached separately)."""
-    where = cache_dir(spec, guess=guess, root=root)
-    sol = load_cached(where) if use_cache else None
-    if sol is not None:
+    def solve():
+        sol = gait_ocp.solve(spec, guess=guess, progress=progress)
+        sol.stats["from_cache"] = False
         return sol
-    sol = gait_ocp.solve(spec, guess=guess, progress=progress)
-    if use_cache:
-        cache.save(where, sol.save)
-    sol.stats["from_cache"] = False
-    return sol
 
-
-def _guess_signature(guess) -> str:
-    if isinstance(guess, gait_ocp.GaitSolution):
-        guess = guess.solution
-    if isinstance(guess, ocp.Solution):
-        sig = f"solution:{guess.status}:{guess.objective:.12g}:{guess.iterations}"
-        # a guess derived from a solution (part of it, time-scaled, …) says how, so two
-        # different guesses from one solution never share a key (e.g. studies.predictive)
-        derived = (guess.info or {}).get("guess_derivation")
-        return f"{sig}:{derived}" if derived else sig
-    return f"guess:{id(guess)}"
+    return cache.solve_or_load(cache_dir(spec, guess=guess, root=root), solve, gait_ocp.GaitSolution.from_cache,
+                               marker="spec.json", use_cache=use_cache)
 
 
 def natural_gait_spec(model: str = "SK", cost: str | None = None, speed: str = "Free", **kw) -> gait_ocp.GaitSpec:
@@ -118,20 +96,6 @@ def natural_gait_spec(model: str = "SK", cost: str | None = None, speed: str = "
     if cost is None:
         cost = {"SK": "Eq4.11", "MSK": "Eq5.33", "NMSK": "Eq5.55"}.get(model, "Eq5.33")
     return gait_ocp.GaitSpec(model=model, cost=cost, speed_class=speed, **kw)
-
-
-def tracking_data(gait):
-    """The data as the gait problem tracks them: the hip channels become the thigh's angle
-    in the laboratory (data hip + data pelvic tilt, model signs; SD unchanged), because the
-    model's HAT is upright while the data's pelvis tilts ≈ 11° forward
-    (:mod:`gaitlib.problems.gait`, :func:`gaitlib.kinematics.pose_from_data`)."""
-    import dataclasses
-
-    mean = gait.mean.copy()
-    for s in cv.SIDES:
-        mean[f"hip_{s}"] = mean[f"hip_{s}"] + mean["pelvis_tilt"]
-    return dataclasses.replace(gait, mean=mean, notes=tuple(getattr(gait, "notes", ()) or ()) +
-                               ("hip = thigh in the laboratory (data hip + pelvic tilt)",))
 
 
 def natural_gait(model: str = "SK", cost: str | None = None, speed: str = "Free", *, use_cache: bool = True,

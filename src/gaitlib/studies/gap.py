@@ -290,7 +290,7 @@ def left_leg_check(diag: D.Diagnosis) -> dict:
     gait_x, replaced = exact_left_leg(ds.gait)
     ds_x = replace(ds, gait=gait_x)
     loc_x = L.locate(diag.baseline, ds_x)
-    view = L.tracking_view(ds.gait)
+    view = gait_ocp.tracking_data(ds.gait)
     gen_sim = view.mean.set_axis(pd.Index(view.time / float(view.cycle_time), name="tau"), axis=0)
     gen = L.locate(gen_sim, ds_x)
     g = gen.channels[gen.channels["side"] == "l"][["channel", "rss", "rms_z", "significant"]]

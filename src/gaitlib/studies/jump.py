@@ -87,10 +87,12 @@ t (s); SI everywhere, degrees only in :data:`TABLE_3_5` and in figures.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import asdict, dataclass, replace
 from typing import Any
 
 import casadi as ca
+
 import numpy as np
 import pandas as pd
 
@@ -914,21 +916,27 @@ def solve(sp: JumpSpec | str, guess: ocp.Guess | ocp.Solution | None = None, *,
     """
     if isinstance(sp, str):
         sp = SPECS[sp]
-    where = None
-    if use_cache and guess is None:
-        where = cache_location(sp, root)
-        found = cache.find(where, "solution.json")
-        if found is not None:
-            import warnings
+    cached = use_cache and guess is None  # a warm-started solve is not the spec's solution
 
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", ocp.SolveFailedWarning)
-                sol = ocp.Solution.load(found)
-            model = JumpModel(toe=sp.toe, damping=sp.damping)
-            p_contact = contact_mod.default_params() if sp.contact == "ellipsoid" else None
-            out = _result(sp, model, p_contact, sol)
-            out.from_cache = True
-            return out
+    def load(found):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ocp.SolveFailedWarning)
+            return ocp.Solution.load(found), True
+
+    sol, from_cache = cache.solve_or_load(cache_location(sp, root) if cached else None,
+                                          lambda: (_solve_continued(sp, guess), False), load,
+                                          marker="solution.json", use_cache=cached,
+                                          write=lambda s_f: s_f[0].save)
+    model = JumpModel(toe=sp.toe, damping=sp.damping)
+    p_contact = contact_mod.default_params() if sp.contact == "ellipsoid" else None
+    out = _result(sp, model, p_contact, sol)
+    out.from_cache = from_cache
+    return out
+
+
+def _solve_continued(sp: JumpSpec, guess) -> ocp.Solution:
+    """Solve ``sp`` from ``guess``, or, without one, through its mesh continuation
+    (:attr:`JumpSpec.continuation`: each coarser mesh warm-starts the next)."""
     record = []
     steps = [n for n in sp.continuation if n < sp.n_intervals] if guess is None else []
     for n in steps:
@@ -943,9 +951,7 @@ def solve(sp: JumpSpec | str, guess: ocp.Guess | ocp.Solution | None = None, *,
     tx = ocp.transcribe(jp.problem, jp.mesh, jp.options)
     sol = tx.solve(jp.guess if guess is None else guess)
     sol.info["continuation"] = record
-    if where is not None:
-        cache.save(where, sol.save)
-    return _result(sp, jp.model, jp.p_contact, sol)
+    return sol
 
 
 def solve_all(names=("toeless", "toe", "ellipsoid"), use_cache: bool = False,

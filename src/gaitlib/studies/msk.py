@@ -38,7 +38,6 @@ from .. import activation
 from .. import conventions as cv
 from .. import data as data_mod
 from .. import metabolics
-from .. import mtg
 from .. import params as params_mod
 from ..problems import gait as gait_ocp
 from . import gait as sg

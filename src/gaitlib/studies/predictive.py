@@ -173,7 +173,7 @@ def thesis_guess(base: gait_ocp.GaitSolution, *, cycle_time: float | None = None
     phase = ocp.PhaseSolution("cycle", X, U, float(ph.t0), tf)
     f = lambda v: "None" if v is None else f"{float(v):.12g}"  # noqa: E731
     how = f"thesis_guess(full={bool(full)}, cycle_time={f(cycle_time)}, stride={f(stride)})"
-    # the derivation is part of the warm start's cache signature (studies.gait._guess_signature)
+    # the derivation is part of the warm start's cache signature (problems.gait.guess_signature)
     return replace(sol, phases={"cycle": phase}, parameters={}, info={**(sol.info or {}), "guess_derivation": how})
 
 
