@@ -59,7 +59,11 @@ import time
 from datetime import datetime, timezone
 from pathlib import Path
 
-import numpy as np
+from gaitlib import blas
+
+blas.pin()  # the Makefile's BLAS settings (unless set), before numpy is imported
+
+import numpy as np  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "results"
 REPEATS = 15
@@ -245,7 +249,6 @@ def compile_c(funs, opt: str, workdir: Path) -> tuple[list, float]:
 def measure(quick: bool) -> dict:
     import casadi as ca
 
-    import gaitlib  # noqa: F401  (one BLAS thread)
     from gaitlib import ocp
     from gaitlib import transcription as tr
     from gaitlib.studies import gait
@@ -329,7 +332,6 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true")
     args = ap.parse_args(argv)
-    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     load = os.getloadavg()[0]
     m = measure(args.quick)
     prof_path = OUT / "msk_profile.json"

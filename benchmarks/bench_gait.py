@@ -21,10 +21,13 @@ import time
 from datetime import datetime, timezone
 from pathlib import Path
 
-import gaitlib  # noqa: F401  (sets one BLAS thread)
-from gaitlib import ocp
-from gaitlib import transcription as tr
-from gaitlib.studies import gait
+from gaitlib import blas
+
+blas.pin()  # the Makefile's BLAS settings (unless set), before numpy is imported
+
+from gaitlib import ocp  # noqa: E402
+from gaitlib import transcription as tr  # noqa: E402
+from gaitlib.studies import gait  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "results"
 

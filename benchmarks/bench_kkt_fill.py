@@ -75,7 +75,9 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true")
     args = ap.parse_args(argv)
 
-    import gaitlib  # noqa: F401  (one BLAS thread)
+    from gaitlib import blas
+
+    blas.pin()  # the Makefile's BLAS settings (unless set)
     from gaitlib.studies.performance import fit_power_law, machine_info, md_table, write_report
 
     if args.quick:

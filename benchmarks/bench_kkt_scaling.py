@@ -67,7 +67,9 @@ def child(model: str, n: int, repeats: int) -> dict:
     import numpy as np
     import scipy.sparse as sp
 
-    import gaitlib  # noqa: F401  (one BLAS thread)
+    from gaitlib import blas
+
+    blas.pin()  # the Makefile's BLAS settings (unless set)
     from gaitlib import ocp
     from gaitlib import transcription as tr
     from gaitlib.studies import gait

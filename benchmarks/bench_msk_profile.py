@@ -82,7 +82,9 @@ def child(args) -> None:
     """One solve, IPOPT's log on stdout; the result as the last line (JSON)."""
     import dataclasses
 
-    import gaitlib  # noqa: F401  (one BLAS thread)
+    from gaitlib import blas
+
+    blas.pin()  # the Makefile's BLAS settings (unless set)
     from gaitlib import ocp
     from gaitlib import transcription as tr
 
@@ -117,7 +119,9 @@ def parse(log: str) -> dict:
 def graph_sizes(quick: bool) -> list[dict]:
     import casadi as ca
 
-    import gaitlib  # noqa: F401
+    from gaitlib import blas
+
+    blas.pin()  # the Makefile's BLAS settings (unless set)
     from gaitlib import ocp
     from gaitlib import transcription as tr
 

@@ -69,7 +69,9 @@ def child(model: str, n_intervals: int, degree: int) -> None:
     import casadi as ca
     import numpy as np
 
-    import gaitlib  # noqa: F401
+    from gaitlib import blas
+
+    blas.pin()  # the Makefile's BLAS settings (unless set)
     from gaitlib import ocp
     from gaitlib import transcription as tr
     from gaitlib.studies import gait

@@ -54,7 +54,9 @@ ENV1 = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": 
 # -- child side: one solve ----------------------------------------------------------------
 
 def _one(case: dict) -> dict:
-    import gaitlib  # noqa: F401  (one BLAS thread)
+    from gaitlib import blas
+
+    blas.pin()  # the Makefile's BLAS settings (unless set)
     from gaitlib import transcription as tr
     from gaitlib.studies import gait
 

@@ -51,8 +51,8 @@ default        The study functions reload cached solutions (the key hashes spec,
 
 Output: ``benchmarks/results/thesis_times.json`` and ``.md``. With ``--chapters`` the rows
 of the other chapters are kept from the existing file (each row records the mode and the
-time of the collection it came from). Set ``OPENBLAS_NUM_THREADS=1`` (gaitlib does) and run
-it niced on a shared machine.
+time of the collection it came from). The script sets the Makefile's BLAS settings
+(:mod:`gaitlib.blas`) unless they are set; run it niced on a shared machine.
 """
 
 from __future__ import annotations
@@ -70,9 +70,11 @@ import traceback
 from contextlib import nullcontext
 from pathlib import Path
 
-# before numpy loads OpenBLAS: the Makefile's kernel (the gap solutions' cache keys hash the
-# data's numbers, which depend on it; environment.md)
-os.environ.setdefault("OPENBLAS_CORETYPE", "Haswell")
+from gaitlib import blas
+
+# before numpy loads OpenBLAS: the Makefile's settings (the gap solutions' cache keys hash
+# the data's numbers, which depend on OpenBLAS's kernel; environment.md)
+blas.pin()
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "results"
@@ -524,8 +526,6 @@ def main(argv=None) -> int:
     ap.add_argument("--chapters", nargs="+", choices=CHAPTERS, default=list(CHAPTERS))
     ap.add_argument("--out", type=Path, default=OUT, help="results directory (default benchmarks/results)")
     args = ap.parse_args(argv)
-    for v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
-        os.environ.setdefault(v, "1")
     chapters = [c for c in CHAPTERS if c in args.chapters]
     mode_name = "cached-only" if args.cached_only else "resolve" if args.resolve else "cached"
     if args.cached_only and args.measure_uncached:
