@@ -341,7 +341,7 @@ def main(argv=None) -> int:
            "machine": f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}",
            "load_at_start": load, "code": __import__("gaitlib.cache").cache.fingerprint(),
            "quick": args.quick, **m, "floors": fl}
-    from gaitlib.studies.performance import md_table, write_report
+    from report import md_table, write_report
 
     sm, vm, cc = m["solver_function_ms"], m["mapped_vm_ms"], m["mapped_compiled_ms"]
     md = [f"# MSK {m['n_intervals']} × {m['degree']}: evaluation cost, SX virtual machine vs compiled C "

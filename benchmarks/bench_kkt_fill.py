@@ -78,7 +78,10 @@ def main(argv=None) -> int:
     from gaitlib import blas
 
     blas.pin()  # the Makefile's BLAS settings (unless set)
-    from gaitlib.studies.performance import fit_power_law, machine_info, md_table, write_report
+
+    from report import machine_info, md_table, write_report
+
+    from gaitlib.studies.performance import fit_power_law
 
     if args.quick:
         grid, degree, models = (2, 4, 8), 3, ("SK",)

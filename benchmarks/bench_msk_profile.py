@@ -173,7 +173,7 @@ def main(argv=None) -> int:
            "machine": f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}",
            "code": __import__("gaitlib.cache").cache.fingerprint(), "quick": args.quick,
            "runs": rows, "graph_sizes": sizes}
-    from gaitlib.studies.performance import md_table, write_report
+    from report import md_table, write_report
 
     stem = "msk_profile_quick" if args.quick else "msk_profile"
     cols = ["variant", "status", "iterations", "solve_s", "ms_per_iteration", "hessian_s", "other_evals_s",

@@ -103,7 +103,9 @@ def main(argv=None) -> int:
     if args.child is not None:
         child(args.child[0], int(args.child[1]), int(args.child[2]))
         return 0
-    from gaitlib.studies.performance import fit_power_law, md_table, write_report
+    from report import md_table, write_report
+
+    from gaitlib.studies.performance import fit_power_law
 
     degree = 3 if args.quick else 5
     rows = []

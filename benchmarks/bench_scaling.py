@@ -104,7 +104,7 @@ def _probe(ls: str) -> None:
 # -- parent side ----------------------------------------------------------------------------
 
 def _machine() -> dict:
-    from gaitlib.studies.performance import machine_info
+    from report import machine_info
 
     return machine_info()
 

@@ -35,8 +35,6 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .. import cache
-
 __all__ = ["results_dir", "load", "load_optional", "fit_power_law", "scaling_table", "scaling_fits", "hessian_table",
            "linear_solver_table", "moco_table", "gait_table", "msk_profile_tables", "eval_floor_table", "kkt_scaling_tables", "measured_on", "ThesisTime", "THESIS_SILENT",
            "thesis_reference_times", "parse_duration", "time_row", "missing_row", "NOT_COMPUTED", "NO_CACHE",
@@ -46,6 +44,11 @@ __all__ = ["results_dir", "load", "load_optional", "fit_power_law", "scaling_tab
 #: Runs of the scaling benchmark whose time per iteration is a measurement (the solver ran
 #: to the end: converged or stopped by its own criterion), as opposed to "timeout"/"error".
 FINISHED = "finished"
+
+#: Status of a thesis-times row whose optimisation is not in the cache (``--cached-only``).
+NOT_COMPUTED = "not computed yet"
+#: Status of a thesis-times row of a study that has no solution cache.
+NO_CACHE = "not measured (no solution cache)"
 
 
 def results_dir() -> Path:
@@ -81,28 +84,6 @@ def load_optional(name: str, root=None) -> dict | None:
     except FileNotFoundError as e:
         print(e)
         return None
-
-
-def md_table(cols, rows) -> list[str]:
-    """A markdown table of ``rows`` (dicts) over ``cols``: floats to 4 significant digits,
-    missing values empty. Returns its lines (header, separator, one per row)."""
-    def cell(v):
-        return f"{v:.4g}" if isinstance(v, float) else ("" if v is None else str(v))
-
-    return ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)] + [
-        "| " + " | ".join(cell(r.get(c)) for c in cols) + " |" for r in rows]
-
-
-def write_report(out: Path, stem: str, doc: dict, md: list[str]) -> None:
-    """A benchmark's results: ``<out>/<stem>.json`` (``doc``) and ``<out>/<stem>.md``
-    (``md`` lines, also printed)."""
-    import json
-
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / f"{stem}.json").write_text(json.dumps(doc, indent=1, default=str))
-    (out / f"{stem}.md").write_text("\n".join(md) + "\n")
-    print("\n".join(md))
 
 
 def fit_power_law(n, y) -> dict:
@@ -285,144 +266,6 @@ def measured_on(res: dict) -> str:
     return s
 
 
-# ======================================================================================
-# Thesis times (issue 8, item 1): every optimisation the book runs beside the thesis's time
-# ======================================================================================
-from dataclasses import dataclass  # noqa: E402
-import math  # noqa: E402
-import re  # noqa: E402
-
-
-@dataclass(frozen=True)
-class ThesisTime:
-    """A compute time the thesis prints: ``seconds`` (s) and ``label`` (the value as printed,
-    with its section or table). GPOPS-II / MATLAB on an Intel i7-6700 (3.4 GHz, 16 GB),
-    IPOPT in first-derivative mode, tolerance 1e-5 (thesis Secs 4.3.2, 5.2.1, 6.1, 7.1)."""
-
-    seconds: float
-    label: str
-
-
-#: Optimisations for which the thesis prints no compute time (the thesis column stays empty).
-THESIS_SILENT = {
-    "ch02 SK": "the thesis prints no time for SK tracking with the contact parameters fixed; its 11 min "
-               "(Sec 4.3.3) is with the 39 contact parameters identified — the Ch 4 (b) row",
-    "ch03": "Ch 3 prints no solve times for the jumps",
-    "ch05 MTG": "Sec 5.1 prints no time for the MTG parameter identification",
-}
-
-#: Where Ch 5's hours (:data:`gaitlib.studies.msk.THESIS_HOURS`) are printed.
-_CH5_SOURCE = {"MSK": "Sec 5.2.2", "NMSK": "Sec 5.3.5"}
-
-_DURATION = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*(s|min|h|hrs?|hours?)\b", re.IGNORECASE)
-
-
-def parse_duration(text: str) -> float:
-    """Seconds of a printed duration at the start of ``text`` ("6 min (Sec 4.3.3, …)" → 360,
-    "5 h (…)" → 18000, "30 s" → 30). Raises ValueError if ``text`` does not start with one."""
-    m = _DURATION.match(text)
-    if m is None:
-        raise ValueError(f"no duration at the start of {text!r}")
-    unit = m.group(2).lower()
-    scale = 1.0 if unit == "s" else 60.0 if unit == "min" else 3600.0
-    return float(m.group(1)) * scale
-
-
-def _hours(h: float) -> str:
-    return f"{h:g} h"
-
-
-def thesis_reference_times() -> dict[str, ThesisTime]:
-    """Every compute time the thesis prints, keyed by the book's optimisation:
-
-    ``"ch04 a"``, ``"ch04 b"``, ``"ch04 c"``, ``"ch04 c_wide"`` — Sec 4.3.3 (6 min GlobalSearch,
-    11 min GPOPS-II) and Sec 4.4.2 (5 h), from :data:`gaitlib.studies.contact_id.THESIS_TIME`
-    ((c′) is our variant of (c): the thesis's (c) is its reference);
-    ``"ch05 MSK"``, ``"ch05 NMSK"`` — Secs 5.2.2 and 5.3.5 (2 h each,
-    :data:`gaitlib.studies.msk.THESIS_HOURS`); ``"ch02 MSK"`` — the same MSK Eq 5.33 problem
-    (Ch 2 solves it with the thesis's parameter sets);
-    ``"ch06 <model> <cost>"`` — Table 6.3 (:data:`~gaitlib.studies.predictive.THESIS_HOURS_TABLE_6_3`);
-    ``"ch07 <model> <our class>"`` — Table 7.2 for the thesis's class of the same rank
-    (:data:`~gaitlib.studies.predictive.THESIS_HOURS_TABLE_7_2`, :data:`~gaitlib.studies.predictive.THESIS_CLASS`).
-
-    Nothing else: where the thesis prints no time (:data:`THESIS_SILENT`) there is no key."""
-    from . import contact_id, msk, predictive
-
-    out: dict[str, ThesisTime] = {}
-    for k, lab in contact_id.THESIS_TIME.items():
-        out[f"ch04 {k}"] = ThesisTime(parse_duration(lab), lab if k != "c_wide" else f"{lab}; thesis's (c)")
-    for m, h in msk.THESIS_HOURS.items():
-        out[f"ch05 {m}"] = ThesisTime(3600.0 * h, f"{_hours(h)} ({_CH5_SOURCE[m]}, GPOPS-II)")
-    out["ch02 MSK"] = out["ch05 MSK"]  # the same MSK Eq 5.33 problem (Ch 2: the thesis's parameter sets)
-    for m, row in predictive.THESIS_HOURS_TABLE_6_3.items():
-        for cost, h in row.items():
-            out[f"ch06 {m} {cost}"] = ThesisTime(3600.0 * h, f"{_hours(h)} (Table 6.3, {m} {cost})")
-    for m, row in predictive.THESIS_HOURS_TABLE_7_2.items():
-        for ours, theirs in predictive.THESIS_CLASS.items():
-            if theirs in row:
-                h = row[theirs]
-                out[f"ch07 {m} {ours}"] = ThesisTime(3600.0 * h, f"{_hours(h)} (Table 7.2, {m} {theirs})")
-    return out
-
-
-#: Status of a row whose optimisation is not in the cache (``--cached-only``).
-NOT_COMPUTED = "not computed yet"
-#: Status of a row of a study that has no solution cache (skipped by ``--cached-only``).
-NO_CACHE = "not measured (no solution cache)"
-
-#: Columns of the thesis-times table, in order.
-TIME_COLUMNS = ("chapter", "run", "study_call", "n_solves", "status", "converged", "iterations", "build_s",
-                "solve_s", "wall_s", "ms_per_iteration", "thesis_time", "thesis_time_s", "speedup", "from_cache",
-                "solved_at", "cache_entry", "note")
-
-
-def _num(x):
-    if x is None:
-        return None
-    x = float(x)
-    return x if math.isfinite(x) else None
-
-
-def time_row(chapter: str, run: str, *, status: str, converged: bool, iterations, build_s, solve_s,
-             wall_s=None, n_solves: int = 1, from_cache=None, solved_at=None, cache_entry=None,
-             thesis_key: str | None = None, study_call: str = "", note: str = "", thesis=None) -> dict:
-    """One optimisation of the book as a row of the thesis-times table.
-
-    ``build_s`` (s): symbolic graph, exact derivatives and IPOPT set-up; ``solve_s`` (s): the
-    IPOPT call(s); ``wall_s`` defaults to ``build_s + solve_s`` (given explicitly for
-    multi-start searches whose wall time includes scoring the start points);
-    ``iterations`` summed over the ``n_solves`` NLP solves of the optimisation (continuation
-    stages included). ``ms_per_iteration`` = 1000 · solve_s / iterations.
-
-    The thesis's time (``thesis_key`` in :func:`thesis_reference_times`, or ``thesis`` given
-    as a :class:`ThesisTime`) is carried as a labelled reference; ``speedup`` = thesis time /
-    our wall time, **only for a converged run** (``converged``): a run IPOPT did not finish
-    keeps its status and has no speed-up."""
-    ref = thesis if thesis is not None else (thesis_reference_times().get(thesis_key) if thesis_key else None)
-    build, solve = _num(build_s), _num(solve_s)
-    wall = _num(wall_s) if wall_s is not None else (build + solve if build is not None and solve is not None else None)
-    its = int(iterations) if iterations is not None else None
-    mspi = 1e3 * solve / its if (solve is not None and its) else None
-    speedup = ref.seconds / wall if (converged and ref is not None and wall) else None
-    return {"chapter": chapter, "run": run, "study_call": study_call, "n_solves": int(n_solves),
-            "status": str(status), "converged": bool(converged), "iterations": its, "build_s": build,
-            "solve_s": solve, "wall_s": wall, "ms_per_iteration": mspi,
-            "thesis_time": ref.label if ref is not None else None,
-            "thesis_time_s": ref.seconds if ref is not None else None, "speedup": speedup,
-            "from_cache": from_cache, "solved_at": solved_at, "cache_entry": cache_entry, "note": note}
-
-
-def missing_row(chapter: str, run: str, reason: str, *, status: str = NOT_COMPUTED, thesis_key: str | None = None,
-                study_call: str = "") -> dict:
-    """A row for an optimisation that was not collected (not in the cache under
-    ``--cached-only``, or a study without a cache): no times, no speed-up, ``reason`` as note
-    (what to run to compute it). The thesis's time, if any, is still shown."""
-    row = time_row(chapter, run, status=status, converged=False, iterations=None, build_s=None, solve_s=None,
-                   thesis_key=thesis_key, study_call=study_call, note=reason)
-    row["n_solves"] = 0
-    return row
-
-
 def thesis_times_table(res: dict | None = None) -> pd.DataFrame:
     """The stored thesis-times table (``thesis_times.json``) for display: one row per
     optimisation, times in s, the thesis's time with its label, the speed-up (converged
@@ -524,36 +367,3 @@ def thesis_times_figure(res: dict | None = None):
     ax.set_title("Every optimisation with a thesis time: ours vs the thesis's (speed-up at our bar)", fontsize=9)
     fig.tight_layout()
     return fig
-
-
-#: Raised by a solve attempted inside :func:`no_solving`.
-NotInCache = cache.NotCached
-
-
-def no_solving(what: str = "solving is disabled (--cached-only)"):
-    """Within the block, a solve of anything not cached raises :class:`NotInCache`
-    (:func:`gaitlib.cache.only`); cached solutions still load."""
-    return cache.only(what)
-
-
-def machine_info() -> dict:
-    """The machine a benchmark ran on: CPU model, cores, memory (GiB), platform, Python, host."""
-    import os
-    import platform
-    from pathlib import Path
-
-    cpu = platform.processor() or ""
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    mem = None
-    try:
-        mem = round(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2 ** 30, 1)
-    except (ValueError, OSError, AttributeError):
-        pass
-    return {"cpu": cpu, "cores": os.cpu_count(), "memory_gb": mem, "platform": platform.platform(),
-            "python": platform.python_version(), "node": platform.node()}
