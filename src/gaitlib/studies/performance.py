@@ -559,11 +559,17 @@ def thesis_times_findings(res: dict | None = None) -> list[str]:
     not_conv = rows[~rows["converged"].astype(bool) & ~missing]
     if len(not_conv):
         out.append("• Did not converge (no speed-up given): " + "; ".join(
-            f"{r.chapter} {r.run}: {r.status} after {r.iterations} iterations" for r in not_conv.itertuples()) + ".")
+            f"{r.chapter} {r.run}: {r.status} after {_count(r.iterations)} iterations"
+            for r in not_conv.itertuples()) + ".")
     if missing.any():
         out.append("• Not collected: " + "; ".join(
             f"{r.chapter} {r.run} ({r.status})" for r in rows[missing].itertuples()) + ".")
     return out
+
+
+def _count(x) -> str:
+    """An integer count that may have become a float (a column with missing values), or "?"."""
+    return "?" if x is None or pd.isna(x) else f"{int(x)}"
 
 
 def mumps_orderings_findings(res: dict) -> list[str]:
