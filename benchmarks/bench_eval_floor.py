@@ -1,4 +1,4 @@
-"""How fast could the MSK solve be on its own iteration path? (issue 4's ≤ 20 s target; issue 8)
+"""How fast could the MSK solve be on its own iteration path? (the ≤ 20 s target of the MSK solve)
 
     .venv/bin/python benchmarks/bench_eval_floor.py           # MSK 20 × 5, ≈ 3 min (gcc -O2 of one node)
     .venv/bin/python benchmarks/bench_eval_floor.py --quick   # MSK 4 × 3, -O1 (checks the script)

@@ -1,4 +1,4 @@
-"""Natural-gait solve times (issue 4 targets; issue 8 item 1): SK Eq 4.11 and MSK Eq 5.33
+"""Natural-gait solve times: SK Eq 4.11 and MSK Eq 5.33
 at the full mesh (20 × 5 LGR), from the data-based guess and warm-started, with the exact
 Hessian and with L-BFGS.
 

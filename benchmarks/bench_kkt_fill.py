@@ -1,4 +1,4 @@
-"""Why the linear algebra grows faster than the mesh (issue 8, item 3): the symbolic fill of
+"""Why the linear algebra grows faster than the mesh: the symbolic fill of
 the KKT matrix's factorisation, mesh by mesh.
 
     .venv/bin/python benchmarks/bench_kkt_fill.py            # SK and MSK, 5–80 intervals × 5, ≈ 8 min

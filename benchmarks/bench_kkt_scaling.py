@@ -1,4 +1,4 @@
-"""Cost of one interior-point iteration vs mesh size, measured at a fixed point (issue 8, item 3).
+"""Cost of one interior-point iteration vs mesh size, measured at a fixed point.
 
     .venv/bin/python benchmarks/bench_kkt_scaling.py            # SK 5–80, MSK and NMSK 5–20 intervals, ≈ 10 min
     .venv/bin/python benchmarks/bench_kkt_scaling.py --quick    # SK 2–4 intervals (checks the script)

@@ -1,4 +1,4 @@
-"""Where the MSK data-tracking solve spends its time (issue 4's ≤ 20 s target; issue 8).
+"""Where the MSK data-tracking solve spends its time (its target: ≤ 20 s).
 
     .venv/bin/python benchmarks/bench_msk_profile.py            # full mesh, ≈ 10 min
     .venv/bin/python benchmarks/bench_msk_profile.py --quick    # 4 × 3 mesh, ≈ 1 min (checks the script)

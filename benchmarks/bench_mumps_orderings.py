@@ -1,4 +1,4 @@
-"""MUMPS's own analysis of IPOPT's KKT matrix, ordering by ordering and mesh by mesh (issue 8, item 3).
+"""MUMPS's own analysis of IPOPT's KKT matrix, ordering by ordering and mesh by mesh.
 
     .venv/bin/python benchmarks/bench_mumps_orderings.py           # SK 5–80, MSK 5–40 intervals × 5, ≈ 8 min
     .venv/bin/python benchmarks/bench_mumps_orderings.py --quick   # SK 2 and 4 intervals × 3 (checks the script)

@@ -1,4 +1,4 @@
-"""Scaling of the gait OCP (issue 8 item 3): solve time and time per iteration vs mesh size
+"""Scaling of the gait OCP: solve time and time per iteration vs mesh size
 and model; exact Hessian vs limited-memory; the linear solvers casadi's IPOPT can load.
 
     .venv/bin/python benchmarks/bench_scaling.py              # the full benchmark, ≈ 20–30 min

@@ -1,4 +1,4 @@
-"""Thesis times (issue 8, item 1): every optimisation the book runs — its wall time,
+"""Thesis times: every optimisation the book runs — its wall time,
 iterations and time per iteration here — beside the compute time the thesis prints for it,
 and the speed-up (thesis time / our wall time, converged runs only).
 

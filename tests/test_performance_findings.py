@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import math
 
-
 from gaitlib.studies import performance as perf
 
 
