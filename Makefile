@@ -5,7 +5,9 @@ PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
-# One BLAS thread per process: on 2 cores threading only adds system time (see environment.md).
+# The BLAS settings every solve runs under (gaitlib.blas.SETTINGS; see environment.md); the
+# notebook kernel is installed with them too. One BLAS thread per process: on 2 cores
+# threading only adds system time.
 export OPENBLAS_NUM_THREADS := 1
 export OMP_NUM_THREADS := 1
 export MKL_NUM_THREADS := 1
@@ -14,6 +16,7 @@ export MKL_NUM_THREADS := 1
 # left leg differently in the last bits, and the gap diagnosis's cache keys (which hash the
 # data's numbers) miss every stored solution (see environment.md).
 export OPENBLAS_CORETYPE := Haswell
+BLAS_VARS := OPENBLAS_NUM_THREADS OMP_NUM_THREADS MKL_NUM_THREADS OPENBLAS_CORETYPE
 
 .PHONY: book test check-book venv data clean
 
@@ -24,7 +27,7 @@ $(STAMP): requirements.txt pyproject.toml
 	$(BIN)/pip install --quiet --upgrade pip
 	$(BIN)/pip install --quiet -r requirements.txt
 	$(BIN)/pip install --quiet --no-deps --no-build-isolation -e .
-	$(BIN)/python -m ipykernel install --sys-prefix --name python3 >/dev/null
+	$(BIN)/python -m ipykernel install --sys-prefix --name python3 $(foreach v,$(BLAS_VARS),--env $(v) $($(v))) >/dev/null
 	touch $(STAMP)
 
 book: $(STAMP)

@@ -1,4 +1,4 @@
-"""How fast could the MSK solve be on its own iteration path? (issue 4's ≤ 20 s target; issue 8)
+"""How fast could the MSK solve be on its own iteration path? (the ≤ 20 s target of the MSK solve)
 
     .venv/bin/python benchmarks/bench_eval_floor.py           # MSK 20 × 5, ≈ 3 min (gcc -O2 of one node)
     .venv/bin/python benchmarks/bench_eval_floor.py --quick   # MSK 4 × 3, -O1 (checks the script)
@@ -59,7 +59,11 @@ import time
 from datetime import datetime, timezone
 from pathlib import Path
 
-import numpy as np
+from gaitlib import blas
+
+blas.pin()  # the Makefile's BLAS settings (unless set), before numpy is imported
+
+import numpy as np  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "results"
 REPEATS = 15
@@ -245,7 +249,6 @@ def compile_c(funs, opt: str, workdir: Path) -> tuple[list, float]:
 def measure(quick: bool) -> dict:
     import casadi as ca
 
-    import gaitlib  # noqa: F401  (one BLAS thread)
     from gaitlib import ocp
     from gaitlib.problems import gait as gait_ocp
     from gaitlib.studies import gait
@@ -329,7 +332,6 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true")
     args = ap.parse_args(argv)
-    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     load = os.getloadavg()[0]
     m = measure(args.quick)
     prof_path = OUT / "msk_profile.json"
@@ -339,7 +341,7 @@ def main(argv=None) -> int:
            "machine": f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}",
            "load_at_start": load, "code": __import__("gaitlib.cache").cache.fingerprint(),
            "quick": args.quick, **m, "floors": fl}
-    from gaitlib.studies.performance import md_table, write_report
+    from report import md_table, write_report
 
     sm, vm, cc = m["solver_function_ms"], m["mapped_vm_ms"], m["mapped_compiled_ms"]
     md = [f"# MSK {m['n_intervals']} × {m['degree']}: evaluation cost, SX virtual machine vs compiled C "

@@ -1,4 +1,4 @@
-"""Natural-gait solve times (issue 4 targets; issue 8 item 1): SK Eq 4.11 and MSK Eq 5.33
+"""Natural-gait solve times: SK Eq 4.11 and MSK Eq 5.33
 at the full mesh (20 × 5 LGR), from the data-based guess and warm-started, with the exact
 Hessian and with L-BFGS.
 
@@ -21,10 +21,13 @@ import time
 from datetime import datetime, timezone
 from pathlib import Path
 
-import gaitlib  # noqa: F401  (sets one BLAS thread)
-from gaitlib import ocp
-from gaitlib.problems import gait as gait_ocp
-from gaitlib.studies import gait
+from gaitlib import blas
+
+blas.pin()  # the Makefile's BLAS settings (unless set), before numpy is imported
+
+from gaitlib import ocp  # noqa: E402
+from gaitlib.problems import gait as gait_ocp  # noqa: E402
+from gaitlib.studies import gait  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "results"
 

@@ -1,4 +1,4 @@
-"""Why the linear algebra grows faster than the mesh (issue 8, item 3): the symbolic fill of
+"""Why the linear algebra grows faster than the mesh: the symbolic fill of
 the KKT matrix's factorisation, mesh by mesh.
 
     .venv/bin/python benchmarks/bench_kkt_fill.py            # SK and MSK, 5–80 intervals × 5, ≈ 8 min
@@ -75,8 +75,13 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true")
     args = ap.parse_args(argv)
 
-    import gaitlib  # noqa: F401  (one BLAS thread)
-    from gaitlib.studies.performance import fit_power_law, machine_info, md_table, write_report
+    from gaitlib import blas
+
+    blas.pin()  # the Makefile's BLAS settings (unless set)
+
+    from report import machine_info, md_table, write_report
+
+    from gaitlib.studies.performance import fit_power_law
 
     if args.quick:
         grid, degree, models = (2, 4, 8), 3, ("SK",)

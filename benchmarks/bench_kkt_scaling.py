@@ -1,4 +1,4 @@
-"""Cost of one interior-point iteration vs mesh size, measured at a fixed point (issue 8, item 3).
+"""Cost of one interior-point iteration vs mesh size, measured at a fixed point.
 
     .venv/bin/python benchmarks/bench_kkt_scaling.py            # SK 5–80, MSK and NMSK 5–20 intervals, ≈ 10 min
     .venv/bin/python benchmarks/bench_kkt_scaling.py --quick    # SK 2–4 intervals (checks the script)
@@ -67,7 +67,9 @@ def child(model: str, n: int, repeats: int) -> dict:
     import numpy as np
     import scipy.sparse as sp
 
-    import gaitlib  # noqa: F401  (one BLAS thread)
+    from gaitlib import blas
+
+    blas.pin()  # the Makefile's BLAS settings (unless set)
     from gaitlib import ocp
     from gaitlib.problems import gait as gait_ocp
     from gaitlib.studies import gait
@@ -135,6 +137,8 @@ def main(argv=None) -> int:
     if args.child:
         print("RESULT " + json.dumps(child(args.child[0], int(args.child[1]), args.repeats)), flush=True)
         return 0
+    from report import md_table, write_report
+
     from gaitlib.studies import performance as perf
 
     env = {**os.environ, **ENV1}
@@ -169,11 +173,11 @@ def main(argv=None) -> int:
     stem = "kkt_scaling_quick" if args.quick else "kkt_scaling"
     cols = ["model", "n_intervals", "nodes", "kkt_dim", "kkt_nnz", *QUANTITIES, "load_at_start"]
     md = [f"# One iteration's pieces at a fixed point vs mesh size ({doc['measured']}, {doc['machine']})", ""]
-    md += perf.md_table(cols, rows)
+    md += md_table(cols, rows)
     md += ["", "| model | quantity | exponent b | ± | R² | nodes |", "|---|---|---|---|---|---|"]
     md += [f"| {f['model']} | {f['quantity']} | {f['exponent']:.3f} | {f.get('exponent_se', float('nan')):.3f} | "
            f"{f['r2']:.4f} | {f['nodes']} |" for f in fits]
-    perf.write_report(OUT, stem, doc, md)
+    write_report(OUT, stem, doc, md)
     return 0
 
 

@@ -1,4 +1,4 @@
-"""Where the MSK data-tracking solve spends its time (issue 4's ≤ 20 s target; issue 8).
+"""Where the MSK data-tracking solve spends its time (its target: ≤ 20 s).
 
     .venv/bin/python benchmarks/bench_msk_profile.py            # full mesh, ≈ 10 min
     .venv/bin/python benchmarks/bench_msk_profile.py --quick    # 4 × 3 mesh, ≈ 1 min (checks the script)
@@ -82,7 +82,9 @@ def child(args) -> None:
     """One solve, IPOPT's log on stdout; the result as the last line (JSON)."""
     import dataclasses
 
-    import gaitlib  # noqa: F401  (one BLAS thread)
+    from gaitlib import blas
+
+    blas.pin()  # the Makefile's BLAS settings (unless set)
     from gaitlib import ocp
     from gaitlib.problems import gait as gait_ocp
 
@@ -117,7 +119,9 @@ def parse(log: str) -> dict:
 def graph_sizes(quick: bool) -> list[dict]:
     import casadi as ca
 
-    import gaitlib  # noqa: F401
+    from gaitlib import blas
+
+    blas.pin()  # the Makefile's BLAS settings (unless set)
     from gaitlib import ocp
     from gaitlib.problems import gait as gait_ocp
 
@@ -169,7 +173,7 @@ def main(argv=None) -> int:
            "machine": f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}",
            "code": __import__("gaitlib.cache").cache.fingerprint(), "quick": args.quick,
            "runs": rows, "graph_sizes": sizes}
-    from gaitlib.studies.performance import md_table, write_report
+    from report import md_table, write_report
 
     stem = "msk_profile_quick" if args.quick else "msk_profile"
     cols = ["variant", "status", "iterations", "solve_s", "ms_per_iteration", "hessian_s", "other_evals_s",

@@ -1,4 +1,4 @@
-"""MUMPS's own analysis of IPOPT's KKT matrix, ordering by ordering and mesh by mesh (issue 8, item 3).
+"""MUMPS's own analysis of IPOPT's KKT matrix, ordering by ordering and mesh by mesh.
 
     .venv/bin/python benchmarks/bench_mumps_orderings.py           # SK 5–80, MSK 5–40 intervals × 5, ≈ 8 min
     .venv/bin/python benchmarks/bench_mumps_orderings.py --quick   # SK 2 and 4 intervals × 3 (checks the script)
@@ -69,7 +69,9 @@ def child(model: str, n_intervals: int, degree: int) -> None:
     import casadi as ca
     import numpy as np
 
-    import gaitlib  # noqa: F401
+    from gaitlib import blas
+
+    blas.pin()  # the Makefile's BLAS settings (unless set)
     from gaitlib import ocp
     from gaitlib.problems import gait as gait_ocp
     from gaitlib.studies import gait
@@ -101,7 +103,9 @@ def main(argv=None) -> int:
     if args.child is not None:
         child(args.child[0], int(args.child[1]), int(args.child[2]))
         return 0
-    from gaitlib.studies.performance import fit_power_law, md_table, write_report
+    from report import md_table, write_report
+
+    from gaitlib.studies.performance import fit_power_law
 
     degree = 3 if args.quick else 5
     rows = []

@@ -1,4 +1,4 @@
-"""Scaling of the gait OCP (issue 8 item 3): solve time and time per iteration vs mesh size
+"""Scaling of the gait OCP: solve time and time per iteration vs mesh size
 and model; exact Hessian vs limited-memory; the linear solvers casadi's IPOPT can load.
 
     .venv/bin/python benchmarks/bench_scaling.py              # the full benchmark, ≈ 20–30 min
@@ -54,7 +54,9 @@ ENV1 = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": 
 # -- child side: one solve ----------------------------------------------------------------
 
 def _one(case: dict) -> dict:
-    import gaitlib  # noqa: F401  (one BLAS thread)
+    from gaitlib import blas
+
+    blas.pin()  # the Makefile's BLAS settings (unless set)
     from gaitlib.problems import gait as gait_ocp
     from gaitlib.studies import gait
 
@@ -102,7 +104,7 @@ def _probe(ls: str) -> None:
 # -- parent side ----------------------------------------------------------------------------
 
 def _machine() -> dict:
-    from gaitlib.studies.performance import machine_info
+    from report import machine_info
 
     return machine_info()
 

@@ -1,4 +1,4 @@
-"""Thesis times (issue 8, item 1): every optimisation the book runs — its wall time,
+"""Thesis times: every optimisation the book runs — its wall time,
 iterations and time per iteration here — beside the compute time the thesis prints for it,
 and the speed-up (thesis time / our wall time, converged runs only).
 
@@ -34,7 +34,7 @@ default        The study functions reload cached solutions (the key hashes spec,
                ``from_cache`` says which rows were reloaded, ``solved_at`` is the file time
                of the cache entry (for entries of the repository's store: unknown). Runs
                not in the cache are solved now (serially, in this process) and cached.
---cached-only  Never solve (gaitlib.studies.performance.no_solving): an optimisation that
+--cached-only  Never solve (gaitlib.cache.only): an optimisation that
                is not in the cache becomes a "not computed yet" row saying what to run.
                The Ch 5 MTG identification has no solution cache (the book re-solves it at
                every build, ≈ 10 s each); it is skipped unless ``--measure-uncached``.
@@ -51,8 +51,8 @@ default        The study functions reload cached solutions (the key hashes spec,
 
 Output: ``benchmarks/results/thesis_times.json`` and ``.md``. With ``--chapters`` the rows
 of the other chapters are kept from the existing file (each row records the mode and the
-time of the collection it came from). Set ``OPENBLAS_NUM_THREADS=1`` (gaitlib does) and run
-it niced on a shared machine.
+time of the collection it came from). The script sets the Makefile's BLAS settings
+(:mod:`gaitlib.blas`) unless they are set; run it niced on a shared machine.
 """
 
 from __future__ import annotations
@@ -70,9 +70,19 @@ import traceback
 from contextlib import nullcontext
 from pathlib import Path
 
-# before numpy loads OpenBLAS: the Makefile's kernel (the gap solutions' cache keys hash the
-# data's numbers, which depend on it; environment.md)
-os.environ.setdefault("OPENBLAS_CORETYPE", "Haswell")
+from gaitlib import blas
+
+# before numpy loads OpenBLAS: the Makefile's settings (the gap solutions' cache keys hash
+# the data's numbers, which depend on OpenBLAS's kernel; environment.md)
+blas.pin()
+
+import thesis_times as tt  # noqa: E402  (benchmarks/thesis_times.py)
+from report import machine_info  # noqa: E402
+from gaitlib import cache  # noqa: E402
+from gaitlib.studies import performance  # noqa: E402
+
+#: Why a solve is refused under ``--cached-only`` (the message of :class:`gaitlib.cache.NotCached`).
+NO_SOLVING = "solving is disabled (--cached-only)"
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "results"
@@ -159,15 +169,15 @@ def _merge_entries(entries: list[dict]) -> dict:
 # --------------------------------------------------------------------------------------
 # Chapters
 # --------------------------------------------------------------------------------------
-def _gait_row(perf, chapter, run, sol, where, *, thesis_key=None, call="", note=""):
+def _gait_row(chapter, run, sol, where, *, thesis_key=None, call="", note=""):
     st = sol.stats
-    return perf.time_row(chapter, run, status=st["status"], converged=bool(st["success"]),
+    return tt.time_row(chapter, run, status=st["status"], converged=bool(st["success"]),
                          iterations=st["iterations"], build_s=st["build_time_s"], solve_s=st["solve_time_s"],
                          from_cache=bool(st.get("from_cache", False)), thesis_key=thesis_key, study_call=call,
                          note=note, **_entry(where, "spec.json"))
 
 
-def ch02(perf, ctx):
+def ch02(ctx):
     from gaitlib.studies import gait
 
     rows = []
@@ -176,16 +186,16 @@ def ch02(perf, ctx):
         run = f"{model} natural gait, {gait.natural_gait_spec(model).cost} (thesis's parameter sets)"
         try:
             sol = gait.natural_gait(model)
-        except perf.NotInCache:
-            rows.append(perf.missing_row("ch02", run, _how_to("ch02"), thesis_key=f"ch02 {model}", study_call=call))
+        except cache.NotCached:
+            rows.append(tt.missing_row("ch02", run, _how_to("ch02"), thesis_key=f"ch02 {model}", study_call=call))
             continue
-        note = perf.THESIS_SILENT.get(f"ch02 {model}", "")
-        rows.append(_gait_row(perf, "ch02", run, sol, gait.cache_dir(sol.spec), thesis_key=f"ch02 {model}",
+        note = tt.THESIS_SILENT.get(f"ch02 {model}", "")
+        rows.append(_gait_row("ch02", run, sol, gait.cache_dir(sol.spec), thesis_key=f"ch02 {model}",
                               call=call, note=note))
     return rows
 
 
-def ch03(perf, ctx):
+def ch03(ctx):
     from gaitlib.studies import jump
 
     rows = []
@@ -194,8 +204,8 @@ def ch03(perf, ctx):
         run = f"jump: {jump.SPECS[name].label}"
         try:
             s = jump.solve(name, use_cache=True)
-        except perf.NotInCache:
-            rows.append(perf.missing_row("ch03", run, _how_to("ch03"), study_call=call))
+        except cache.NotCached:
+            rows.append(tt.missing_row("ch03", run, _how_to("ch03"), study_call=call))
             continue
         sol = s.solution
         steps = sol.info.get("continuation", [])
@@ -205,15 +215,15 @@ def ch03(perf, ctx):
         cont = "; ".join(f"{c['n_intervals']}-interval continuation: {c['status']}, {c['iterations']} it"
                          for c in steps)
         note = (f"{cont}; {s.spec.n_intervals}-interval solve: {sol.iterations} it. "
-                if cont else "") + perf.THESIS_SILENT["ch03"]
-        rows.append(perf.time_row("ch03", run, status=sol.status, converged=bool(sol.success), iterations=its,
+                if cont else "") + tt.THESIS_SILENT["ch03"]
+        rows.append(tt.time_row("ch03", run, status=sol.status, converged=bool(sol.success), iterations=its,
                                   build_s=build, solve_s=solve, n_solves=1 + len(steps),
                                   from_cache=bool(s.from_cache), study_call=call, note=note,
                                   **_entry(jump.cache_location(s.spec), "solution.json")))
     return rows
 
 
-def _approach_row(perf, key, r, log, call, run):
+def _approach_row(key, r, log, call, run):
     st = r.stats
     if key == "a":
         marker, n = "result.json", st["n_local"]
@@ -233,13 +243,13 @@ def _approach_row(perf, key, r, log, call, run):
             note = f"{n - 1} continuation stages + the problem (residual bounds N, N, N·m): {sts}"
         if key == "c_wide":
             note = "our variant of (c): Table 4.7 contact bounds widened to contain the thesis's (c) values"
-    return perf.time_row("ch04", run, status=st["status"], converged=bool(st["success"]), iterations=st["iterations"],
+    return tt.time_row("ch04", run, status=st["status"], converged=bool(st["success"]), iterations=st["iterations"],
                          build_s=st["build_s"], solve_s=st["solve_s"], wall_s=wall, n_solves=n, from_cache=from_cache,
                          thesis_key=f"ch04 {key}", study_call=call, note=note,
                          **_merge_entries(log.entries(marker)))
 
 
-def ch04(perf, ctx):
+def ch04(ctx):
     from gaitlib.studies import contact_id as ci
 
     rows = []
@@ -252,7 +262,7 @@ def ch04(perf, ctx):
     done = {}
     for key in ("a", "b", "c", "c_wide"):
         if key in ("c", "c_wide") and "b" not in done:
-            rows.append(perf.missing_row("ch04", runs[key], _how_to("ch04") + " ((b) first: it is the warm start)",
+            rows.append(tt.missing_row("ch04", runs[key], _how_to("ch04") + " ((b) first: it is the warm start)",
                                          thesis_key=f"ch04 {key}", study_call=calls[key]))
             continue
         if key == "c":
@@ -264,16 +274,16 @@ def ch04(perf, ctx):
         try:
             with _CacheLog() as log:
                 r = f()
-        except perf.NotInCache:
-            rows.append(perf.missing_row("ch04", runs[key], _how_to("ch04"), thesis_key=f"ch04 {key}",
+        except cache.NotCached:
+            rows.append(tt.missing_row("ch04", runs[key], _how_to("ch04"), thesis_key=f"ch04 {key}",
                                          study_call=calls[key]))
             continue
         done[key] = r
-        rows.append(_approach_row(perf, key, r, log, calls[key], runs[key]))
+        rows.append(_approach_row(key, r, log, calls[key], runs[key]))
     return rows
 
 
-def ch05(perf, ctx):
+def ch05(ctx):
     from gaitlib.studies import msk, mtg_id
 
     rows = []
@@ -281,26 +291,26 @@ def ch05(perf, ctx):
         call = f"studies.mtg_id.identify(chapter_spec({', '.join(f'{k}={v}' for k, v in kw.items())}))"
         run = f"MTG parameter identification, {lab}"
         if ctx["cached_only"] and not ctx["measure_uncached"]:
-            rows.append(perf.missing_row("ch05", run, "studies.mtg_id.identify has no solution cache (the book "
+            rows.append(tt.missing_row("ch05", run, "studies.mtg_id.identify has no solution cache (the book "
                                          "re-solves it at every build, ≈ 10 s); run without --cached-only or with "
-                                         "--measure-uncached", status=perf.NO_CACHE, study_call=call))
+                                         "--measure-uncached", status=tt.NO_CACHE, study_call=call))
             continue
         r = mtg_id.identify(mtg_id.chapter_spec(**kw))  # no cache: solved here (main lifts the guard)
         st = r.stats
-        rows.append(perf.time_row("ch05", run, status=st["status"], converged=bool(st["success"]),
+        rows.append(tt.time_row("ch05", run, status=st["status"], converged=bool(st["success"]),
                                   iterations=st["iterations"], build_s=st["build_time_s"], solve_s=st["solve_time_s"],
                                   from_cache=False, solved_at=_now(), cache_entry=None, study_call=call,
-                                  note=perf.THESIS_SILENT["ch05 MTG"] + "; not cached: measured in this run"))
+                                  note=tt.THESIS_SILENT["ch05 MTG"] + "; not cached: measured in this run"))
     base = None
     for model in ("MSK", "NMSK"):
         call = f'studies.msk.solve("{model}")'
         spec = msk.ch5_spec(model)
         run = f"{model} natural gait, {spec.cost} (Ch 4/5 parameter sets)"
         try:
-            with perf.no_solving() if ctx["cached_only"] else nullcontext():
+            with cache.only(NO_SOLVING) if ctx["cached_only"] else nullcontext():
                 sol = msk.solve(model)
-        except perf.NotInCache:
-            rows.append(perf.missing_row("ch05", run, _how_to("ch05"), thesis_key=f"ch05 {model}", study_call=call))
+        except cache.NotCached:
+            rows.append(tt.missing_row("ch05", run, _how_to("ch05"), thesis_key=f"ch05 {model}", study_call=call))
             continue
         if model == "MSK":
             base = sol
@@ -308,11 +318,11 @@ def ch05(perf, ctx):
         else:
             where = msk.sg.cache_dir(sol.spec, guess=base)
             note = "warm-started from the Ch 5 MSK solution (the thesis: data and EMG guess)"
-        rows.append(_gait_row(perf, "ch05", run, sol, where, thesis_key=f"ch05 {model}", call=call, note=note))
+        rows.append(_gait_row("ch05", run, sol, where, thesis_key=f"ch05 {model}", call=call, note=note))
     return rows
 
 
-def _study_rows(perf, chapter, res, call, item_of, label_of, guess_note=""):
+def _study_rows(chapter, res, call, item_of, label_of, guess_note=""):
     """Rows of a Ch 6/7 StudyResult (and a list of the runs that stopped at an IPOPT status
     other than success, to be rerun at 3000 iterations as the book does)."""
     from gaitlib.studies import gait
@@ -325,21 +335,21 @@ def _study_rows(perf, chapter, res, call, item_of, label_of, guess_note=""):
         key = f"{chapter} {spec.model} {item_of(spec)}"
         if sol is None:
             if rec.error and "NotInCache" in rec.error:
-                rows.append(perf.missing_row(chapter, run, _how_to(chapter), thesis_key=key, study_call=call))
+                rows.append(tt.missing_row(chapter, run, _how_to(chapter), thesis_key=key, study_call=call))
             else:
                 err = (rec.error or "").strip().splitlines()[-1:] or [""]
-                rows.append(perf.time_row(chapter, run, status=rec.status, converged=False, iterations=None,
+                rows.append(tt.time_row(chapter, run, status=rec.status, converged=False, iterations=None,
                                           build_s=None, solve_s=None, thesis_key=key, study_call=call,
                                           note=f"error: {err[0]}"))
             continue
         if not rec.ok:
             failed.append(name)
-        rows.append(_gait_row(perf, chapter, run, sol, gait.cache_dir(spec, guess=res.guesses.get(name)),
+        rows.append(_gait_row(chapter, run, sol, gait.cache_dir(spec, guess=res.guesses.get(name)),
                               thesis_key=key, call=call))
     return rows, failed
 
 
-def _reruns(perf, chapter, res, failed, call, item_of, label_of):
+def _reruns(chapter, res, failed, call, item_of, label_of):
     from gaitlib.studies import gait
 
     rows = []
@@ -350,16 +360,16 @@ def _reruns(perf, chapter, res, failed, call, item_of, label_of):
         c = f'{call}.rerun("{name}", max_iter=3000)'
         try:
             sol = res.rerun(name, max_iter=3000)
-        except perf.NotInCache:
-            rows.append(perf.missing_row(chapter, run, _how_to(chapter), thesis_key=key, study_call=c))
+        except cache.NotCached:
+            rows.append(tt.missing_row(chapter, run, _how_to(chapter), thesis_key=key, study_call=c))
             continue
-        rows.append(_gait_row(perf, chapter, run, sol, gait.cache_dir(spec, guess=res.guesses.get(name)),
+        rows.append(_gait_row(chapter, run, sol, gait.cache_dir(spec, guess=res.guesses.get(name)),
                               thesis_key=key, call=c,
                               note=f"the 1000-iteration run stopped with {res.records[name].status}"))
     return rows
 
 
-def _predictive(perf, chapter, study, items, item_of, label_of):
+def _predictive(chapter, study, items, item_of, label_of):
     """Ch 6/7: the study as the book calls it (serial), NMSK from the thesis's guess, reruns."""
     from gaitlib.studies import predictive as pr
 
@@ -368,36 +378,36 @@ def _predictive(perf, chapter, study, items, item_of, label_of):
     call = f"studies.predictive.{study}"
     try:
         res = fn(("MSK", "NMSK"), items, progress=False, serial=True)
-    except perf.NotInCache:
+    except cache.NotCached:
         missing = [(m, i) for m in ("MSK", "NMSK") for i in items]
-        return [perf.missing_row(chapter, label_of(m, i), _how_to(chapter) + " (the Ch 5 solutions it starts from "
+        return [tt.missing_row(chapter, label_of(m, i), _how_to(chapter) + " (the Ch 5 solutions it starts from "
                                  "are not in the cache either)", thesis_key=f"{chapter} {m} {i}", study_call=call)
                 for m, i in missing]
-    r, failed = _study_rows(perf, chapter, res, f"{call}(('MSK', 'NMSK'))", item_of, label_of)
+    r, failed = _study_rows(chapter, res, f"{call}(('MSK', 'NMSK'))", item_of, label_of)
     rows += r
-    rows += _reruns(perf, chapter, res, failed, "res", item_of, label_of)
+    rows += _reruns(chapter, res, failed, "res", item_of, label_of)
     tg = fn(("NMSK",), items, progress=False, serial=True, guess={"NMSK": "thesis"})
-    r, _ = _study_rows(perf, chapter, tg, f'{call}(("NMSK",), guess={{"NMSK": "thesis"}})', item_of, label_of,
+    r, _ = _study_rows(chapter, tg, f'{call}(("NMSK",), guess={{"NMSK": "thesis"}})', item_of, label_of,
                        guess_note=" (thesis's partial guess)")
     rows += r
     return rows
 
 
-def ch06(perf, ctx):
+def ch06(ctx):
     from gaitlib.studies import predictive as pr
 
-    return _predictive(perf, "ch06", "cost_function_study", pr.CH6_COSTS, lambda s: s.cost,
+    return _predictive("ch06", "cost_function_study", pr.CH6_COSTS, lambda s: s.cost,
                        lambda model, cost: f"{model} {cost}")
 
 
-def ch07(perf, ctx):
+def ch07(ctx):
     from gaitlib.studies import predictive as pr
 
-    return _predictive(perf, "ch07", "speed_study", pr.CH7_CLASSES, lambda s: s.speed_class,
+    return _predictive("ch07", "speed_study", pr.CH7_CLASSES, lambda s: s.speed_class,
                        lambda model, cls: f"{model} {cls} (thesis class {pr.THESIS_CLASS[cls]})")
 
 
-def ch08(perf, ctx):
+def ch08(ctx):
     """Our gap chapter: one row per study, summed over the NLP solves it used (the ``gap``
     cache entries, each with the statistics of its solve). Not in the thesis: no thesis time."""
     from gaitlib.studies import gap as G
@@ -417,8 +427,8 @@ def ch08(perf, ctx):
         try:
             with _CacheLog() as log:
                 fn()
-        except perf.NotInCache:
-            rows.append(perf.missing_row("ch08", run, _how_to("ch08"), study_call=call))
+        except cache.NotCached:
+            rows.append(tt.missing_row("ch08", run, _how_to("ch08"), study_call=call))
             continue
         paths = [Path(p) for p in dict.fromkeys(log.lines)
                  if Path(p).parent.name == "gap" and (Path(p) / "summary.json").is_file()]
@@ -427,7 +437,7 @@ def ch08(perf, ctx):
         n = len(stats)
         status = "Solve_Succeeded (all)" if ok == n else f"{ok} of {n} NLP solves succeeded"
         ents = _merge_entries([_entry(p, "summary.json") for p in paths])
-        rows.append(perf.time_row(
+        rows.append(tt.time_row(
             "ch08", run, status=status, converged=(ok == n), n_solves=n,
             iterations=sum(int(st.get("iterations") or 0) for st in stats),
             build_s=sum(float(st.get("build_time_s") or 0.0) for st in stats),
@@ -446,8 +456,6 @@ COLLECT = {"ch02": ch02, "ch03": ch03, "ch04": ch04, "ch05": ch05, "ch06": ch06,
 # Machine, output
 # --------------------------------------------------------------------------------------
 def _machine() -> dict:
-    from gaitlib.studies.performance import machine_info
-
     return machine_info()
 
 
@@ -524,8 +532,6 @@ def main(argv=None) -> int:
     ap.add_argument("--chapters", nargs="+", choices=CHAPTERS, default=list(CHAPTERS))
     ap.add_argument("--out", type=Path, default=OUT, help="results directory (default benchmarks/results)")
     args = ap.parse_args(argv)
-    for v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
-        os.environ.setdefault(v, "1")
     chapters = [c for c in CHAPTERS if c in args.chapters]
     mode_name = "cached-only" if args.cached_only else "resolve" if args.resolve else "cached"
     if args.cached_only and args.measure_uncached:
@@ -543,8 +549,6 @@ def main(argv=None) -> int:
         os.environ["GAITLIB_SOLUTIONS"] = tmp.name
         os.environ["GAITLIB_STORE"] = ""
 
-    from gaitlib.studies import performance as perf
-
     ctx = {"cached_only": args.cached_only, "measure_uncached": args.measure_uncached}
     started, t0, load0 = _now(), time.perf_counter(), list(os.getloadavg())
     rows = []
@@ -554,14 +558,14 @@ def main(argv=None) -> int:
         # --cached-only: nothing is solved; with --measure-uncached, Ch 5 guards its cached
         # solves itself and solves the (uncached) MTG identification
         lift = ch == "ch05" and args.measure_uncached
-        guard = perf.no_solving() if args.cached_only and not lift else nullcontext()
+        guard = cache.only(NO_SOLVING) if args.cached_only and not lift else nullcontext()
         try:
             with guard:
-                new = COLLECT[ch](perf, ctx)
+                new = COLLECT[ch](ctx)
         except Exception:  # noqa: BLE001 — a chapter that fails is reported, not dropped
             tb = traceback.format_exc()
             print(tb, file=sys.stderr)
-            new = [perf.time_row(ch, f"{ch}: collection failed", status="error", converged=False, iterations=None,
+            new = [tt.time_row(ch, f"{ch}: collection failed", status="error", converged=False, iterations=None,
                                  build_s=None, solve_s=None, note=tb.strip().splitlines()[-1])]
         for r in new:
             r["mode"], r["collected"] = mode_name, started
@@ -589,8 +593,8 @@ def main(argv=None) -> int:
                     "collections": collections,
                     "note": "times as measured when each solution was solved (cache) or in the collection "
                             "(from_cache false); 2-core machine shared with other jobs"},
-           "thesis_silent": perf.THESIS_SILENT, "rows": rows}
-    doc["summary"] = perf.thesis_times_summary(doc)
+           "thesis_silent": tt.THESIS_SILENT, "rows": rows}
+    doc["summary"] = performance.thesis_times_summary(doc)
     args.out.mkdir(parents=True, exist_ok=True)
     out_json.write_text(json.dumps(doc, indent=1, default=str) + "\n")
     write_markdown(doc, args.out / "thesis_times.md")

@@ -2,10 +2,10 @@
 
 The same optimal control problem as ``moco/moco_side.py`` builds with OpenSim Moco, built
 with gaitlib's own layers: the 9-DOF model is read from ``moco/2D_gait.osim`` by
-:func:`gaitlib.peers.osim_planar_model` (PlanarTree, Simbody's smooth sphere contact), the
-reference is filtered and splined as Moco 4.6 does (:func:`gaitlib.peers.opensim_lowpass`,
-:class:`gaitlib.peers.NaturalQuinticSpline`), and the problem is transcribed and solved by
-:mod:`gaitlib.ocp` (exact Hessian, CasADi SX).
+:func:`moco.peers.osim_planar_model` (``moco/peers.py``: a gaitlib PlanarTree, Simbody's
+smooth sphere contact), the reference is filtered and splined as Moco 4.6 does
+(:func:`moco.peers.opensim_lowpass`, :class:`moco.peers.NaturalQuinticSpline`), and the
+problem is transcribed and solved by :mod:`gaitlib.ocp` (exact Hessian, CasADi SX).
 
 Problem (one phase, t ∈ [0, T], T = 0.470089 s)
 ------------------------------------------------
@@ -52,9 +52,11 @@ import pandas as pd
 
 from gaitlib import ocp
 from gaitlib.collocation import Mesh
-from gaitlib.peers import NaturalQuinticSpline, opensim_lowpass, osim_planar_model, read_sto
 
 HERE = Path(__file__).resolve().parent
+if str(HERE) not in sys.path:  # benchmarks/ (loaded by path from bench_moco_t9track.py)
+    sys.path.insert(0, str(HERE))
+from moco.peers import NaturalQuinticSpline, opensim_lowpass, osim_planar_model, read_sto  # noqa: E402
 MOCO_DIR = HERE / "moco"
 T_FINAL = 0.470089
 OPTIMAL_FORCE = 150.0

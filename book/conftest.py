@@ -5,6 +5,9 @@ hours inside ``make test``.
 ``solutions/README.md`` lists the notebooks whose solutions ``tools/store_solutions.py``
 stored (with their times from the store); a notebook not listed there would re-solve from
 scratch. Set ``GAITLIB_BOOK_SOLVE=1`` to execute it anyway (``make book`` always does).
+
+The notebooks' kernels inherit this process's environment: the Makefile's BLAS settings are
+set here (:func:`gaitlib.blas.pin`) for nbval runs outside ``make``.
 """
 
 from __future__ import annotations
@@ -13,6 +16,10 @@ import os
 from pathlib import Path
 
 import pytest
+
+from gaitlib import blas
+
+blas.pin()
 
 STORE_README = Path(__file__).resolve().parents[1] / "solutions" / "README.md"
 

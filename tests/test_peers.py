@@ -1,7 +1,7 @@
-"""Tests of gaitlib.peers: the planar model read from Moco's 2D_gait.osim, its smooth sphere
-contact, and the replicas of Moco's reference-data processing. OpenSim is never imported;
-the OpenSim comparisons use numbers that ``benchmarks/moco/moco_side.py`` wrote with
-opensim 4.6 (``benchmarks/moco/opensim_check/``)."""
+"""Tests of ``benchmarks/moco/peers.py`` (the T9-track benchmark's peer model): the planar
+model read from Moco's 2D_gait.osim, its smooth sphere contact, and the replicas of Moco's
+reference-data processing. OpenSim is never imported; the OpenSim comparisons use numbers
+that ``benchmarks/moco/moco_side.py`` wrote with opensim 4.6 (``benchmarks/moco/opensim_check/``)."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gaitlib.peers import (
+from moco.peers import (  # benchmarks/ is on sys.path (tests/conftest.py)
     OSIM_GRAVITY,
     NaturalQuinticSpline,
     opensim_lowpass,

@@ -1,6 +1,8 @@
-"""Thesis-times table (issue 8 item 1; gaitlib.studies.performance, benchmarks/bench_thesis_times.py):
-the thesis's printed times as labelled references, the speed-up only for converged runs, the
-no-solving guard of --cached-only. Nothing here solves."""
+"""Thesis-times table: the rows ``benchmarks/bench_thesis_times.py`` writes
+(``benchmarks/thesis_times.py``: the thesis's printed times as labelled references, the
+speed-up only for converged runs), the stored table as the book reads it
+(:mod:`gaitlib.studies.performance`), and the no-solving guard of ``--cached-only``
+(:func:`gaitlib.cache.only`)."""
 
 from __future__ import annotations
 
@@ -8,24 +10,24 @@ import math
 
 import pytest
 
+import thesis_times as tt  # benchmarks/ is on sys.path (tests/conftest.py)
 from gaitlib import cache
-
 from gaitlib.studies import contact_id, msk, predictive
 from gaitlib.studies import performance as perf
 
 
 def test_parse_duration():
-    assert perf.parse_duration("6 min (Sec 4.3.3, GlobalSearch)") == 360.0
-    assert perf.parse_duration("11 min") == 660.0
-    assert perf.parse_duration("5 h (Sec 4.4.2, GPOPS-II)") == 5 * 3600.0
-    assert perf.parse_duration("2 hrs") == 7200.0
-    assert perf.parse_duration("30 s") == 30.0
+    assert tt.parse_duration("6 min (Sec 4.3.3, GlobalSearch)") == 360.0
+    assert tt.parse_duration("11 min") == 660.0
+    assert tt.parse_duration("5 h (Sec 4.4.2, GPOPS-II)") == 5 * 3600.0
+    assert tt.parse_duration("2 hrs") == 7200.0
+    assert tt.parse_duration("30 s") == 30.0
     with pytest.raises(ValueError):
-        perf.parse_duration("about two hours")
+        tt.parse_duration("about two hours")
 
 
 def test_thesis_reference_times_are_the_printed_ones_with_their_source():
-    ref = perf.thesis_reference_times()
+    ref = tt.thesis_reference_times()
     # Sec 4.3.3: 6 min / 11 min; Sec 4.4.2: 5 h — from contact_id.THESIS_TIME, not retyped
     assert ref["ch04 a"].seconds == 360 and "Sec 4.3.3" in ref["ch04 a"].label
     assert ref["ch04 b"].seconds == 660 and "Sec 4.3.3" in ref["ch04 b"].label
@@ -50,41 +52,41 @@ def test_thesis_reference_times_are_the_printed_ones_with_their_source():
     assert len([k for k in ref if k.startswith("ch06")]) == 16 and len([k for k in ref if k.startswith("ch07")]) == 8
     # where the thesis prints nothing there is no reference
     assert "ch02 SK" not in ref and not any(k.startswith("ch03") for k in ref)
-    assert "ch02 SK" in perf.THESIS_SILENT and "ch03" in perf.THESIS_SILENT
+    assert "ch02 SK" in tt.THESIS_SILENT and "ch03" in tt.THESIS_SILENT
 
 
 def test_speedup_only_for_converged_rows():
-    ok = perf.time_row("ch06", "MSK DT", status="Solve_Succeeded", converged=True, iterations=500, build_s=30.0,
+    ok = tt.time_row("ch06", "MSK DT", status="Solve_Succeeded", converged=True, iterations=500, build_s=30.0,
                        solve_s=90.0, thesis_key="ch06 MSK DT")
     assert ok["wall_s"] == 120.0 and ok["ms_per_iteration"] == pytest.approx(180.0)
     assert ok["speedup"] == pytest.approx(7200 / 120.0) and ok["thesis_time"].startswith("2 h (Table 6.3")
-    bad = perf.time_row("ch06", "NMSK SDT3", status="Maximum_Iterations_Exceeded", converged=False, iterations=1000,
+    bad = tt.time_row("ch06", "NMSK SDT3", status="Maximum_Iterations_Exceeded", converged=False, iterations=1000,
                         build_s=30.0, solve_s=300.0, thesis_key="ch06 NMSK SDT3")
     assert bad["status"] == "Maximum_Iterations_Exceeded" and bad["speedup"] is None
     assert bad["thesis_time_s"] == 3600 and bad["wall_s"] == 330.0  # the time is still reported
-    silent = perf.time_row("ch03", "jump", status="Solve_Succeeded", converged=True, iterations=10, build_s=1.0,
+    silent = tt.time_row("ch03", "jump", status="Solve_Succeeded", converged=True, iterations=10, build_s=1.0,
                            solve_s=2.0)
     assert silent["thesis_time"] is None and silent["speedup"] is None
     # a multistart search: its wall time (scoring the starts included) is given explicitly
-    a = perf.time_row("ch04", "(a)", status="Solve_Succeeded", converged=True, iterations=800, build_s=9.0,
+    a = tt.time_row("ch04", "(a)", status="Solve_Succeeded", converged=True, iterations=800, build_s=9.0,
                       solve_s=15.0, wall_s=30.0, n_solves=11, thesis_key="ch04 a")
     assert a["wall_s"] == 30.0 and a["speedup"] == pytest.approx(12.0) and a["n_solves"] == 11
-    miss = perf.missing_row("ch07", "MSK Fast", "not computed yet — run X", thesis_key="ch07 MSK Fast")
+    miss = tt.missing_row("ch07", "MSK Fast", "not computed yet — run X", thesis_key="ch07 MSK Fast")
     assert miss["status"] == perf.NOT_COMPUTED and miss["wall_s"] is None and miss["speedup"] is None
     assert miss["thesis_time_s"] == 10 * 3600 and miss["note"].endswith("run X")
-    assert set(perf.TIME_COLUMNS) <= set(ok)
+    assert set(tt.TIME_COLUMNS) <= set(ok)
 
 
 def test_summary_and_table_of_a_document():
-    rows = [perf.time_row("ch06", "MSK DT", status="Solve_Succeeded", converged=True, iterations=500, build_s=20.0,
+    rows = [tt.time_row("ch06", "MSK DT", status="Solve_Succeeded", converged=True, iterations=500, build_s=20.0,
                           solve_s=80.0, thesis_key="ch06 MSK DT", from_cache=True),
-            perf.time_row("ch06", "MSK FP", status="Solve_Succeeded", converged=True, iterations=500, build_s=20.0,
+            tt.time_row("ch06", "MSK FP", status="Solve_Succeeded", converged=True, iterations=500, build_s=20.0,
                           solve_s=380.0, thesis_key="ch06 MSK FP", from_cache=False),
-            perf.time_row("ch06", "NMSK SDT3", status="Maximum_Iterations_Exceeded", converged=False,
+            tt.time_row("ch06", "NMSK SDT3", status="Maximum_Iterations_Exceeded", converged=False,
                           iterations=1000, build_s=20.0, solve_s=280.0, thesis_key="ch06 NMSK SDT3", from_cache=True),
-            perf.time_row("ch03", "jump", status="Solve_Succeeded", converged=True, iterations=10, build_s=1.0,
+            tt.time_row("ch03", "jump", status="Solve_Succeeded", converged=True, iterations=10, build_s=1.0,
                           solve_s=9.0, from_cache=True),
-            perf.missing_row("ch07", "MSK Fast", "run X", thesis_key="ch07 MSK Fast")]
+            tt.missing_row("ch07", "MSK Fast", "run X", thesis_key="ch07 MSK Fast")]
     doc = {"meta": {"measured": "2026-11-22T13:00:00+00:00"}, "rows": rows}
     s = perf.thesis_times_summary(doc)
     assert (s["n_rows"], s["n_converged"], s["n_not_converged"], s["n_missing"]) == (5, 3, 1, 1)
@@ -104,7 +106,7 @@ def test_stored_table_is_consistent():
         doc = perf.load("thesis_times")
     except FileNotFoundError:
         pytest.skip("thesis_times.json not written yet")
-    labels = {t.label for t in perf.thesis_reference_times().values()}
+    labels = {t.label for t in tt.thesis_reference_times().values()}
     assert doc["meta"]["machine"]["cores"] and doc["meta"]["collections"]
     for r in doc["rows"]:
         if r["speedup"] is not None:
@@ -123,16 +125,15 @@ def test_stored_table_is_consistent():
             assert math.isclose(r["ms_per_iteration"], 1e3 * r["solve_s"] / r["iterations"], rel_tol=1e-9)
 
 
-def test_no_solving_refuses_and_restores(tmp_path, monkeypatch):
-    """Inside no_solving a study that would solve raises before any symbolic work (no entry
-    written), and patches nothing: afterwards the same call solves."""
+def test_cached_only_refuses_a_solve_and_patches_nothing(tmp_path, monkeypatch):
+    """Inside cache.only (the guard of --cached-only) a study that would solve raises
+    NotCached before any symbolic work (no entry written); afterwards the same call solves."""
     from gaitlib.studies import gait
 
     monkeypatch.setenv("GAITLIB_STORE", "")
-    with perf.no_solving("cached only"):
-        with pytest.raises(perf.NotInCache, match="cached only"):
+    with cache.only("cached only"):
+        with pytest.raises(cache.NotCached, match="cached only"):
             gait.natural_gait("SK", root=tmp_path, n_intervals=2, degree=2)  # empty cache: would solve
     assert not any(tmp_path.rglob("spec.json"))  # nothing stored
-    assert perf.NotInCache is cache.NotCached
     sol = gait.natural_gait("SK", root=tmp_path, n_intervals=2, degree=2, max_iter=3)
     assert sol.stats["iterations"] <= 3 and any(tmp_path.rglob("spec.json"))

@@ -19,8 +19,9 @@ import os
 import sys
 import tempfile
 
-for _k, _v in (("OPENBLAS_NUM_THREADS", "1"), ("OMP_NUM_THREADS", "1"), ("OPENBLAS_CORETYPE", "Haswell")):
-    os.environ.setdefault(_k, _v)
+from gaitlib import blas
+
+blas.pin()  # the Makefile's BLAS settings, before numpy is imported
 os.environ["GAITLIB_SOLUTIONS"] = tempfile.mkdtemp(prefix="gap-dry-run-")
 
 

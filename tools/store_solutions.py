@@ -21,11 +21,11 @@ import tempfile
 import time
 from pathlib import Path
 
+from gaitlib import blas
+
 # the Makefile's BLAS settings, for the notebooks this runs (keys of gap solutions hash the
 # data's numbers, which depend on OpenBLAS's kernel: see environment.md)
-for _k, _v in (("OPENBLAS_NUM_THREADS", "1"), ("OMP_NUM_THREADS", "1"), ("MKL_NUM_THREADS", "1"),
-               ("OPENBLAS_CORETYPE", "Haswell")):
-    os.environ.setdefault(_k, _v)
+blas.pin()
 
 REPO = Path(__file__).resolve().parents[1]
 STORE = REPO / "solutions"

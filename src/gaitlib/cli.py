@@ -52,6 +52,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+from . import blas
+
 #: Exit status of errors, refusals and results that rest on a solve that did not converge.
 EXIT_FAILED = 2
 
@@ -434,6 +436,7 @@ def _expected() -> tuple:
 
 
 def main(argv: list[str] | None = None) -> int:
+    blas.pin()  # the Makefile's BLAS settings unless set; numpy is not imported yet
     args = build_parser().parse_args(argv)
     if args.debug:
         return args.func(args)

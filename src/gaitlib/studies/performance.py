@@ -1,58 +1,87 @@
-"""Performance (issue 8): the stored benchmark results as tables, and the growth-exponent fit.
+"""The Performance page's readers: the stored benchmark results as tables, figures and
+findings, and the growth-exponent fit.
 
-Nothing here solves anything: the functions read the JSON files that the scripts in
+Nothing here solves or times anything: the functions read the JSON files that the scripts in
 ``benchmarks/`` write (``scaling.json`` — :file:`benchmarks/bench_scaling.py`, ``gait.json``
 — :file:`benchmarks/bench_gait.py`, ``moco_t9track.json`` —
 :file:`benchmarks/bench_moco_t9track.py`, ``thesis_times.json`` —
-:file:`benchmarks/bench_thesis_times.py`), each of which records when and on which machine
-it was measured.
+:file:`benchmarks/bench_thesis_times.py`, and the profiles of the MSK solve and the KKT
+system), each of which records when and on which machine it was measured. The writers
+(timing, machine, report files, the thesis's reference times) live with the scripts in
+``benchmarks/``.
 
 Functions
 ---------
 :func:`results_dir`        where the benchmark results are (``benchmarks/results``).
-:func:`load`               one results file as a dict.
+:func:`load`, :func:`load_optional`  one results file as a dict.
 :func:`fit_power_law`      least-squares fit of ``y = c · n^b`` on log–log axes.
 :func:`scaling_table`      per model × mesh: iterations, wall times, time per iteration.
 :func:`scaling_fits`       the growth exponents of time per iteration (and its parts) vs nodes.
-:func:`hessian_table`, :func:`linear_solver_table`, :func:`moco_table`, :func:`gait_table`
+:func:`scaling_figure`     time per iteration, solve and build time vs nodes, with the fits.
+:func:`hessian_table`, :func:`linear_solver_table`, :func:`moco_table`, :func:`gait_table`,
+:func:`msk_profile_tables`, :func:`eval_floor_table`, :func:`eval_floor_frames`,
+:func:`kkt_scaling_tables`
 :func:`measured_on`        one sentence: date, machine, load, from a file's metadata.
-
-Thesis times (issue 8 item 1; :file:`benchmarks/bench_thesis_times.py`):
-
-:func:`thesis_reference_times`  every compute time the thesis prints, as labelled references.
-:func:`parse_duration`     "6 min (…)" → 360 s.
-:func:`time_row`, :func:`missing_row`  one row of the table (speed-up only for converged runs).
 :func:`thesis_times_table`, :func:`thesis_times_summary`, :func:`thesis_times_by_chapter`,
-:func:`thesis_times_figure`  the stored table for the page.
-:func:`no_solving`         context manager: any attempt to solve raises :class:`NotInCache`.
+:func:`thesis_times_figure`  the stored thesis-times table.
+
+Findings (lists of sentences, computed from the results; the targets are the constants below):
+:func:`msk_profile_findings`, :func:`eval_floor_findings`, :func:`compiled_solve_finding`,
+:func:`thesis_times_findings`, :func:`mumps_orderings_findings`, :func:`findings` (the
+page's summary: scaling per model, the machine's share, the KKT system at a fixed point, its
+fill, the thesis mesh, Hessian, linear solvers, Moco).
 """
 
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from .. import cache
-
-__all__ = ["results_dir", "load", "load_optional", "fit_power_law", "scaling_table", "scaling_fits", "hessian_table",
-           "linear_solver_table", "moco_table", "gait_table", "msk_profile_tables", "eval_floor_table", "kkt_scaling_tables", "measured_on", "ThesisTime", "THESIS_SILENT",
-           "thesis_reference_times", "parse_duration", "time_row", "missing_row", "NOT_COMPUTED", "NO_CACHE",
-           "TIME_COLUMNS", "thesis_times_table", "thesis_times_summary", "thesis_times_by_chapter",
-           "thesis_times_figure", "NotInCache", "no_solving", "md_table", "write_report"]
+__all__ = ["results_dir", "load", "load_optional", "fit_power_law", "scaling_table", "scaling_fits",
+           "scaling_figure", "hessian_table", "linear_solver_table", "moco_table", "gait_table",
+           "msk_profile_tables", "eval_floor_table", "eval_floor_frames", "kkt_scaling_tables", "measured_on",
+           "NOT_COMPUTED", "NO_CACHE", "FINISHED", "thesis_times_table", "thesis_times_summary",
+           "thesis_times_by_chapter", "thesis_times_figure", "LINEAR_GROWTH", "LINEAR_TOLERANCE",
+           "MSK_SOLVE_TARGET_S", "CONVERGED", "THESIS_MESH_NODES", "MUMPS_AUTO_ORDERING",
+           "SAME_OBJECTIVE_RTOL", "msk_profile_findings", "eval_floor_findings", "compiled_solve_finding",
+           "thesis_times_findings", "mumps_orderings_findings", "findings"]
 
 #: Runs of the scaling benchmark whose time per iteration is a measurement (the solver ran
 #: to the end: converged or stopped by its own criterion), as opposed to "timeout"/"error".
 FINISHED = "finished"
 
+#: The target of the mesh-scaling study: time per iteration grows no faster than linearly
+#: with the number of collocation nodes N (exponent b of ``t ∝ N^b`` at most 1).
+LINEAR_GROWTH = 1.0
+#: Work that is proportional to N by construction (the NLP evaluations at a fixed point) is
+#: read as linear up to an exponent of ``LINEAR_GROWTH + LINEAR_TOLERANCE``.
+LINEAR_TOLERANCE = 0.02
+#: The target for the MSK data-tracking solve at the full mesh (s), met only by a run that
+#: converged (:data:`CONVERGED`).
+MSK_SOLVE_TARGET_S = 20.0
+#: The IPOPT status of a converged run in the profiles.
+CONVERGED = "Solve_Succeeded"
+#: Collocation nodes of the thesis's mesh (20 intervals × 5 LGR points).
+THESIS_MESH_NODES = 100
+#: ``mumps_pivot_order`` value of IPOPT's default: MUMPS chooses the ordering itself.
+MUMPS_AUTO_ORDERING = 7
+#: Two solves of the same problem end in the same solution when they take the same
+#: iterations and their objectives agree to this relative tolerance.
+SAME_OBJECTIVE_RTOL = 1e-6
+
+#: Status of a thesis-times row whose optimisation is not in the cache (``--cached-only``).
+NOT_COMPUTED = "not computed yet"
+#: Status of a thesis-times row of a study that has no solution cache.
+NO_CACHE = "not measured (no solution cache)"
+
 
 def results_dir() -> Path:
     """``$GAITLIB_BENCHMARK_RESULTS`` if set, else ``benchmarks/results`` of the source
     checkout this package is imported from."""
-    import os
-
     if os.environ.get("GAITLIB_BENCHMARK_RESULTS"):
         return Path(os.environ["GAITLIB_BENCHMARK_RESULTS"])
     here = Path(__file__).resolve()
@@ -81,28 +110,6 @@ def load_optional(name: str, root=None) -> dict | None:
     except FileNotFoundError as e:
         print(e)
         return None
-
-
-def md_table(cols, rows) -> list[str]:
-    """A markdown table of ``rows`` (dicts) over ``cols``: floats to 4 significant digits,
-    missing values empty. Returns its lines (header, separator, one per row)."""
-    def cell(v):
-        return f"{v:.4g}" if isinstance(v, float) else ("" if v is None else str(v))
-
-    return ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)] + [
-        "| " + " | ".join(cell(r.get(c)) for c in cols) + " |" for r in rows]
-
-
-def write_report(out: Path, stem: str, doc: dict, md: list[str]) -> None:
-    """A benchmark's results: ``<out>/<stem>.json`` (``doc``) and ``<out>/<stem>.md``
-    (``md`` lines, also printed)."""
-    import json
-
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / f"{stem}.json").write_text(json.dumps(doc, indent=1, default=str))
-    (out / f"{stem}.md").write_text("\n".join(md) + "\n")
-    print("\n".join(md))
 
 
 def fit_power_law(n, y) -> dict:
@@ -242,7 +249,7 @@ def msk_profile_tables(res: dict | None = None) -> tuple[pd.DataFrame, pd.DataFr
 def eval_floor_table(res: dict) -> pd.DataFrame:
     """``bench_eval_floor.py``: the MSK solve time at best on the default run's iteration path
     (s), under three assumptions about the function evaluations, beside the measured solve and
-    the ≤ 20 s target. Rows: measured; evaluations free (linear systems + rest); Hessian
+    the :data:`MSK_SOLVE_TARGET_S` target. Rows: measured; evaluations free (linear systems + rest); Hessian
     compiled to C (per-node, measured C/VM speed), the other evaluations as measured; every
     evaluation at the Hessian's C/VM ratio."""
     f = res["floors"]
@@ -251,7 +258,8 @@ def eval_floor_table(res: dict) -> pd.DataFrame:
             ("evaluations free: linear systems + rest", f["floor_evaluations_free_s"]),
             (f"Hessian compiled (C/VM {ratio:.2f}), other evaluations as measured", f["floor_hessian_compiled_s"]),
             (f"every evaluation compiled at the Hessian's ratio {ratio:.2f}", f["floor_all_compiled_s"])]
-    return pd.DataFrame([{"assumption": a, "solve time (s)": v, "≤ 20 s": v <= 20.0} for a, v in rows])
+    return pd.DataFrame([{"assumption": a, "solve time (s)": v, f"≤ {MSK_SOLVE_TARGET_S:g} s": v <= MSK_SOLVE_TARGET_S}
+                         for a, v in rows])
 
 
 def kkt_scaling_tables(res: dict | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
@@ -283,144 +291,6 @@ def measured_on(res: dict) -> str:
     if meta.get("note"):
         s += f" — {meta['note']}"
     return s
-
-
-# ======================================================================================
-# Thesis times (issue 8, item 1): every optimisation the book runs beside the thesis's time
-# ======================================================================================
-from dataclasses import dataclass  # noqa: E402
-import math  # noqa: E402
-import re  # noqa: E402
-
-
-@dataclass(frozen=True)
-class ThesisTime:
-    """A compute time the thesis prints: ``seconds`` (s) and ``label`` (the value as printed,
-    with its section or table). GPOPS-II / MATLAB on an Intel i7-6700 (3.4 GHz, 16 GB),
-    IPOPT in first-derivative mode, tolerance 1e-5 (thesis Secs 4.3.2, 5.2.1, 6.1, 7.1)."""
-
-    seconds: float
-    label: str
-
-
-#: Optimisations for which the thesis prints no compute time (the thesis column stays empty).
-THESIS_SILENT = {
-    "ch02 SK": "the thesis prints no time for SK tracking with the contact parameters fixed; its 11 min "
-               "(Sec 4.3.3) is with the 39 contact parameters identified — the Ch 4 (b) row",
-    "ch03": "Ch 3 prints no solve times for the jumps",
-    "ch05 MTG": "Sec 5.1 prints no time for the MTG parameter identification",
-}
-
-#: Where Ch 5's hours (:data:`gaitlib.studies.msk.THESIS_HOURS`) are printed.
-_CH5_SOURCE = {"MSK": "Sec 5.2.2", "NMSK": "Sec 5.3.5"}
-
-_DURATION = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*(s|min|h|hrs?|hours?)\b", re.IGNORECASE)
-
-
-def parse_duration(text: str) -> float:
-    """Seconds of a printed duration at the start of ``text`` ("6 min (Sec 4.3.3, …)" → 360,
-    "5 h (…)" → 18000, "30 s" → 30). Raises ValueError if ``text`` does not start with one."""
-    m = _DURATION.match(text)
-    if m is None:
-        raise ValueError(f"no duration at the start of {text!r}")
-    unit = m.group(2).lower()
-    scale = 1.0 if unit == "s" else 60.0 if unit == "min" else 3600.0
-    return float(m.group(1)) * scale
-
-
-def _hours(h: float) -> str:
-    return f"{h:g} h"
-
-
-def thesis_reference_times() -> dict[str, ThesisTime]:
-    """Every compute time the thesis prints, keyed by the book's optimisation:
-
-    ``"ch04 a"``, ``"ch04 b"``, ``"ch04 c"``, ``"ch04 c_wide"`` — Sec 4.3.3 (6 min GlobalSearch,
-    11 min GPOPS-II) and Sec 4.4.2 (5 h), from :data:`gaitlib.studies.contact_id.THESIS_TIME`
-    ((c′) is our variant of (c): the thesis's (c) is its reference);
-    ``"ch05 MSK"``, ``"ch05 NMSK"`` — Secs 5.2.2 and 5.3.5 (2 h each,
-    :data:`gaitlib.studies.msk.THESIS_HOURS`); ``"ch02 MSK"`` — the same MSK Eq 5.33 problem
-    (Ch 2 solves it with the thesis's parameter sets);
-    ``"ch06 <model> <cost>"`` — Table 6.3 (:data:`~gaitlib.studies.predictive.THESIS_HOURS_TABLE_6_3`);
-    ``"ch07 <model> <our class>"`` — Table 7.2 for the thesis's class of the same rank
-    (:data:`~gaitlib.studies.predictive.THESIS_HOURS_TABLE_7_2`, :data:`~gaitlib.studies.predictive.THESIS_CLASS`).
-
-    Nothing else: where the thesis prints no time (:data:`THESIS_SILENT`) there is no key."""
-    from . import contact_id, msk, predictive
-
-    out: dict[str, ThesisTime] = {}
-    for k, lab in contact_id.THESIS_TIME.items():
-        out[f"ch04 {k}"] = ThesisTime(parse_duration(lab), lab if k != "c_wide" else f"{lab}; thesis's (c)")
-    for m, h in msk.THESIS_HOURS.items():
-        out[f"ch05 {m}"] = ThesisTime(3600.0 * h, f"{_hours(h)} ({_CH5_SOURCE[m]}, GPOPS-II)")
-    out["ch02 MSK"] = out["ch05 MSK"]  # the same MSK Eq 5.33 problem (Ch 2: the thesis's parameter sets)
-    for m, row in predictive.THESIS_HOURS_TABLE_6_3.items():
-        for cost, h in row.items():
-            out[f"ch06 {m} {cost}"] = ThesisTime(3600.0 * h, f"{_hours(h)} (Table 6.3, {m} {cost})")
-    for m, row in predictive.THESIS_HOURS_TABLE_7_2.items():
-        for ours, theirs in predictive.THESIS_CLASS.items():
-            if theirs in row:
-                h = row[theirs]
-                out[f"ch07 {m} {ours}"] = ThesisTime(3600.0 * h, f"{_hours(h)} (Table 7.2, {m} {theirs})")
-    return out
-
-
-#: Status of a row whose optimisation is not in the cache (``--cached-only``).
-NOT_COMPUTED = "not computed yet"
-#: Status of a row of a study that has no solution cache (skipped by ``--cached-only``).
-NO_CACHE = "not measured (no solution cache)"
-
-#: Columns of the thesis-times table, in order.
-TIME_COLUMNS = ("chapter", "run", "study_call", "n_solves", "status", "converged", "iterations", "build_s",
-                "solve_s", "wall_s", "ms_per_iteration", "thesis_time", "thesis_time_s", "speedup", "from_cache",
-                "solved_at", "cache_entry", "note")
-
-
-def _num(x):
-    if x is None:
-        return None
-    x = float(x)
-    return x if math.isfinite(x) else None
-
-
-def time_row(chapter: str, run: str, *, status: str, converged: bool, iterations, build_s, solve_s,
-             wall_s=None, n_solves: int = 1, from_cache=None, solved_at=None, cache_entry=None,
-             thesis_key: str | None = None, study_call: str = "", note: str = "", thesis=None) -> dict:
-    """One optimisation of the book as a row of the thesis-times table.
-
-    ``build_s`` (s): symbolic graph, exact derivatives and IPOPT set-up; ``solve_s`` (s): the
-    IPOPT call(s); ``wall_s`` defaults to ``build_s + solve_s`` (given explicitly for
-    multi-start searches whose wall time includes scoring the start points);
-    ``iterations`` summed over the ``n_solves`` NLP solves of the optimisation (continuation
-    stages included). ``ms_per_iteration`` = 1000 · solve_s / iterations.
-
-    The thesis's time (``thesis_key`` in :func:`thesis_reference_times`, or ``thesis`` given
-    as a :class:`ThesisTime`) is carried as a labelled reference; ``speedup`` = thesis time /
-    our wall time, **only for a converged run** (``converged``): a run IPOPT did not finish
-    keeps its status and has no speed-up."""
-    ref = thesis if thesis is not None else (thesis_reference_times().get(thesis_key) if thesis_key else None)
-    build, solve = _num(build_s), _num(solve_s)
-    wall = _num(wall_s) if wall_s is not None else (build + solve if build is not None and solve is not None else None)
-    its = int(iterations) if iterations is not None else None
-    mspi = 1e3 * solve / its if (solve is not None and its) else None
-    speedup = ref.seconds / wall if (converged and ref is not None and wall) else None
-    return {"chapter": chapter, "run": run, "study_call": study_call, "n_solves": int(n_solves),
-            "status": str(status), "converged": bool(converged), "iterations": its, "build_s": build,
-            "solve_s": solve, "wall_s": wall, "ms_per_iteration": mspi,
-            "thesis_time": ref.label if ref is not None else None,
-            "thesis_time_s": ref.seconds if ref is not None else None, "speedup": speedup,
-            "from_cache": from_cache, "solved_at": solved_at, "cache_entry": cache_entry, "note": note}
-
-
-def missing_row(chapter: str, run: str, reason: str, *, status: str = NOT_COMPUTED, thesis_key: str | None = None,
-                study_call: str = "") -> dict:
-    """A row for an optimisation that was not collected (not in the cache under
-    ``--cached-only``, or a study without a cache): no times, no speed-up, ``reason`` as note
-    (what to run to compute it). The thesis's time, if any, is still shown."""
-    row = time_row(chapter, run, status=status, converged=False, iterations=None, build_s=None, solve_s=None,
-                   thesis_key=thesis_key, study_call=study_call, note=reason)
-    row["n_solves"] = 0
-    return row
 
 
 def thesis_times_table(res: dict | None = None) -> pd.DataFrame:
@@ -526,34 +396,376 @@ def thesis_times_figure(res: dict | None = None):
     return fig
 
 
-#: Raised by a solve attempted inside :func:`no_solving`.
-NotInCache = cache.NotCached
+# --------------------------------------------------------------------------------------
+# Figures and findings of the page
+# --------------------------------------------------------------------------------------
+def scaling_figure(res: dict | None = None):
+    """Three log–log panels over the finished mesh runs of each model: time per iteration
+    (converged runs as dots, the others as crosses, the fitted power law, for SK also its
+    function-evaluation and IPOPT + MUMPS parts and a linear reference through the smallest
+    SK mesh), solve time and build time (s), against the collocation nodes. Returns the figure."""
+    import matplotlib.pyplot as plt
+    from matplotlib.ticker import NullFormatter, ScalarFormatter
+
+    res = load("scaling") if res is None else res
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4))
+    colors = {"SK": "C0", "MSK": "C1", "NMSK": "C2"}
+    fin = pd.DataFrame([r for r in res["runs"] if r["group"] == "mesh" and r["outcome"] == FINISHED])
+    for model, g in fin.groupby("model", sort=False):
+        g = g.sort_values("nodes")
+        f = fit_power_law(g["nodes"], g["ms_per_iteration"])
+        conv = g["success"].astype(bool)
+        axes[0].loglog(g["nodes"][conv], g["ms_per_iteration"][conv], "o", color=colors[model])
+        axes[0].loglog(g["nodes"][~conv], g["ms_per_iteration"][~conv], "x", color=colors[model], ms=9)
+        if np.isfinite(f["exponent"]):
+            n = np.geomspace(g["nodes"].min(), g["nodes"].max(), 20)
+            axes[0].loglog(n, f["prefactor"] * n ** f["exponent"], "-", color=colors[model],
+                           label=f"{model}: b = {f['exponent']:.2f}")
+        else:
+            axes[0].plot([], [], "o", color=colors[model], label=f"{model}: one size")
+        axes[1].loglog(g["nodes"], g["solve_s"], "o-", color=colors[model], label=model)
+        axes[2].loglog(g["nodes"], g["build_s"], "o-", color=colors[model], label=model)
+        if model == "SK":
+            axes[0].loglog(g["nodes"], g["function_evals_ms_per_iteration"], "v:", color=colors[model], ms=4,
+                           label="SK: function evaluations")
+            axes[0].loglog(g["nodes"], g["ipopt_rest_ms_per_iteration"], "s:", color=colors[model], ms=4,
+                           label="SK: IPOPT + MUMPS")
+    if len(fin):
+        n = np.geomspace(fin["nodes"].min(), fin["nodes"].max(), 20)
+        sk = fin[fin["model"] == "SK"].sort_values("nodes")
+        if len(sk):
+            ref = sk["ms_per_iteration"].iloc[0] * n / sk["nodes"].iloc[0]
+            axes[0].loglog(n, ref, "k--", lw=0.8, label="linear (b = 1)")
+    axes[0].set(xlabel="collocation nodes N", ylabel="ms per iteration",
+                title="Time per iteration (× = did not converge)")
+    axes[1].set(xlabel="collocation nodes N", ylabel="s", title="Solve time (IPOPT call)")
+    axes[2].set(xlabel="collocation nodes N", ylabel="s", title="Build time (NLP + exact derivatives)")
+    for ax in axes:
+        if len(fin):
+            ax.set_xticks(sorted(fin["nodes"].unique()))
+            ax.xaxis.set_major_formatter(ScalarFormatter())
+            ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.legend(fontsize=7)
+        ax.grid(True, which="both", lw=0.3)
+    fig.tight_layout()
+    return fig
 
 
-def no_solving(what: str = "solving is disabled (--cached-only)"):
-    """Within the block, a solve of anything not cached raises :class:`NotInCache`
-    (:func:`gaitlib.cache.only`); cached solutions still load."""
-    return cache.only(what)
+def msk_profile_findings(res: dict) -> list[str]:
+    """``bench_msk_profile.py`` in three sentences: the book options' run (status,
+    iterations, solve time against :data:`MSK_SOLVE_TARGET_S` — met only if it converged —
+    and the shares of the Hessian, the other evaluations and the linear systems); the MSK
+    graph's size relative to SK's; the option variants that converged (fastest, objective
+    range). The first run is the book's options."""
+    runs, sizes = msk_profile_tables(res)
+    d = runs.iloc[0]
+    sz = sizes.set_index("model")
+    met = d["solve (s)"] <= MSK_SOLVE_TARGET_S and d["status"] == CONVERGED
+    ok = runs[runs["status"] == CONVERGED]
+    return [
+        f"• Book options: {d['status']}, {d['iterations']} iterations, {d['solve (s)']:.1f} s "
+        f"({d['ms / iteration']:.0f} ms per iteration) — the ≤ {MSK_SOLVE_TARGET_S:g} s target is "
+        f"{'met' if met else 'NOT met'}. Of the solve, "
+        f"{100 * d['Hessian (s)'] / d['solve (s)']:.0f} % is the Hessian, "
+        f"{100 * d['other evaluations (s)'] / d['solve (s)']:.0f} % the other evaluations, "
+        f"{100 * d['linear systems, MUMPS (s)'] / d['solve (s)']:.0f} % the linear systems; "
+        f"{d['iterations with Hessian perturbation']} of {d['iterations']} iterations needed a Hessian perturbation.",
+        f"• The MSK constraints are "
+        f"{sz.loc['MSK', 'constraint SX instructions'] / sz.loc['SK', 'constraint SX instructions']:.0f}× "
+        f"the SK constraints in SX instructions and the Hessian "
+        f"{sz.loc['MSK', 'Hessian SX instructions'] / sz.loc['SK', 'Hessian SX instructions']:.1f}×: "
+        f"the muscle torque generators' piecewise-quintic curves (≈ 60 pieces per generator, each piece "
+        f"selected by a chain of if_else nodes at every node) are most of the difference.",
+        f"• Option variants that converged: {len(ok) - 1}; fastest {ok['solve (s)'].min():.1f} s "
+        f"({ok.loc[ok['solve (s)'].idxmin(), 'variant']}); objectives of the converged runs "
+        f"{ok['objective'].min():.3f}–{ok['objective'].max():.3f} (different local optima)."]
 
 
-def machine_info() -> dict:
-    """The machine a benchmark ran on: CPU model, cores, memory (GiB), platform, Python, host."""
-    import os
-    import platform
-    from pathlib import Path
+def eval_floor_frames(res: dict) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """``bench_eval_floor.py``: (ms per call of the solver's own functions on CasADi's SX
+    virtual machine, one row; per-node functions mapped over all nodes, virtual machine vs
+    compiled C, ms)."""
+    fn = pd.DataFrame([res["solver_function_ms"]]).rename(index={0: "ms per call (SX virtual machine)"})
+    mapped = pd.DataFrame({"SX virtual machine (ms)": res["mapped_vm_ms"],
+                           "compiled C (ms)": res["mapped_compiled_ms"]}).rename_axis(
+        f"per-node, mapped over {res['collocation_nodes']} nodes")
+    return fn, mapped
 
-    cpu = platform.processor() or ""
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    mem = None
-    try:
-        mem = round(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2 ** 30, 1)
-    except (ValueError, OSError, AttributeError):
-        pass
-    return {"cpu": cpu, "cores": os.cpu_count(), "memory_gb": mem, "platform": platform.platform(),
-            "python": platform.python_version(), "node": platform.node()}
+
+def eval_floor_findings(res: dict) -> list[str]:
+    """``bench_eval_floor.py``'s floors in two sentences: the solver's Hessian is a sum of
+    per-node Hessians (non-zeros outside the nodes' blocks, SX instructions per node × nodes
+    against the solver's); the compiled per-node Hessian's time and the solve-time floors on
+    the default path, with the evaluation budget per iteration that :data:`MSK_SOLVE_TARGET_S`
+    leaves."""
+    fl = res["floors"]
+    return [
+        f"• The solver's Hessian has {res['hessian_nnz']:,} non-zeros, "
+        f"{res['hessian_nnz_outside_node_blocks']} outside the nodes' (x, u) blocks; per node "
+        f"{res['node_hessian_instructions']:,} SX instructions × {res['collocation_nodes']} nodes = "
+        f"{res['nodes_x_node_hessian_instructions']:,}, against {res['solver_hessian_instructions']:,} in the "
+        f"solver's Hessian: the same work, evaluated per node.",
+        f"• Compiled with gcc {res['gcc']} ({res['compile_s']:.0f} s), the per-node Hessian over all nodes "
+        f"takes {res['mapped_compiled_ms']['hessian']:.1f} ms against the solver's "
+        f"{res['solver_function_ms']['nlp_hess_l']:.1f} ms ({fl['compiled_to_vm_hessian_ratio']:.2f}×). On the "
+        f"default path ({fl['iterations']} iterations) the solve would take at best "
+        f"{fl['floor_hessian_compiled_s']:.1f} s with the Hessian compiled and "
+        f"{fl['floor_all_compiled_s']:.1f} s with every evaluation equally faster; the linear systems and "
+        f"IPOPT's own work alone take {fl['floor_evaluations_free_s']:.1f} s. Reaching {MSK_SOLVE_TARGET_S:g} s "
+        f"on this path would need all evaluations together in ≤ {fl['evaluation_budget_ms_per_iteration']:.1f} ms "
+        f"per iteration."]
+
+
+def compiled_solve_finding(res: dict) -> str:
+    """``bench_eval_floor.py``'s solve with the assembled compiled Hessian beside the book's
+    solver (first row of ``compiled_solve.solves``) from the same start, in one sentence; the
+    two are the same path when iterations match and the objectives agree to
+    :data:`SAME_OBJECTIVE_RTOL`."""
+    cs = res["compiled_solve"]
+    sv = pd.DataFrame(cs["solves"])
+    bk, cp = sv.iloc[0], sv.iloc[1]
+    same = (bk["iterations"] == cp["iterations"]
+            and abs(bk["objective"] - cp["objective"]) <= SAME_OBJECTIVE_RTOL * abs(bk["objective"]))
+    return (f"• Assembled from the compiled per-node Hessians, IPOPT's exact Hessian equals the solver's to "
+            f"{cs['hessian_check_max_rel_diff']:.0e} (relative) and costs {cs['hessian_ms']['assembled_compiled']:.1f} ms "
+            f"instead of {cs['hessian_ms']['solver']:.1f} ms. Solved with it: {cp['status']}, {cp['iterations']} "
+            f"iterations, {cp['solve_s']:.1f} s ({cp['ms_per_iteration']:.0f} ms per iteration), objective "
+            f"{cp['objective']:.4f}; the book's solver in the same run: {bk['status']}, {bk['iterations']} iterations, "
+            f"{bk['solve_s']:.1f} s ({bk['ms_per_iteration']:.0f} ms per iteration), objective {bk['objective']:.4f}. "
+            + ("Same path, same solution." if same else
+               "Round-off differences alone (the same Hessian summed in another order) send IPOPT down another "
+               "path to another local optimum: a faster Hessian does not give the book's solve faster."))
+
+
+def thesis_times_findings(res: dict | None = None) -> list[str]:
+    """The stored thesis-times table in sentences: counts (converged, not, not collected,
+    reloaded from the cache) and our total wall time; the speed-up range over the converged
+    rows with a thesis time, with the smallest and largest; the runs that did not converge;
+    the rows not collected."""
+    res = load("thesis_times") if res is None else res
+    ts = thesis_times_summary(res)
+    rows = pd.DataFrame(res["rows"])
+    out = [f"• {ts['n_rows']} optimisations: {ts['n_converged']} converged, {ts['n_not_converged']} did not, "
+           f"{ts['n_missing']} not collected; {ts['n_from_cache']} of the measured ones reloaded from the cache with "
+           f"the times of their solve. Our wall times add up to {ts['total_wall_s'] / 3600:.1f} h."]
+    if ts["n_with_thesis"]:
+        conv = rows[rows["speedup"].notna()]
+        lo, hi = conv.loc[conv["speedup"].idxmin()], conv.loc[conv["speedup"].idxmax()]
+        out.append(f"• Over the {ts['n_with_thesis']} converged optimisations with a thesis time the speed-up is "
+                   f"{ts['speedup_min']:.1f}–{ts['speedup_max']:.0f}× (median {ts['speedup_median']:.0f}×). Smallest: "
+                   f"{lo['chapter']} {lo['run']} — {lo['wall_s'] / 60:.1f} min here vs {lo['thesis_time']}; largest: "
+                   f"{hi['chapter']} {hi['run']} — {hi['wall_s'] / 60:.1f} min vs {hi['thesis_time']}.")
+    missing = _missing_mask(rows)
+    not_conv = rows[~rows["converged"].astype(bool) & ~missing]
+    if len(not_conv):
+        out.append("• Did not converge (no speed-up given): " + "; ".join(
+            f"{r.chapter} {r.run}: {r.status} after {_count(r.iterations)} iterations"
+            for r in not_conv.itertuples()) + ".")
+    if missing.any():
+        out.append("• Not collected: " + "; ".join(
+            f"{r.chapter} {r.run} ({r.status})" for r in rows[missing].itertuples()) + ".")
+    return out
+
+
+def _count(x) -> str:
+    """An integer count that may have become a float (a column with missing values), or "?"."""
+    return "?" if x is None or pd.isna(x) else f"{int(x)}"
+
+
+def mumps_orderings_findings(res: dict) -> list[str]:
+    """``bench_mumps_orderings.py`` in sentences: the orderings this MUMPS build lacks (MUMPS
+    used another one instead; their fits mix two orderings and are left out), then per model
+    the range of the flops exponents over the orderings, the slowest-growing ordering against
+    IPOPT's default (:data:`MUMPS_AUTO_ORDERING`) at the largest mesh, and whether any
+    ordering grows no faster than linearly (:data:`LINEAR_GROWTH`)."""
+    rows, fits = pd.DataFrame(res["rows"]), pd.DataFrame(res["fits"])
+    fl_fits = fits[fits["quantity"] == "flops"]
+    fallback = rows[rows["requested_name"].str.split().str[0] != rows["ordering_name"]]
+    fallback = fallback[fallback["requested"] != MUMPS_AUTO_ORDERING]
+    out = []
+    if len(fallback):
+        out.append("• Not in this MUMPS build (MUMPS used another ordering instead): " + "; ".join(
+            f"{name} → {', '.join(f'{u} (KKT of {g2.kkt_n.min():,}–{g2.kkt_n.max():,} rows)' for u, g2 in g.groupby('ordering_name'))}"
+            for name, g in fallback.groupby("requested_name", sort=False)) + ". Their fitted exponents mix two "
+            "orderings and are left out below.")
+    mixed = set(fallback["requested_name"])
+    for model, g in fl_fits[~fl_fits["requested_name"].isin(mixed)].groupby("model", sort=False):
+        best = g.loc[g["exponent"].idxmin()]
+        at = rows[rows["model"] == model]
+        at = at[at["nodes"] == at["nodes"].max()]
+        auto = at.loc[at["requested"] == MUMPS_AUTO_ORDERING, "flops"].iloc[0]
+        at = at.set_index("requested_name")["flops"]
+        used = rows[(rows["model"] == model) & (rows["requested"] == MUMPS_AUTO_ORDERING)]["ordering_name"].unique()
+        is_default = best["used"] in used
+        out.append(f"• {model}: one factorisation's operations grow as nodes^{g['exponent'].min():.2f}–"
+                   f"{g['exponent'].max():.2f} over the orderings; the slowest growth is {best['requested_name']}'s "
+                   f"(nodes^{best['exponent']:.2f} ± {best['exponent_se']:.2f})"
+                   + (", which is what IPOPT's default (MUMPS's automatic choice) uses. " if is_default else
+                      f", but at the largest mesh its count is {at[best['requested_name']] / auto:.2f}× that of "
+                      f"IPOPT's default (MUMPS's automatic choice: {', '.join(used)}). ")
+                   + ("No ordering MUMPS offers grows linearly or slower." if g["exponent"].min() > LINEAR_GROWTH else
+                      "At least one ordering grows no faster than linearly."))
+    return out
+
+
+def _fit(fits: pd.DataFrame, model: str, quantity: str = "time per iteration"):
+    """The row of :func:`scaling_fits` for ``model`` and ``quantity``, or None (no row or no
+    exponent fitted)."""
+    if fits.empty:
+        return None
+    r = fits[(fits["model"] == model) & (fits["quantity"] == quantity)]
+    return None if r.empty or not np.isfinite(r["exponent"].iloc[0]) else r.iloc[0]
+
+
+def _scaling_lines(table: pd.DataFrame, fits: pd.DataFrame) -> list[str]:
+    """Per model: the exponent of time per iteration against :data:`LINEAR_GROWTH`, its two
+    parts, the iterations' exponent and every run's status."""
+    out = []
+    for model in ("SK", "MSK", "NMSK"):
+        g = table[table["model"] == model]
+        if g.empty:
+            continue
+        f = _fit(fits, model)
+        statuses = ", ".join(f"{int(r.n_intervals)} intervals: {r.status} ({int(r.iterations)} it, "
+                             f"{r.ms_per_iteration:.0f} ms/it)" for r in g.itertuples() if isinstance(r.status, str))
+        if f is None:
+            out.append(f"• {model}: {statuses}; one mesh size only, no exponent fitted.")
+            continue
+        verdict = "meets" if f["exponent"] <= LINEAR_GROWTH else "does NOT meet"
+        parts = [p for p in (_fit(fits, model, "function evaluations per iteration"),
+                             _fit(fits, model, "IPOPT + MUMPS per iteration")) if p is not None]
+        split = (f" (function evaluations b = {parts[0]['exponent']:.2f}, IPOPT + MUMPS b = {parts[1]['exponent']:.2f})"
+                 if len(parts) == 2 else "")
+        it = _fit(fits, model, "iterations")
+        its = f"; iterations ∝ N^{it['exponent']:.2f}" if it is not None else ""
+        out.append(f"• {model}: time per iteration grows as N^{f['exponent']:.2f} over N = {f['nodes']} nodes{split}, "
+                   f"which {verdict} the target of at most linear growth{its}. Runs: {statuses}.")
+    return out
+
+
+def _machine_share_lines(table: pd.DataFrame, fits: pd.DataFrame) -> list[str]:
+    """SK: the excess exponent of the CasADi evaluations (exactly proportional work) read as
+    the machine's share, and IPOPT + MUMPS's exponent corrected by it."""
+    sk_runs = table[table["model"] == "SK"].sort_values("nodes")
+    sk_f, sk_fe = _fit(fits, "SK"), _fit(fits, "SK", "function evaluations per iteration")
+    sk_mu = _fit(fits, "SK", "IPOPT + MUMPS per iteration")
+    if len(sk_runs) < 2 or sk_f is None or sk_fe is None or sk_mu is None:
+        return []
+    excess, b_mu = sk_fe["exponent"] - LINEAR_GROWTH, sk_mu["exponent"]
+    load_col = "load (1 min) at start"
+    return [f"• How much of that is the machine: the CasADi evaluations do exactly proportional work (the same "
+            f"per-node expressions at every node), yet measure b = {sk_fe['exponent']:.2f} for SK; the 1-minute load "
+            f"average was {sk_runs[load_col].iloc[0]:.1f} at the smallest SK mesh and "
+            f"{sk_runs[load_col].iloc[-1]:.1f} at the largest (2 cores). If contention and cache "
+            f"effects inflate every exponent by that {excess:+.2f}, IPOPT + MUMPS per iteration "
+            f"(b = {b_mu:.2f}) still grows "
+            f"{'faster than linearly' if b_mu - excess > LINEAR_GROWTH else 'no faster than linearly'} "
+            f"(b ≈ {b_mu - excess:.2f})."]
+
+
+def _kkt_lines(res: dict) -> list[str]:
+    """Per model of ``bench_kkt_scaling.py``: the evaluations' exponent (linear up to
+    :data:`LINEAR_TOLERANCE`), one MUMPS factorisation + solve's exponent and the largest
+    rise of its cost per KKT row from one mesh to the next."""
+    rows, fits = kkt_scaling_tables(res)
+    kf = fits.set_index(["model", "quantity"])["exponent"]
+    out = []
+    for model in dict.fromkeys(fits["model"]):
+        b_ev, b_fa = kf[(model, "evaluations_ms")], kf[(model, "factor_solve_ms")]
+        kr = rows[rows["model"] == model].sort_values("nodes")
+        jump = (kr["factorisation_ms"] / kr["kkt_dim"]).pct_change().max()
+        out.append(f"• {model} at a fixed point: the NLP evaluations of one iteration grow as N^{b_ev:.2f} "
+                   f"({'linear' if b_ev <= LINEAR_GROWTH + LINEAR_TOLERANCE else 'superlinear'}); one MUMPS "
+                   f"factorisation + solve through CasADi's interface as N^{b_fa:.2f}, with its cost per KKT row "
+                   f"rising by up to {100 * jump:.0f} % from one mesh to the next — MUMPS's own choices at CasADi's "
+                   f"default settings, not IPOPT's (IPOPT's linear-system time per iteration is the 'IPOPT + MUMPS' "
+                   f"exponent above).")
+    return out
+
+
+def _fill_lines(res: dict, fits: pd.DataFrame) -> list[str]:
+    """Per model of ``bench_kkt_fill.py``: the factor's and the flops' exponents (with and
+    without the periodic constraint) beside IPOPT + MUMPS's measured exponent."""
+    ff = pd.DataFrame(res["fits"])
+    b = ff.set_index(["model", "periodic", "quantity"])["exponent"]
+    out = []
+    for model in dict.fromkeys(ff["model"]):
+        b_fl, b_np, b_L = b[(model, True, "flops_proxy")], b[(model, False, "flops_proxy")], b[(model, True, "L_nnz")]
+        mu = _fit(fits, model, "IPOPT + MUMPS per iteration")
+        out.append(f"• {model}, counted rather than timed: a minimum-degree LDLᵀ of the KKT matrix has a factor growing "
+                   f"as N^{b_L:.2f} but flops growing as N^{b_fl:.2f} (N^{b_np:.2f} without the periodic constraint)"
+                   + (f", beside IPOPT + MUMPS's measured N^{mu['exponent']:.2f}" if mu is not None else "")
+                   + ": the superlinear part of the linear algebra is the fill of the minimum-degree ordering, not "
+                     "the machine (MUMPS's own counts for every ordering it offers are in the section above).")
+    return out
+
+
+def _thesis_mesh_lines(table: pd.DataFrame) -> list[str]:
+    """Time per iteration of each model at :data:`THESIS_MESH_NODES`, and the build times."""
+    by_model = table[table["nodes"] == THESIS_MESH_NODES].set_index("model")
+    if not {"SK", "MSK"} <= set(by_model.index):
+        return []
+    msg = (f"• At the thesis mesh ({THESIS_MESH_NODES} nodes) one iteration costs "
+           f"{by_model.loc['SK', 'ms_per_iteration']:.0f} ms (SK), {by_model.loc['MSK', 'ms_per_iteration']:.0f} ms (MSK)")
+    if "NMSK" in by_model.index:
+        msg += f", {by_model.loc['NMSK', 'ms_per_iteration']:.0f} ms (NMSK)"
+    return [msg + f"; building the NLP takes {by_model['build_s'].min():.0f}–{by_model['build_s'].max():.0f} s."]
+
+
+def _hessian_lines(hess: pd.DataFrame) -> list[str]:
+    """Exact Hessian vs L-BFGS on the same problem: statuses, iterations, solve times,
+    objectives and the cost of an L-BFGS iteration relative to an exact one."""
+    done = hess[hess["outcome"] == FINISHED]
+    if done["hessian"].nunique() < 2:
+        return [f"• Exact Hessian vs L-BFGS: not measured ({', '.join(hess['outcome'].astype(str))})."]
+    ex = done[done["hessian"] == "exact"].iloc[0]
+    lm = done[done["hessian"] == "limited-memory"].iloc[0]
+    return [f"• Exact Hessian vs L-BFGS ({ex['model']}, {int(ex['n_intervals'])} intervals): {ex['status']} in "
+            f"{int(ex['iterations'])} iterations / {ex['solve_s']:.0f} s vs {lm['status']} in {int(lm['iterations'])} "
+            f"iterations / {lm['solve_s']:.0f} s (objective {ex['objective']:.4g} vs {lm['objective']:.4g}); an L-BFGS "
+            f"iteration costs {lm['ms_per_iteration'] / ex['ms_per_iteration']:.2f}× an exact one."]
+
+
+def _linear_solver_lines(avail: pd.DataFrame, lin: pd.DataFrame) -> list[str]:
+    """The linear solvers that load in this casadi build, and each finished one's time per
+    iteration and objective against MUMPS's."""
+    loads = avail[avail["loads"]]["linear_solver"].tolist() if not avail.empty else []
+    fails = avail[~avail["loads"]]["linear_solver"].tolist() if not avail.empty else []
+    out = [f"• Linear solvers that load in this casadi build: {', '.join(loads)}; "
+           f"{len(avail) - len(loads)} others fail to load ({', '.join(fails)})."]
+    done = lin[lin["outcome"] == FINISHED] if len(lin) else lin
+    if len(done) and (done["linear_solver"] == "mumps").any():
+        mu = done[done["linear_solver"] == "mumps"].iloc[0]
+        for r in done[done["linear_solver"] != "mumps"].itertuples():
+            out.append(f"  {r.linear_solver}: {r.status}, {r.iterations} iterations, {r.ms_per_iteration:.0f} "
+                       f"ms/iteration ({r.ms_per_iteration / mu['ms_per_iteration']:.1f}× MUMPS's "
+                       f"{mu['ms_per_iteration']:.0f} ms), objective {r.objective:.4g} (MUMPS {mu['objective']:.4g}).")
+    return out
+
+
+def _moco_lines(mt: pd.DataFrame) -> list[str]:
+    """The T9-track side by side: per scheme the median solve times and the speed-ups."""
+    return ["• Against OpenSim Moco (T9-track), median solve times: " + "; ".join(
+        f"{r['scheme']}: Moco {r['Moco solve (s)']:.2f} s, gaitlib {r['gaitlib solve (s)']:.2f} s = "
+        f"{r['speed-up']:.1f}× (with IPOPT's default options {r['speed-up, gaitlib with IPOPT defaults']:.1f}×; "
+        f"setup + solve {r['Moco setup + solve (s)']:.1f} s vs {r['gaitlib setup + solve (s)']:.1f} s)"
+        for _, r in mt.iterrows()) + "."]
+
+
+def findings(scaling: dict, moco: dict, kkt: dict | None = None, fill: dict | None = None) -> list[str]:
+    """The page's summary, one sentence per finding, computed from the stored results: the
+    mesh scaling of each model against :data:`LINEAR_GROWTH` and the machine's share of it
+    (``scaling``); one iteration's pieces at a fixed point (``kkt``, optional); the counted
+    fill of the factorisation (``fill``, optional); the thesis mesh; exact Hessian vs L-BFGS
+    and the linear solvers (``scaling``); OpenSim Moco (``moco``)."""
+    table, fits = scaling_table(scaling), scaling_fits(scaling)
+    out = _scaling_lines(table, fits) + _machine_share_lines(table, fits)
+    if kkt is not None:
+        out += _kkt_lines(kkt)
+    if fill is not None:
+        out += _fill_lines(fill, fits)
+    out += _thesis_mesh_lines(table)
+    out += _hessian_lines(hessian_table(scaling))
+    out += _linear_solver_lines(*linear_solver_table(scaling))
+    out += _moco_lines(moco_table(moco))
+    return out
