@@ -70,6 +70,7 @@ import traceback
 from contextlib import nullcontext
 from pathlib import Path
 
+from gaitlib.problems import gait as gait_ocp
 from gaitlib import blas
 
 # before numpy loads OpenBLAS: the Makefile's settings (the gap solutions' cache keys hash
@@ -190,7 +191,7 @@ def ch02(ctx):
             rows.append(tt.missing_row("ch02", run, _how_to("ch02"), thesis_key=f"ch02 {model}", study_call=call))
             continue
         note = tt.THESIS_SILENT.get(f"ch02 {model}", "")
-        rows.append(_gait_row("ch02", run, sol, gait.cache_dir(sol.spec), thesis_key=f"ch02 {model}",
+        rows.append(_gait_row("ch02", run, sol, gait_ocp.cache_dir(sol.spec), thesis_key=f"ch02 {model}",
                               call=call, note=note))
     return rows
 
@@ -314,9 +315,9 @@ def ch05(ctx):
             continue
         if model == "MSK":
             base = sol
-            where, note = msk.sg.cache_dir(sol.spec), ""
+            where, note = gait_ocp.cache_dir(sol.spec), ""
         else:
-            where = msk.sg.cache_dir(sol.spec, guess=base)
+            where = gait_ocp.cache_dir(sol.spec, guess=base)
             note = "warm-started from the Ch 5 MSK solution (the thesis: data and EMG guess)"
         rows.append(_gait_row("ch05", run, sol, where, thesis_key=f"ch05 {model}", call=call, note=note))
     return rows
@@ -325,7 +326,6 @@ def ch05(ctx):
 def _study_rows(chapter, res, call, item_of, label_of, guess_note=""):
     """Rows of a Ch 6/7 StudyResult (and a list of the runs that stopped at an IPOPT status
     other than success, to be rerun at 3000 iterations as the book does)."""
-    from gaitlib.studies import gait
 
     rows, failed = [], []
     for name, spec in res.specs.items():
@@ -344,13 +344,12 @@ def _study_rows(chapter, res, call, item_of, label_of, guess_note=""):
             continue
         if not rec.ok:
             failed.append(name)
-        rows.append(_gait_row(chapter, run, sol, gait.cache_dir(spec, guess=res.guesses.get(name)),
+        rows.append(_gait_row(chapter, run, sol, gait_ocp.cache_dir(spec, guess=res.guesses.get(name)),
                               thesis_key=key, call=call))
     return rows, failed
 
 
 def _reruns(chapter, res, failed, call, item_of, label_of):
-    from gaitlib.studies import gait
 
     rows = []
     for name in failed:
@@ -363,7 +362,7 @@ def _reruns(chapter, res, failed, call, item_of, label_of):
         except cache.NotCached:
             rows.append(tt.missing_row(chapter, run, _how_to(chapter), thesis_key=key, study_call=c))
             continue
-        rows.append(_gait_row(chapter, run, sol, gait.cache_dir(spec, guess=res.guesses.get(name)),
+        rows.append(_gait_row(chapter, run, sol, gait_ocp.cache_dir(spec, guess=res.guesses.get(name)),
                               thesis_key=key, call=c,
                               note=f"the 1000-iteration run stopped with {res.records[name].status}"))
     return rows

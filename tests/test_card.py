@@ -8,10 +8,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from gaitlib.problems import gait as gait_ocp
 from gaitlib import cache
 from gaitlib.cli import main
 from gaitlib.studies import card
-from gaitlib.studies import gait as sg
 from gaitlib.studies import msk
 
 
@@ -92,7 +92,7 @@ def test_cli_writes_card(cli_card):
 
 def test_card_reads_the_stored_numbers(tmp_path, monkeypatch):
     """Change a stored number in a copy of the Ch 5 MSK entry: the card's row follows it."""
-    where = sg.cache_dir(msk.ch5_spec("MSK"))
+    where = gait_ocp.cache_dir(msk.ch5_spec("MSK"))
     found = cache.find(where, "spec.json")
     if found is None:
         pytest.skip("the Ch 5 MSK solution is not stored")

@@ -1,5 +1,5 @@
 """The command line's contract: exit status, one-line errors, options checked before any
-solve, outputs staged and moved into place (gaitlib.cli, gaitlib.gap.cli)."""
+solve, outputs staged and moved into place (gaitlib.cli, gaitlib.cli.gap)."""
 
 from __future__ import annotations
 
@@ -9,11 +9,12 @@ from types import SimpleNamespace
 import pandas as pd
 import pytest
 
+from gaitlib.problems import gait as gait_ocp
 from gaitlib import __version__, cli
 from gaitlib import data as data_mod
 from gaitlib import sweep as sw
 from gaitlib.gap import diagnose as D
-from gaitlib import effects
+from gaitlib import effects as effects_mod
 from gaitlib.gap import io as gio
 
 FAILED = "Maximum_Iterations_Exceeded"
@@ -34,9 +35,8 @@ def _no_solve(*a, **k):
 def no_solve(monkeypatch):
     """Any solve (gait study, sweep, diagnosis, twin) fails the test."""
     from gaitlib.gap import twin
-    from gaitlib.studies import gait
 
-    for mod, name in ((gait, "solve_cached"), (sw, "solve_specs"), (D, "diagnose"), (twin, "make_twin")):
+    for mod, name in ((gait_ocp, "solve_cached"), (gait_ocp, "solve_specs"), (D, "diagnose"), (twin, "make_twin")):
         monkeypatch.setattr(mod, name, _no_solve)
 
 
@@ -89,7 +89,7 @@ def test_bad_options_are_rejected_at_parse_time(argv, capsys, no_solve, tmp_path
     (["sweep", "--costs", "DT,XX", "--out", "o"], ["unknown cost 'XX'"]),
     (["sweep", "--costs", ",", "--out", "o"], ["--costs and --speeds"]),
     (["gap", "--data", "missing.csv", "--out", "o", "--effects", "friction,nope"],
-     ["unknown effect(s) nope", "known: " + ", ".join(effects.EFFECTS)]),
+     ["unknown effect(s) nope", "known: " + ", ".join(effects_mod.EFFECTS)]),
     (["gap-twin", "--effect", "body_mass", "--out", "t.csv"], ["needs --magnitude", "[-0.3, 0.3]"]),
     (["gap-twin", "--effect", "body_mass", "--magnitude", "5", "--out", "t.csv"], ["outside [-0.3, 0.3]"]),
     (["gap-twin", "--effect", "nope", "--magnitude", "0.1", "--out", "t.csv"], ["unknown effect 'nope'"]),
@@ -117,12 +117,11 @@ def test_debug_shows_the_traceback(capsys, no_solve):
 
 
 def test_unexpected_errors_are_one_line_too(capsys, monkeypatch, tmp_path):
-    from gaitlib.studies import gait
 
     def boom(*a, **k):
         raise ZeroDivisionError("deep inside")
 
-    monkeypatch.setattr(gait, "solve_cached", boom)
+    monkeypatch.setattr(gait_ocp, "solve_cached", boom)
     rc, _, err = _run(["run", "gait", "--out", str(tmp_path / "o"), "--cache", str(tmp_path / "c")], capsys)
     line = _one_line(err, "run")
     assert rc == 2 and "ZeroDivisionError: deep inside" in line and "--debug" in line
@@ -355,7 +354,7 @@ def test_sweep_exit_status_and_owned_run_folders(capsys, tmp_path, monkeypatch):
         return {n: sw.RunRecord(n, False, "error", None, "Traceback\nValueError: boom", 0.1, "serial")
                 if n.endswith("Slow") else sw.RunRecord(n, True, "done", None, None, 0.1, "serial") for n in specs}
 
-    monkeypatch.setattr(sw, "solve_specs", fake_solve_specs)
+    monkeypatch.setattr(gait_ocp, "solve_specs", fake_solve_specs)
     base = ["sweep", "--model", "SK", "--costs", "DT", "--intervals", "4", "--degree", "3", "--cache", "c",
             "--out", "o"]
     rc, _, err = _run(base + ["--speeds", "Slow,Free"], capsys)

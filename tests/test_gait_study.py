@@ -89,7 +89,7 @@ def test_reload_reproduces_frames_and_cache_serves_the_same_solution(coarse):
     sol = gait_ocp.GaitSolution.load(out)
     q_csv = pd.read_csv(out / "q.csv", index_col=0)
     np.testing.assert_allclose(sol.q.to_numpy(), q_csv.to_numpy(), rtol=1e-8, atol=1e-10)
-    cached = gait.solve_cached(sol.spec, root=root)
+    cached = gait_ocp.solve_cached(sol.spec, root=root)
     assert cached.stats["solve_time_s"] == sol.stats["solve_time_s"]  # served, not re-solved
     np.testing.assert_array_equal(cached.q.to_numpy(), sol.q.to_numpy())
     table = gait.rmse_beside_thesis(sol)

@@ -10,7 +10,7 @@ import pytest
 from gaitlib import data as data_mod
 from gaitlib import ocp
 from gaitlib.problems import gait as gait_ocp
-from gaitlib import effects
+from gaitlib import effects as effects_mod
 from gaitlib.gap import io as gio
 from gaitlib.gap import locate as L
 
@@ -94,7 +94,7 @@ def test_effects_at_null_leave_the_problem_unchanged():
     optimum); a magnitude fixed at 0 drops the effect. SK for the effects that apply to it,
     MSK for the muscle-level ones."""
     ref = {}
-    for name, e in effects.EFFECTS.items():
+    for name, e in effects_mod.EFFECTS.items():
         if not e.resolve:
             continue
         model = "SK" if "SK" in e.models else "MSK"
@@ -103,19 +103,19 @@ def test_effects_at_null_leave_the_problem_unchanged():
             ref[model] = _nlp_at_guess(gait_ocp.GaitSpec(**base))
         _, T0, f0, g0 = ref[model]
         gp, T, f1, g1 = _nlp_at_guess(gait_ocp.GaitSpec(**base, effects=((name, None),)))
-        assert [p.name for p in gp.problem.parameters] == [f"effects.{name}.{q.name}" for q in e.params]
+        assert [p.name for p in gp.problem.parameters] == [f"fx.{name}.{q.name}" for q in e.params]
         assert f1 == pytest.approx(f0, rel=1e-12, abs=1e-12), name
         if e.path is None:
             assert np.allclose(g1, g0, atol=1e-9), name
         else:  # co-contraction at c = 0: a_flex ≥ 0 and a_ext ≥ 0 — inactive for the guess
             assert len(g1) > len(g0) and T.n_constraints > T0.n_constraints
-        fixed0 = effects.bind(gait_ocp.GaitSpec(**base, effects=((name, 0.0),)), None)
+        fixed0 = effects_mod.bind(gait_ocp.GaitSpec(**base, effects=((name, 0.0),)), None)
         assert fixed0.items == [] and fixed0.parameters == []
 
 
 def test_effects_registry_documented():
-    assert len(effects.EFFECTS) >= 6
-    for name, e in effects.EFFECTS.items():
+    assert len(effects_mod.EFFECTS) >= 6
+    for name, e in effects_mod.EFFECTS.items():
         assert e.name == name and e.n_params >= 1 and len(e.doc) > 200
         assert "Parameters" in e.doc and all(p.unit for p in e.params)
         for p in e.params:
@@ -144,8 +144,8 @@ def test_hat_com_offset_static_moment():
     """Upright HAT at rest: the offset's extra moment about the hip is m_HAT g d, no force."""
     spec = gait_ocp.GaitSpec(**TINY, effects=(("hat_com", 0.03),))
     gp = gait_ocp.build(spec)
-    ctx = effects.Context(spec, gp.model, gp.ref, gp.ref.gait.cycle_time, gp.p_body, gp.p_contact)
-    w = np.asarray(effects.EFFECTS["hat_com"].root_load(_named_x({}), {"d": 0.03}, ctx), float).ravel()
+    ctx = effects_mod.Context(spec, gp.model, gp.ref, gp.ref.gait.cycle_time, gp.p_body, gp.p_contact)
+    w = np.asarray(effects_mod.EFFECTS["hat_com"].root_load(_named_x({}), {"d": 0.03}, ctx), float).ravel()
     m = gp.p_body[gp.model.p_body_names.index("mass_hat")]
     assert w == pytest.approx([0.0, 0.0, m * 9.81 * 0.03], abs=1e-12)
 
@@ -155,14 +155,14 @@ def test_arm_swing_antiphase_cancels_horizontal_force_and_moment():
     arms' horizontal forces and pitch moments cancel exactly, their vertical forces add."""
     spec = gait_ocp.GaitSpec(**TINY, effects=(("arm_swing", 1.0),))
     gp = gait_ocp.build(spec)
-    ctx = effects.Context(spec, gp.model, gp.ref, gp.ref.gait.cycle_time, gp.p_body, gp.p_contact)
+    ctx = effects_mod.Context(spec, gp.model, gp.ref, gp.ref.gait.cycle_time, gp.p_body, gp.p_contact)
     cr, cl = float(np.mean(gp.ref.q["hip_r"])), float(np.mean(gp.ref.q["hip_l"]))
     a, ad, add = 0.3, 1.1, -4.0
     x = _named_x({"hip_r": cr + a, "qd_hip_r": ad, "qdd_hip_r": add,
                   "hip_l": cl - a, "qd_hip_l": -ad, "qdd_hip_l": -add})
-    w = np.asarray(effects.EFFECTS["arm_swing"].root_load(x, {"G": 1.0}, ctx), float).ravel()
+    w = np.asarray(effects_mod.EFFECTS["arm_swing"].root_load(x, {"G": 1.0}, ctx), float).ravel()
     assert abs(w[0]) < 1e-12 and abs(w[2]) < 1e-12
-    m, lc = effects.ARM["mass"], effects.ARM["com"]
+    m, lc = effects_mod.ARM["mass"], effects_mod.ARM["com"]
     # each arm's COM rises by lc (1 − cos φ); vertical force = 2 m d²/dt² of it, here with φ = a
     phi, phid, phidd = a, ad, add
     ydd = lc * (phidd * np.sin(phi) + phid**2 * np.cos(phi))
@@ -178,7 +178,7 @@ def test_left_shift_reference_is_the_fourier_shift(real):
     delta = ca.SX.sym("delta")
     names = list(frame.columns)
     dsym = ca.SX.sym("d", len(names))
-    over = effects.EFFECTS["left_shift"].reference(ocp.Named(dsym, names, "data"), {"delta": delta}, None, None)
+    over = effects_mod.EFFECTS["left_shift"].reference(ocp.Named(dsym, names, "data"), {"delta": delta}, None, None)
     f = ca.Function("f", [dsym, delta], [over["ref_knee_l"], over["ref_grf_y_l"]])
     g = real.gait
     for dv in (0.0, 0.02, -0.035):
@@ -189,7 +189,7 @@ def test_left_shift_reference_is_the_fourier_shift(real):
         ref_kn = data_mod.fourier_shift(g.mean["knee_r"].to_numpy(), g.left_shift + dv, 5)
         ref_gy = data_mod.fourier_shift(g.mean["grf_y_r"].to_numpy(), g.left_shift + dv, 5)
         assert np.allclose(kn, ref_kn, atol=1e-9) and np.allclose(gy, ref_gy, atol=1e-7)
-    assert effects.left_generated(g)
+    assert effects_mod.left_generated(g)
 
 
 # -------------------------------------------------------------------------- IO and twins
@@ -241,7 +241,7 @@ def test_twin_round_trip_through_the_tidy_reader(tmp_path, real):
     p = tmp_path / "twin.csv"
     clean.to_csv(p, index=False, float_format="%.12g")
     ds = gio.read_data(p)
-    assert not effects.left_generated(ds.gait)
+    assert not effects_mod.left_generated(ds.gait)
     loc = L.locate(sol, ds)
     assert loc.rss < 1e-12
     rss = []
@@ -331,7 +331,7 @@ def test_needs_retry_on_failure_or_a_nested_fit_worse_than_the_baseline():
     from gaitlib.gap import diagnose as D
 
     base = _S("Solve_Succeeded", 10.0)
-    nested = next(n for n, e in effects.EFFECTS.items() if D._nested(e))
+    nested = next(n for n, e in effects_mod.EFFECTS.items() if D._nested(e))
     assert D.needs_retry(nested, None, base)
     assert D.needs_retry(nested, _S("Maximum_Iterations_Exceeded", 1.0), base)
     assert D.needs_retry(nested, _S("Solve_Succeeded", 10.5), base)
@@ -361,7 +361,7 @@ def test_candidate_retry_keeps_the_best_start(tmp_path, real):
     low = copy.copy(base)
     low.stats = dict(base.stats, objective=-1.0)
     name = "friction"
-    assert D._nested(effects.EFFECTS[name])
+    assert D._nested(effects_mod.EFFECTS[name])
     fits = D.candidate_fits(spec, {"d": real}, {"d": low}, [name], root=root, alternates=alts, serial=True,
                             progress=False)["d"]
     f = fits[name]
@@ -448,7 +448,7 @@ def test_cli_gap_on_a_hand_written_csv(tmp_path):
     rk = {r["effect"]: r for r in j["ranking"]}
     assert set(rk) == {"friction", "hat_com", "segment_inertia"}
     for name, r in rk.items():
-        e = effects.EFFECTS[name]
+        e = effects_mod.EFFECTS[name]
         assert r["n_params"] == e.n_params and set(r["parameters"]) == {q.name for q in e.params}
         assert r["rss_before"] == pytest.approx(loc["summary"]["rss"])
         assert r["start"] in ("baseline", "null") + D.BASELINE_STARTS and r["nests_baseline"]

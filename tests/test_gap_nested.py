@@ -11,7 +11,7 @@ import pytest
 from gaitlib import data as data_mod
 from gaitlib.problems import gait as gait_ocp
 from gaitlib.gap import diagnose as D
-from gaitlib import effects
+from gaitlib import effects as effects_mod
 from gaitlib.gap import io as gio
 from gaitlib.gap import locate as L
 
@@ -27,7 +27,7 @@ def test_every_nlp_candidate_nests_the_baseline():
     """Every NLP-identified effect has its null value inside its bounds (the baseline model is
     a member); profiled effects are fitted on grids without the null value and are stated
     as not nesting."""
-    for n, e in effects.EFFECTS.items():
+    for n, e in effects_mod.EFFECTS.items():
         nests, why = D.nesting(n)
         assert why
         if e.identify == "nlp":
@@ -53,9 +53,9 @@ def test_null_start_reproduces_the_baseline_point(real):
         r1 = N._NullRunner(D._with_effects(spec, ((name, None),)))
         T1 = ocp.transcribe(r1.problem, r1.gp.mesh, ocp.SolverOptions(max_iter=0))
         w1 = T1.initial_point(N.null_guess(base))
-        p = [f"effects.{name}.{q.name}" for q in effects.EFFECTS[name].params]
+        p = [f"fx.{name}.{q.name}" for q in effects_mod.EFFECTS[name].params]
         ip = [T1.ip[T1.problem.parameter_names.index(k)] for k in p]
-        assert np.all(w1[ip] == [q.null for q in effects.EFFECTS[name].params])
+        assert np.all(w1[ip] == [q.null for q in effects_mod.EFFECTS[name].params])
         s1 = T1.solve(N.null_guess(base), data={"cycle": r1.frame(real.gait)})
         assert s1.objective == pytest.approx(base.solution.objective, rel=1e-12, abs=1e-14), name
 

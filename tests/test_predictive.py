@@ -84,10 +84,10 @@ def test_full_guess_scales_every_state_and_control_consistently(base):
     assert pr.GUESS_POLICY == {"MSK": "thesis", "NMSK": "ch5"}
     # guesses derived differently from one solution are cached under different keys
     spec = pr.ch6_specs("MSK", base, ("DT",), **MESH)["MSK DT"]
-    dirs = {sg.cache_dir(spec, guess=g) for g in (pr.run_guess(base, "thesis"), pr.run_guess(base, "ch5"),
+    dirs = {gait_ocp.cache_dir(spec, guess=g) for g in (pr.run_guess(base, "thesis"), pr.run_guess(base, "ch5"),
                                                    pr.run_guess(base, "thesis", cycle_time=1.0, stride=1.0), base)}
     assert len(dirs) == 4
-    assert sg.cache_dir(spec, guess=pr.run_guess(base, "ch5")) == sg.cache_dir(spec, guess=pr.run_guess(base, "ch5"))
+    assert gait_ocp.cache_dir(spec, guess=pr.run_guess(base, "ch5")) == gait_ocp.cache_dir(spec, guess=pr.run_guess(base, "ch5"))
     with pytest.raises(ValueError, match="guess must be"):
         pr.run_guess(base, "data")
 
@@ -119,7 +119,7 @@ def test_fully_predictive_fits_the_data_worse_than_data_tracking(base, root):
     Both start from the whole baseline solution (from the thesis's partial guess, DT at 5 x 3
     stopped at the iteration limit on an AVX2-only EPYC and converged elsewhere)."""
     specs = pr.ch6_specs("MSK", base, ("DT", "FP"), **MESH)
-    sols = {k: sg.solve_cached(s, guess=pr.run_guess(base, "ch5"), root=root) for k, s in specs.items()}
+    sols = {k: gait_ocp.solve_cached(s, guess=pr.run_guess(base, "ch5"), root=root) for k, s in specs.items()}
     for s in sols.values():
         assert s.stats["status"] == "Solve_Succeeded"
     free = data.load_gait_data("Free")

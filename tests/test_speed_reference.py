@@ -6,7 +6,6 @@ import pytest
 
 from gaitlib import data
 from gaitlib.problems import gait as gait_ocp
-from gaitlib.studies import gait as sg
 
 COARSE = dict(model="SK", cost="DT", n_intervals=8, degree=3)
 
@@ -28,7 +27,7 @@ def test_time_scaled_keeps_magnitudes_and_takes_target_timing():
 @pytest.fixture(scope="module")
 def coarse_sk(tmp_path_factory):
     root = tmp_path_factory.mktemp("sol")
-    sol = sg.solve_cached(gait_ocp.GaitSpec(**COARSE), root=root)
+    sol = gait_ocp.solve_cached(gait_ocp.GaitSpec(**COARSE), root=root)
     assert sol.stats["status"] == "Solve_Succeeded"
     return sol, root
 
@@ -62,7 +61,7 @@ def test_track_class_solves_at_the_target_timing_on_scaled_data(coarse_sk):
     np.testing.assert_allclose(d["ref_tau_knee_r"].to_numpy(), free.mean["tau_knee_r"].to_numpy())
     assert not np.allclose(d["ref_tau_knee_r"].to_numpy(), np.interp(
         d.index.to_numpy() * slow.cycle_time, slow.time, slow.mean["tau_knee_r"].to_numpy()))
-    sol = sg.solve_cached(sp, root=root)
+    sol = gait_ocp.solve_cached(sp, root=root)
     assert sol.stats["status"] == "Solve_Succeeded"
     assert np.isclose(sol.stats["tf_s"], slow.cycle_time)
     # the pelvis advances one Slow stride per cycle (periodic offset)

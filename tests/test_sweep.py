@@ -62,7 +62,7 @@ def _check_records(recs: dict, root: Path) -> None:
 @pytest.fixture(scope="module")
 def serial(tmp_path_factory):
     root = tmp_path_factory.mktemp("serial_cache")
-    recs = sw.solve_specs(SPECS, cache_root=root, serial=True, progress=False)
+    recs = gait_ocp.solve_specs(SPECS, cache_root=root, serial=True, progress=False)
     _check_records(recs, root)
     assert all(r.worker.startswith("serial:") for r in recs.values())
     return recs
@@ -70,7 +70,7 @@ def serial(tmp_path_factory):
 
 def test_localcluster_gives_bitwise_the_serial_results(serial, tmp_path, capfd):
     root = tmp_path / "cache"
-    recs = sw.solve_specs(SPECS, cache_root=root, n_workers=2)
+    recs = gait_ocp.solve_specs(SPECS, cache_root=root, n_workers=2)
     _check_records(recs, root)
     assert all(r.worker.startswith("tcp://") for r in recs.values())
     for name in SPECS:
@@ -80,7 +80,7 @@ def test_localcluster_gives_bitwise_the_serial_results(serial, tmp_path, capfd):
     assert "LocalCluster(2 workers" in err and len(lines) == len(SPECS)
     assert [ln.split()[1] for ln in lines if ln.endswith("FAILED")] == ["SK_DT_Free_3it"]
     # a second sweep of the same runs reloads them in this process: no cluster, same results
-    again = sw.solve_specs(SPECS, cache_root=root, n_workers=2)
+    again = gait_ocp.solve_specs(SPECS, cache_root=root, n_workers=2)
     assert "LocalCluster" not in capfd.readouterr().err
     assert all(r.worker.startswith("cache:") for r in again.values())
     assert [(r.name, r.ok, r.status) for r in again.values()] == [(r.name, r.ok, r.status) for r in recs.values()]
@@ -146,7 +146,7 @@ def dask_cluster(tmp_path_factory):
 def test_existing_cluster_gives_bitwise_the_serial_results(serial, dask_cluster, tmp_path):
     address, decoy = dask_cluster
     root = tmp_path / "cache"
-    recs = sw.solve_specs(SPECS, cache_root=root, scheduler=address)
+    recs = gait_ocp.solve_specs(SPECS, cache_root=root, scheduler=address)
     _check_records(recs, root)
     assert not decoy.exists() or not any(decoy.rglob("spec.json"))
     for name in SPECS:

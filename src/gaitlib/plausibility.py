@@ -54,7 +54,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .data import DataError, QUANTITY_UNITS
+from .tidy import QUANTITY_UNITS, DataError, load_tidy
 
 __all__ = ["DataError", "Range", "RANGES", "ACCEPTED_SIDES", "MAX_STEP_PCT", "check_tidy", "check_file"]
 
@@ -226,9 +226,7 @@ def check_tidy(df: pd.DataFrame, path="<data>", *, allow_no_sd: bool = False) ->
 
 
 def check_file(path, *, speed_class: str | None = None, allow_no_sd: bool = False) -> tuple:
-    """:func:`gaitlib.data.load_tidy` then :func:`check_tidy` on a CSV (one class or all)."""
-    from .data import load_tidy
-
+    """:func:`gaitlib.tidy.load_tidy` then :func:`check_tidy` on a CSV (one class or all)."""
     df = load_tidy(path)
     if speed_class is not None:
         df = df[df["speed_class"] == speed_class]

@@ -47,7 +47,7 @@ diagnosis is ``"unexplained"``. Verdict ``"explained"`` if it also closes ≥ 50
 RSS, ``"partial"`` otherwise.
 
 Interval: the data's means are redrawn B times as mean + SD*/√n · g(τ) (g: smooth unit
-noise, :func:`gaitlib.gap.twin.smooth_noise`; a generated left leg gets the right leg's
+noise, :func:`gaitlib.gap.noise.smooth_noise`; a generated left leg gets the right leg's
 noise at its shifted time), the solutions held fixed, and % closed recomputed; the 2.5 and
 97.5 percentiles are reported. The solutions are not re-solved per draw (cost), so the
 interval covers the data's uncertainty, not the re-identification's.
@@ -65,9 +65,11 @@ import pandas as pd
 
 from ..problems import gait as gait_ocp
 from ..ocp import _json_default  # the same JSON encoding as saved solutions
-from .. import effects
+from .. import effects as effects_mod
 from . import io as gio
 from . import locate as L
+from .method import BIC_THRESHOLD, DEFAULT_BASE, EXPLAINED_PCT, PROFILE_GRID
+from .noise import smooth_noise
 from .nullstart import null_start_many
 from .solve import solve_many
 
@@ -75,15 +77,6 @@ __all__ = ["BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "Fit", "Diagnosis", 
            "candidates", "base_spec", "as_dataset", "baseline_fits", "pick_best", "BASELINE_STARTS",
            "COARSE_MESH", "GRF_SD_FACTOR", "RETRY_MARGIN", "grf_weighted", "candidate_fits", "needs_retry",
            "alternates_of", "lowest_objective", "BaselineFailed", "nesting", "ABOVE_LOCATED", "FIT_STARTS"]
-
-#: ΔBIC a top effect must reach (≤) to be named.
-BIC_THRESHOLD = -10.0
-#: Fixed magnitudes tried for ``identify="profile"`` effects that need a re-solve.
-PROFILE_GRID = {"co_contraction": (0.1, 0.2, 0.35, 0.5), "joint_stiffness": (-0.5, 1.0, 2.0, 3.0)}
-#: Default baseline: SK, data-tracking cost (Eq 4.11), 10 × 3 LGR.
-DEFAULT_BASE = dict(model="SK", cost="DT", n_intervals=10, degree=3)
-#: % of the RSS a named effect must close for the verdict "explained" (else "partial").
-EXPLAINED_PCT = 50.0
 
 
 def base_spec(base=None) -> gait_ocp.GaitSpec:
@@ -109,13 +102,13 @@ def as_dataset(data, like=None, fill_from=None, n_subjects=None) -> gio.DataSet:
 
 def candidates(spec0: gait_ocp.GaitSpec, gait, effects=None) -> tuple[list, dict]:
     """(applicable effect names, {name: reason} of those left out)."""
-    names = list(effects.EFFECTS) if effects is None else list(effects)
+    names = list(effects_mod.EFFECTS) if effects is None else list(effects)
     ok, skipped = [], {}
     for n in names:
-        e = effects.EFFECTS[n]
+        e = effects_mod.EFFECTS[n]
         if spec0.model not in e.models:
             skipped[n] = f"not applicable to the {spec0.model} model (signature: {e.signature})"
-        elif n == "left_shift" and not effects.left_generated(gait):
+        elif n == "left_shift" and not effects_mod.left_generated(gait):
             skipped[n] = "the data's left leg is measured, not generated from the right one"
         elif e.identify == "profile" and e.resolve and n not in PROFILE_GRID:
             skipped[n] = "no profile grid"
@@ -179,8 +172,6 @@ class BaselineFailed(RuntimeError):
 
 def _noise_fns(located_list, rng, B: int) -> dict:
     """Smooth unit noise draws per channel id: id → callable(τ) → (B, len τ)."""
-    from .twin import smooth_noise
-
     ids = sorted({c for loc in located_list for c in loc.channels["channel"]})
     return {c: smooth_noise(rng, B) for c in ids}
 
@@ -257,7 +248,7 @@ class Diagnosis:
             "summary": self.summary(),
             "effects": {n: {"title": e.title, "n_params": e.n_params, "identify": e.identify,
                             "params": [p.__dict__ for p in e.params], "nests_baseline": nesting(n)[0],
-                            "nesting": nesting(n)[1]} for n, e in effects.EFFECTS.items()},
+                            "nesting": nesting(n)[1]} for n, e in effects_mod.EFFECTS.items()},
             "settings": self.settings,
         }
         if self.solution_located is not None:
@@ -331,7 +322,7 @@ ABOVE_LOCATED = "located gap above the baseline's"
 
 def nesting(name: str) -> tuple[bool, str]:
     """(whether the candidate's kept fit can always reproduce the baseline, why)."""
-    e = effects.EFFECTS[name]
+    e = effects_mod.EFFECTS[name]
     if not e.resolve:
         return True, "comparison on the baseline solution; the null value is kept unless a value does better"
     if _nested(e):
@@ -355,7 +346,7 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
     n_eff = loc0.n_eff
     rows = []
     for name, f in fits.items():
-        e = effects.EFFECTS[name]
+        e = effects_mod.EFFECTS[name]
         nests, _ = nesting(name)
         row = {"effect": name, "title": e.title, "n_params": f.n_params, "identify": f.identify,
                "parameters": f.thetas.get(name, {}), "status": f.status, "ok": f.ok, "start": f.start,
@@ -393,7 +384,7 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
     shrink, intervals = {}, {}
     tops = [r["effect"] for _, r in ranking.iterrows() if r["ok"] and np.isfinite(r["dBIC"])][:top]
     rng = np.random.default_rng(seed)
-    generated = effects.left_generated(ds.gait)
+    generated = effects_mod.left_generated(ds.gait)
     shift0 = float(ds.gait.left_shift)
     fns = _noise_fns([loc0] + [fits[k].located for k in tops], rng, resamples) if resamples and tops else None
     r0 = _resampled_rss(loc0, ds, fns, shift0, generated) if fns else None
@@ -540,7 +531,7 @@ def _nested(e) -> bool:
 
 
 def _nlp_fit(n: str, sol, ds, error: bool = False) -> Fit:
-    e = effects.EFFECTS[n]
+    e = effects_mod.EFFECTS[n]
     st, ok = _status(sol)
     if sol is None and error:
         st = "error"
@@ -556,7 +547,7 @@ def needs_retry(n: str, sol, base_sol) -> bool:
     contains."""
     if sol is None or not _status(sol)[1]:
         return True
-    if not _nested(effects.EFFECTS[n]) or base_sol is None:
+    if not _nested(effects_mod.EFFECTS[n]) or base_sol is None:
         return False
     f0, f1 = float(base_sol.stats["objective"]), float(sol.stats["objective"])
     return f1 > f0 + RETRY_MARGIN * abs(f0)
@@ -582,7 +573,7 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
     (:func:`assemble` does not rank it)."""
     groups = {}
     for n in names:
-        e = effects.EFFECTS[n]
+        e = effects_mod.EFFECTS[n]
         if not e.resolve:
             continue
         if e.identify == "nlp":
@@ -600,7 +591,7 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
     retry = {}
     if alternates:
         for n in names:
-            e = effects.EFFECTS[n]
+            e = effects_mod.EFFECTS[n]
             if not (e.resolve and e.identify == "nlp"):
                 continue
             spec = _with_effects(spec0, ((n, None),))
@@ -623,7 +614,7 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
     null = {}
     if null_start:
         for n in names:
-            e = effects.EFFECTS[n]
+            e = effects_mod.EFFECTS[n]
             if not (e.resolve and _nested(e)):
                 continue
             jobs = [(f"{k}|{n}|null", ds.gait, bases[k]) for k, ds in datasets.items()
@@ -636,7 +627,7 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
     for k, ds in datasets.items():
         fits = {}
         for n in names:
-            e = effects.EFFECTS[n]
+            e = effects_mod.EFFECTS[n]
             if not e.resolve:
                 fits[n] = _comparison_fit(n, bases[k], ds)
             elif e.identify == "nlp":
@@ -690,7 +681,7 @@ def _comparison_fit(name: str, base_sol, ds) -> Fit:
     """Comparison-only effect: bounded scalar search of the gap on the baseline solution."""
     from scipy.optimize import minimize_scalar
 
-    e = effects.EFFECTS[name]
+    e = effects_mod.EFFECTS[name]
     p = e.magnitude
     sim = L.sim_channels(base_sol, ds.gait.source)
 

@@ -11,6 +11,7 @@ import pandas as pd
 
 from .. import marks as mk
 from .locate import PHASES
+from .method import BIC_THRESHOLD
 
 __all__ = ["gap_heatmap", "ranking_bars", "shrink_heatmaps", "confusion_plot", "channel_curves"]
 
@@ -101,8 +102,6 @@ def ranking_bars(ranking: pd.DataFrame, top: str | None = None, threshold: float
     its status after its name; ``mark``: the baseline fit's failure label (every number here
     is relative to it)."""
     import matplotlib.pyplot as plt
-
-    from .diagnose import BIC_THRESHOLD
 
     threshold = BIC_THRESHOLD if threshold is None else threshold
     r = ranking.dropna(subset=["dBIC"]).iloc[::-1]

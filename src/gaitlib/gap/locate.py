@@ -210,7 +210,7 @@ def locate(sim, ds, thetas: dict | None = None, exclude=()) -> Located:
     (:func:`gaitlib.effects.adjust_data`). ``exclude``: model channels not to count
     (default: those a DataSet filled from another data set).
     """
-    from .. import effects
+    from .. import effects as effects_mod
     from .io import DataSet, filled_channels
 
     n = 1
@@ -222,7 +222,7 @@ def locate(sim, ds, thetas: dict | None = None, exclude=()) -> Located:
     if not isinstance(sim, pd.DataFrame):
         sim = sim_channels(sim, gait.source)
     if thetas:
-        gait = effects.adjust_data(gait, thetas)
+        gait = effects_mod.adjust_data(gait, thetas)
     view = gait_ocp.tracking_data(gait)
     tau = np.arange(N_GRID) / N_GRID
     t_data = np.asarray(view.time, float) / float(view.cycle_time)

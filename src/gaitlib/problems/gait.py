@@ -117,8 +117,13 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import socket
+import time
 from dataclasses import asdict, dataclass, field, replace
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -134,6 +139,7 @@ from ..collocation import Mesh
 from ..model import ChildModel
 from ..ocp import Goal, Guess, Named, Parameter, PathConstraint, Periodic, Phase, PhaseGuess, Problem, SolverOptions
 from .. import ocp
+from .. import sweep
 
 #: Version of the gait formulation (this module with the physics, the collocation engine, the
 #: data references, the effect library, bounds, initial guesses and solver options): part of
@@ -1484,3 +1490,91 @@ def _content_digest(obj) -> str:
 
     feed(obj)
     return h.hexdigest()[:16]
+
+
+# -- cached solves -----------------------------------------------------------------------
+
+def cache_dir(spec: GaitSpec, *, guess=None, root=None) -> Path:
+    """Where :func:`solve_cached` stores (or finds) the solution of ``spec`` from ``guess``:
+    keyed by the spec, the warm start's identity, the gait formulation's version and the
+    data and identified sets the spec reads."""
+    desc = {"kind": "gait", **spec.to_dict()}
+    if guess is not None:
+        desc["warm_start"] = guess_signature(guess)
+    return cache.lookup("gait", desc, root, formulation=FORMULATION, identified=spec.identified_sets())
+
+
+def load_cached(where) -> GaitSolution | None:
+    """The gait solution stored at a :func:`gaitlib.cache.lookup` directory (or the same
+    entry in the repository's store), with ``stats["from_cache"] = True``; None if absent.
+    A failed solve reloads as failed (its warning silenced: the status is the result)."""
+    found = cache.find(where, "spec.json")
+    return None if found is None else GaitSolution.from_cache(found)
+
+
+def solve_cached(spec: GaitSpec, *, use_cache: bool = True, root=None, guess=None,
+                 progress: bool = False) -> GaitSolution:
+    """Solve ``spec`` or reload it from the cache (never a stale entry: the key is the
+    spec, the warm start, the formulation's version and the data). Failed solves are stored and reloaded as
+    failed — their status is the result. ``guess``: a :class:`~gaitlib.ocp.Guess` or
+    another :class:`~gaitlib.ocp.Solution` (warm start; part of the cache key via its
+    objective and status only if given, so warm-started runs are cached separately)."""
+    def solve():
+        sol = solve(spec, guess=guess, progress=progress)
+        sol.stats["from_cache"] = False
+        return sol
+
+    return cache.solve_or_load(cache_dir(spec, guess=guess, root=root), solve, GaitSolution.from_cache,
+                               marker="spec.json", use_cache=use_cache)
+
+
+def _solve_spec(arg):
+    """Worker side of :func:`solve_specs`: ``(spec, guess, use_cache, root)`` → GaitSolution."""
+    spec, guess, use_cache, root = arg
+    return solve_cached(spec, use_cache=use_cache, root=root, guess=guess)
+
+
+def solve_specs(specs: Mapping[str, Any], *, guesses: Mapping[str, Any] | None = None, use_cache: bool = True,
+                cache_root=None, **sweep_kw) -> dict[str, sweep.RunRecord]:
+    """Solve (or reload from the cache) named :class:`~gaitlib.problems.gait.GaitSpec` s as one
+    sweep; ``value`` of each record is the :class:`~gaitlib.problems.gait.GaitSolution`.
+
+    Parameters
+    ----------
+    specs : name → GaitSpec.
+    guesses : optional name → warm start (a :class:`~gaitlib.ocp.Guess`, an
+        :class:`~gaitlib.ocp.Solution` or a GaitSolution) for some of the specs.
+    use_cache : reuse stored solutions and store new ones (:func:`solve_cached`).
+    cache_root : the solutions cache; default :func:`gaitlib.cache.default_dir` *of this
+        process*, resolved here and passed to every worker explicitly (workers of an
+        existing cluster may have another ``GAITLIB_SOLUTIONS``).
+    **sweep_kw : ``scheduler``, ``n_workers``, ``serial``, ``progress`` of :func:`gaitlib.sweep.sweep`.
+
+    Returns
+    -------
+    dict name → :class:`~gaitlib.sweep.RunRecord` in the order of ``specs``; ``status`` is IPOPT's return
+    status (``"error"`` if the run raised), ``ok`` True only for ``Solve_Succeeded`` or
+    ``Solved_To_Acceptable_Level``. Cached failures come back as failures.
+    """
+    guesses = dict(guesses or {})
+    unknown = sorted(set(guesses) - set(specs))
+    if unknown:
+        raise ValueError(f"guesses given for unknown runs: {unknown}")
+    for name, spec in specs.items():
+        if not isinstance(spec, GaitSpec):
+            raise TypeError(f"specs[{name!r}] must be a GaitSpec, got {type(spec).__name__}")
+    root = str(Path(cache_root if cache_root is not None else cache.default_dir()).resolve())
+    items = {name: (spec, guesses.get(name), bool(use_cache), root) for name, spec in specs.items()}
+    # runs already in the cache are reloaded here (no cluster is started for them)
+    done = {}
+    if use_cache:
+        host = f"cache:{socket.gethostname()}:{os.getpid()}"
+        for name, (spec, guess, _, _) in items.items():
+            t0 = time.perf_counter()
+            sol = load_cached(cache_dir(spec, guess=guess, root=root))
+            if sol is not None:
+                ok, status = sweep._status_of(sol)
+                done[name] = sweep.RunRecord(name, ok, status, sol, None, time.perf_counter() - t0, host)
+    todo = {k: v for k, v in items.items() if k not in done}
+    ran = {r.name: r for r in sweep.sweep(_solve_spec, todo, **sweep_kw)} if todo else {}
+    return {name: done[name] if name in done else ran[name] for name in items}

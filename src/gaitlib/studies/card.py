@@ -424,14 +424,13 @@ def _ch5(bases: dict) -> list[Row]:
 
 def _ch5_bases() -> dict:
     """The Ch 5 MSK and NMSK solutions (Eq 5.33, Eq 5.55) as :class:`StoredGait`."""
-    from . import gait as sg
     from . import msk
 
     out = {}
-    b = stored_gait(sg.cache_dir(msk.ch5_spec("MSK")))
+    b = stored_gait(gait_ocp.cache_dir(msk.ch5_spec("MSK")))
     if b is not None:
         out["MSK"] = b
-        nb = stored_gait(sg.cache_dir(msk.ch5_spec("NMSK"), guess=b.solution))
+        nb = stored_gait(gait_ocp.cache_dir(msk.ch5_spec("NMSK"), guess=b.solution))
         if nb is not None:
             out["NMSK"] = nb
     return out
@@ -443,7 +442,6 @@ def _ch5_bases() -> dict:
 def _runs(bases: dict, which: str) -> dict:
     """name → StoredGait (or None) of the Ch 6 (``which="ch6"``) or Ch 7 runs, found as
     :func:`gaitlib.studies.predictive.cost_function_study` / ``speed_study`` store them."""
-    from . import gait as sg
     from . import predictive as pr
 
     out = {}
@@ -459,7 +457,7 @@ def _runs(bases: dict, which: str) -> dict:
                 guesses[k] = pr.run_guess(base, pr.GUESS_POLICY[m], cycle_time=g.cycle_time,
                                           stride=g.speed * g.cycle_time)
         for k, s in specs.items():
-            out[k] = stored_gait(sg.cache_dir(s, guess=guesses[k]))
+            out[k] = stored_gait(gait_ocp.cache_dir(s, guess=guesses[k]))
     return out
 
 

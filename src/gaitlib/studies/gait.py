@@ -1,9 +1,7 @@
-"""Natural-gait data tracking (issue 4; thesis Secs 4.3.2, 5.2 and 5.3): SK, MSK and NMSK models.
+"""Natural-gait data tracking (thesis Secs 4.3.2, 5.2 and 5.3): SK, MSK and NMSK models.
 
 Functions
 ---------
-:func:`solve_cached`   solve a :class:`~gaitlib.problems.gait.GaitSpec`, or reload the
-                       solution stored under its key (spec + code + data hash).
 :func:`natural_gait`   the Free-speed data-tracking solve of a model (SK: Eq 4.11 with the
                        contact parameters free, as Sec 4.3.2; MSK: Eq 5.33; NMSK: Eq 5.55).
 :func:`rmse_beside_thesis`  our RMSEs beside the thesis's Table 4.9 / 5.4 / 5.11 (labelled).
@@ -21,13 +19,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .. import cache
 from .. import conventions as cv
 from ..problems import gait as gait_ocp
-from ..problems.gait import tracking_data
+from ..problems.gait import solve_cached, tracking_data
 
-__all__ = ["THESIS_RMSE", "solve_cached", "natural_gait", "natural_gait_spec", "rmse_beside_thesis",
-           "channels_frame", "sims_and_marks", "write_outputs", "stats_table", "tracking_data"]
+__all__ = ["THESIS_RMSE", "natural_gait", "natural_gait_spec", "rmse_beside_thesis",
+           "channels_frame", "sims_and_marks", "write_outputs", "stats_table"]
 
 #: Thesis RMSEs (different data, Bovi 2011): (kind, joint/component, side) → value.
 #: Table 4.9, optimal control row (SK, contact parameters identified), torques N·m, GRF N.
@@ -52,40 +49,6 @@ THESIS_RMSE = {
 }
 THESIS_TABLE = {"SK": "thesis, Table 4.9 (optimal control)", "MSK": "thesis, Table 5.4",
                 "NMSK": "thesis, Table 5.11"}
-
-
-def cache_dir(spec: gait_ocp.GaitSpec, *, guess=None, root=None) -> Path:
-    """Where :func:`solve_cached` stores (or finds) the solution of ``spec`` from ``guess``:
-    keyed by the spec, the warm start's identity, the gait formulation's version and the
-    data and identified sets the spec reads."""
-    desc = {"kind": "gait", **spec.to_dict()}
-    if guess is not None:
-        desc["warm_start"] = gait_ocp.guess_signature(guess)
-    return cache.lookup("gait", desc, root, formulation=gait_ocp.FORMULATION, identified=spec.identified_sets())
-
-
-def load_cached(where) -> gait_ocp.GaitSolution | None:
-    """The gait solution stored at a :func:`gaitlib.cache.lookup` directory (or the same
-    entry in the repository's store), with ``stats["from_cache"] = True``; None if absent.
-    A failed solve reloads as failed (its warning silenced: the status is the result)."""
-    found = cache.find(where, "spec.json")
-    return None if found is None else gait_ocp.GaitSolution.from_cache(found)
-
-
-def solve_cached(spec: gait_ocp.GaitSpec, *, use_cache: bool = True, root=None, guess=None,
-                 progress: bool = False) -> gait_ocp.GaitSolution:
-    """Solve ``spec`` or reload it from the cache (never a stale entry: the key hashes the
-    spec, the library's sources and the data). Failed solves are stored and reloaded as
-    failed — their status is the result. ``guess``: a :class:`~gaitlib.ocp.Guess` or
-    another :class:`~gaitlib.ocp.Solution` (warm start; part of the cache key via its
-    objective and status only if given, so warm-started runs are cached separately)."""
-    def solve():
-        sol = gait_ocp.solve(spec, guess=guess, progress=progress)
-        sol.stats["from_cache"] = False
-        return sol
-
-    return cache.solve_or_load(cache_dir(spec, guess=guess, root=root), solve, gait_ocp.GaitSolution.from_cache,
-                               marker="spec.json", use_cache=use_cache)
 
 
 def natural_gait_spec(model: str = "SK", cost: str | None = None, speed: str = "Free", **kw) -> gait_ocp.GaitSpec:

@@ -32,7 +32,7 @@ import pandas as pd
 
 from ..problems import gait as gait_ocp
 from ..gap import diagnose as D
-from .. import effects
+from .. import effects as effects_mod
 from ..gap import io as gio
 from ..gap import locate as L
 
@@ -55,13 +55,13 @@ def effect_table() -> pd.DataFrame:
     """One row per effect: name, title, parameters (with units and bounds), models, where it
     shows, how it is identified, twin magnitudes."""
     rows = []
-    for n, e in effects.EFFECTS.items():
+    for n, e in effects_mod.EFFECTS.items():
         rows.append({"effect": n, "title": e.title, "k (parameters)": e.n_params,
                      "parameters": ", ".join(f"{p.name} [{p.unit}] in [{p.lower:g}, {p.upper:g}]" for p in e.params),
                      "models": "/".join(e.models), "signature": e.signature,
                      "identified by": {"nlp": "NLP variable", "profile": "profile of the gap"}[e.identify]
                      + ("" if e.resolve else " (comparison only)"),
-                     "twin magnitudes": ", ".join(f"{m:g}" for m in e.twin_magnitudes) if n in effects.TWIN_EFFECTS else "—"})
+                     "twin magnitudes": ", ".join(f"{m:g}" for m in e.twin_magnitudes) if n in effects_mod.TWIN_EFFECTS else "—"})
     return pd.DataFrame(rows)
 
 
@@ -251,7 +251,7 @@ def exact_left_leg(gait, order: int | None = None):
     """
     from .. import data as data_mod
 
-    order = effects._FOURIER_ORDER if order is None else order
+    order = effects_mod._FOURIER_ORDER if order is None else order
     tau = gait.time / float(gait.cycle_time)
     shift = float(gait.left_shift)
     mean, sd, replaced = gait.mean.copy(), gait.sd.copy(), []
@@ -302,7 +302,7 @@ def left_leg_check(diag: D.Diagnosis) -> dict:
         if f.located is None or f.solution is None:
             continue
         # data-model effects (left_shift) read the data differently: adjust, then shift exactly
-        gait_f = effects.adjust_data(ds.gait, f.thetas) if f.thetas else ds.gait
+        gait_f = effects_mod.adjust_data(ds.gait, f.thetas) if f.thetas else ds.gait
         lx = L.locate(f.solution, replace(ds, gait=exact_left_leg(gait_f)[0]))
         rows.append({"effect": n, "status": f.status,
                      "RSS (data as tracked)": f.located.rss,
@@ -372,7 +372,7 @@ def twin_validation_full_mesh(seeds=TWIN_SEEDS, serial: bool = True):
     from ..gap import twin
 
     effects = tuple(twin.TWIN_EFFECTS_DEFAULT())
-    mags = {e: (effects.EFFECTS[e].twin_magnitudes[1],) for e in effects}
+    mags = {e: (effects_mod.EFFECTS[e].twin_magnitudes[1],) for e in effects}
     tv = twin.validate_twins(effects, magnitudes=mags, seeds=tuple(seeds), base=dict(SK_BASE), serial=serial,
                              progress=False)
     inj = tv.rows["injected"] != "none"

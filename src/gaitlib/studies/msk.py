@@ -7,7 +7,7 @@ Functions
                             (Table 5.9, τ_act, c3, s1, s2 identified, EMG guess), with our
                             identified MTG set (``mtg_params="ch5"``) and the Ch 4 body and
                             contact sets when they exist (:func:`parameter_sets`).
-:func:`solve`               solve or reload one of them (:func:`gaitlib.studies.gait.solve_cached`).
+:func:`solve`               solve or reload one of them (:func:`gaitlib.problems.gait.solve_cached`).
 :func:`emg_table`           the muscle ↔ EMG-channel mapping (thesis Table 5.5 muscles;
                             Schwartz 2008 and gaitutils channels).
 :func:`emg_reference`       the EMG of both sources on the 16 excitations' names.
@@ -110,10 +110,10 @@ def solve(model: str = "MSK", *, guess: str = "msk", root=None, progress: bool =
     spec = ch5_spec(model, **kw)
     if model == "NMSK" and guess == "msk":
         base = solve("MSK", root=root, progress=progress, **{k: v for k, v in kw.items() if k not in _NMSK_ONLY})
-        return sg.solve_cached(spec, guess=base, root=root, progress=progress)
+        return gait_ocp.solve_cached(spec, guess=base, root=root, progress=progress)
     if guess not in ("msk", "data"):
         raise ValueError(f"guess must be 'msk' or 'data', got {guess!r}")
-    return sg.solve_cached(spec, root=root, progress=progress)
+    return gait_ocp.solve_cached(spec, root=root, progress=progress)
 
 
 # --------------------------------------------------------------------------------------

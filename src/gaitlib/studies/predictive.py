@@ -25,7 +25,7 @@ Our speed classes are Schwartz et al. (2008)'s (Very Slow … Very Fast); the th
 XS/S/M/L classes of its own reference [18] at 0.9/1.09/1.29/1.58 m/s. Thesis numbers appear
 only in columns labelled with their table or figure.
 
-All runs go through :func:`gaitlib.sweep.solve_specs` (dask.distributed; ``serial=True``
+All runs go through :func:`gaitlib.problems.gait.solve_specs` (dask.distributed; ``serial=True``
 in-process) and the solution cache, so a rerun only reloads.
 """
 
@@ -281,7 +281,7 @@ class StudyResult:
         ``max_iter=3000`` to see where a run that hit the iteration limit ends); cached like
         every solve. A separate, labelled result — the study's record keeps its own status."""
         spec = replace(self.specs[name], **changes)
-        return sg.solve_cached(spec, guess=self.guesses.get(name), root=root, progress=progress)
+        return gait_ocp.solve_cached(spec, guess=self.guesses.get(name), root=root, progress=progress)
 
     def rerun_failed(self, max_iter: int = 3000, **kw) -> dict:
         """:meth:`rerun` every run whose record is not ok with ``max_iter`` iterations:
@@ -333,9 +333,8 @@ class StudyResult:
 
 
 def _run(specs: dict, guesses: dict, *, root, scheduler, n_workers, serial, progress) -> tuple[dict, dict]:
-    from .. import sweep
 
-    recs = sweep.solve_specs(specs, guesses=guesses, cache_root=root, scheduler=scheduler, n_workers=n_workers,
+    recs = gait_ocp.solve_specs(specs, guesses=guesses, cache_root=root, scheduler=scheduler, n_workers=n_workers,
                              serial=serial, progress=progress)
     sols = {k: r.value for k, r in recs.items() if r.value is not None}
     return recs, sols

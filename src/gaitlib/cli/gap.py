@@ -23,7 +23,7 @@ def _spec(base: dict):
 def effect_names(text: str | None) -> list | None:
     """``--effects`` as a list of known effect names (None: all); ``CLIError`` naming the
     known ones otherwise."""
-    from ..cli import CLIError
+    from .common import CLIError
     from ..effects import EFFECTS
 
     if text is None:
@@ -43,9 +43,9 @@ def cmd_gap(args) -> int:
     """``gaitlib gap --data CSV --out DIR``: diagnose the gap; writes diagnosis.json + figures.
     Data that fail the reader's checks (:func:`gaitlib.gap.io.read_data`,
     :mod:`gaitlib.plausibility`): one line on stderr, exit 2, nothing built or written."""
-    from .. import cli
-    from . import diagnose as D
-    from . import io as gio
+    from . import common as cli
+    from ..gap import diagnose as D
+    from ..gap import io as gio
 
     effects = effect_names(args.effects)
     # the data gates (gaitlib.plausibility) run here, before any problem is built
@@ -83,7 +83,7 @@ def twin_effects(args) -> tuple:
     """``--effect/--magnitude`` (and ``--effect2/--magnitude2``) as ((name, magnitude), …),
     checked against the effect registry and its bounds (:func:`gaitlib.effects.validate`)
     before any solve; ``CLIError`` otherwise."""
-    from ..cli import CLIError
+    from .common import CLIError
     from ..effects import EFFECTS, validate
 
     pairs = []
@@ -108,8 +108,8 @@ def twin_effects(args) -> tuple:
 
 def cmd_gap_twin(args) -> int:
     """``gaitlib gap-twin --effect NAME --magnitude X --seed N --out CSV``."""
-    from .. import cli
-    from .twin import write_twin
+    from . import common as cli
+    from ..gap.twin import write_twin
 
     effects = twin_effects(args)
     base = _base(args, args.speed)
@@ -127,7 +127,7 @@ def cmd_gap_twin(args) -> int:
 
 
 def _common(p, mesh=(10, 3)):
-    from ..cli import _add_output_options, _int_options
+    from .common import _add_output_options, _int_options
 
     p.add_argument("--model", default="SK", choices=["SK", "MSK", "NMSK"], help="baseline model (default SK)")
     p.add_argument("--cost", default="DT", help="baseline cost function (default DT)")
@@ -136,7 +136,7 @@ def _common(p, mesh=(10, 3)):
 
 
 def add_parsers(sub) -> None:
-    from ..cli import finite_float, int_at_least
+    from .common import finite_float, int_at_least
     from ..effects import EFFECTS
 
     g = sub.add_parser("gap", help="sim-to-real gap diagnosis of a tidy data CSV (diagnosis.json + figures)")

@@ -46,165 +46,11 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
-import shutil
 import sys
-import tempfile
 from pathlib import Path
 
-from . import blas
-
-#: Exit status of errors, refusals and results that rest on a solve that did not converge.
-EXIT_FAILED = 2
-
-
-class CLIError(Exception):
-    """A user-facing error: printed as one line ``gaitlib <command>: <message>``, exit 2."""
-
-
-# -- option types (checked at parse time, before anything is read or solved) ----------
-
-def int_at_least(lo: int):
-    """argparse type: an integer ≥ ``lo``."""
-
-    def parse(text: str) -> int:
-        try:
-            v = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected an integer >= {lo}, got {text!r}") from None
-        if v < lo:
-            raise argparse.ArgumentTypeError(f"expected an integer >= {lo}, got {v}")
-        return v
-
-    parse.__name__ = f"integer >= {lo}"
-    return parse
-
-
-def finite_float(text: str) -> float:
-    """argparse type: a finite number."""
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not math.isfinite(v):
-        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
-    return v
-
-
-class _Parser(argparse.ArgumentParser):
-    """An ArgumentParser whose errors are one line (``gaitlib <command>: <message>``)."""
-
-    def error(self, message):  # noqa: D102 — argparse's hook
-        self.exit(EXIT_FAILED, f"{self.prog}: {message} (see {self.prog} --help)\n")
-
-
-# -- outputs ------------------------------------------------------------------------
-
-def check_cache(root, use_cache: bool) -> str | None:
-    """The solutions cache folder (``root`` or :func:`gaitlib.cache.default_dir`), created
-    and checked for writability when it will be written (``use_cache``); ``CLIError`` if
-    it cannot be. Returns ``root`` as given (None: the default)."""
-    if not use_cache:
-        return root
-    from . import cache
-
-    folder = Path(root) if root is not None else cache.default_dir()
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-        fd, probe = tempfile.mkstemp(prefix=".write-test-", dir=folder)
-        os.close(fd)
-        os.unlink(probe)
-    except OSError as e:
-        raise CLIError(f"the solutions cache {folder} is not writable ({e.strerror or e}); "
-                       "pass --cache DIR or --no-cache") from None
-    return root
-
-
-def _umask() -> int:
-    m = os.umask(0)
-    os.umask(m)
-    return m
-
-
-class Output:
-    """A command's outputs, written to a fresh folder next to their destination and moved
-    into place when the command succeeds (``with Output(...) as o: ... write into o.tmp``).
-
-    Created (before any solve) it checks the destination: ``folder`` is refused if it exists
-    and is not empty (``files=None``: the command writes the whole folder) or if any of
-    ``files`` exists in it, unless ``overwrite``; the temporary folder is made next to it
-    (which proves it writable). On success the entries of ``folder`` the command owns —
-    those it writes now and ``owned`` (e.g. the files a previous run listed) — are removed
-    and the new ones moved in, the names in ``last`` (the files that say "done", e.g.
-    ``summary.json``) last; an absent or empty ``folder`` is replaced in one rename. On an
-    exception nothing is moved and the temporary folder is removed."""
-
-    def __init__(self, folder, *, overwrite: bool = False, owned=(), files=None, last=(), option: str = "--out",
-                 what: str = "the files this command writes"):
-        self.folder = Path(folder)
-        self.owned, self.files, self.last = set(owned), None if files is None else tuple(files), tuple(last)
-        f = self.folder
-        if f.exists() and not f.is_dir():
-            raise CLIError(f"{option} {f}: exists and is not a folder")
-        if f.is_dir():
-            clash = [n for n in self.files if (f / n).exists()] if self.files is not None else \
-                sorted(p.name for p in f.iterdir())
-            if clash and not overwrite:
-                target = f / clash[0] if self.files is not None else f
-                raise CLIError(f"{option} {target} exists{'' if self.files is not None else ' and is not empty'}: "
-                               f"pass --overwrite to replace {what}, or choose another path")
-            if not os.access(f, os.W_OK | os.X_OK):
-                raise CLIError(f"{option} {f}: the folder is not writable")
-        parent = f.absolute().parent
-        try:
-            parent.mkdir(parents=True, exist_ok=True)
-            self.tmp = Path(tempfile.mkdtemp(prefix=f".{f.name}.partial-", dir=parent))
-        except OSError as e:
-            if not f.is_dir():
-                raise CLIError(f"{option} {f}: cannot write in {parent} ({e.strerror or e})") from None
-            try:  # a writable folder in a read-only one: stage inside it
-                self.tmp = Path(tempfile.mkdtemp(prefix=".partial-", dir=f))
-            except OSError as e2:
-                raise CLIError(f"{option} {f}: cannot write in it ({e2.strerror or e2})") from None
-        os.chmod(self.tmp, 0o777 & ~_umask())
-
-    def __enter__(self) -> "Output":
-        return self
-
-    def __exit__(self, exc_type, exc, tb):
-        try:
-            if exc_type is None:
-                self._commit()
-        finally:
-            shutil.rmtree(self.tmp, ignore_errors=True)
-        return False
-
-    def _commit(self):
-        f = self.folder
-        new = sorted(p.name for p in self.tmp.iterdir())
-        inside = self.tmp.parent == f
-        if not inside and (not f.exists() or (self.files is None and not any(f.iterdir()))):
-            os.replace(self.tmp, f)
-            return
-        f.mkdir(exist_ok=True)
-        for name in sorted(set(new) | self.owned):
-            old = f / name
-            if old.is_dir() and not old.is_symlink():
-                shutil.rmtree(old)
-            elif old.exists() or old.is_symlink():
-                old.unlink()
-        for name in sorted(new, key=lambda n: (n in self.last, self.last.index(n) if n in self.last else 0)):
-            os.replace(self.tmp / name, f / name)
-
-
-def _add_output_options(p, cache: bool = True):
-    p.add_argument("--overwrite", action="store_true",
-                   help="replace the files this command owns in an existing --out (others are kept)")
-    if cache:
-        p.add_argument("--cache", default=None, help="solutions cache (default: $GAITLIB_SOLUTIONS or "
-                                                     "~/.cache/gaitlib/solutions)")
-        p.add_argument("--no-cache", action="store_true", help="solve even if cached solutions exist")
-
+from .. import blas
+from .common import EXIT_FAILED, CLIError, Output, _add_output_options, _int_options, _Parser, check_cache, int_at_least
 
 def _listed_files(summary: Path) -> set:
     """The ``files`` a previous run's ``summary.json`` lists (none if unreadable)."""
@@ -218,7 +64,7 @@ def _listed_files(summary: Path) -> set:
 # -- commands -----------------------------------------------------------------------
 
 def _cmd_data(args) -> int:
-    from . import data
+    from .. import data
 
     paths = data.build(args.out, cache_dir=args.cache)
     for name, p in paths.items():
@@ -229,8 +75,9 @@ def _cmd_data(args) -> int:
 def _cmd_run(args) -> int:
     import warnings
 
-    from .ocp import SolveFailedWarning
-    from .studies import gait
+    from ..ocp import SolveFailedWarning
+    from ..problems import gait as gait_ocp
+    from ..studies import gait
 
     kw = dict(n_intervals=args.intervals, degree=args.degree, scheme=args.scheme, max_iter=args.max_iter)
     if args.free_contact is not None:
@@ -244,7 +91,7 @@ def _cmd_run(args) -> int:
               f"{spec.scheme}, key {spec.key()}", flush=True)
         with warnings.catch_warnings():  # a failed solve is reported below, with its status
             warnings.simplefilter("ignore", SolveFailedWarning)
-            sol = gait.solve_cached(spec, use_cache=not args.no_cache, root=root, progress=not args.quiet)
+            sol = gait_ocp.solve_cached(spec, use_cache=not args.no_cache, root=root, progress=not args.quiet)
         if sol.stats.get("from_cache") and not sol.success:
             print(f"note: a cached failed solve ({sol.stats['status']}), loaded from "
                   f"{sol.stats.get('cache_path')}; --no-cache solves it again", file=sys.stderr)
@@ -268,9 +115,8 @@ def _cmd_sweep(args) -> int:
     """``gaitlib sweep``: cost functions × speed classes of one model as one sweep."""
     import pandas as pd
 
-    from . import sweep as sw
-    from .problems import gait as gait_ocp
-    from .studies import gait
+    from ..problems import gait as gait_ocp
+    from ..studies import gait
 
     costs, speeds = _split(args.costs), _split(args.speeds)
     if not costs or not speeds:
@@ -287,7 +133,7 @@ def _cmd_sweep(args) -> int:
         pass
     with Output(out, overwrite=args.overwrite, owned=old | {"sweep.csv"}, last=("sweep.csv",),
                 what="sweep.csv and the run folders it lists") as o:
-        recs = sw.solve_specs(specs, use_cache=not args.no_cache, cache_root=root, scheduler=args.scheduler,
+        recs = gait_ocp.solve_specs(specs, use_cache=not args.no_cache, cache_root=root, scheduler=args.scheduler,
                               n_workers=args.workers, serial=args.serial, progress=True)
         rows = []
         for name, r in recs.items():
@@ -312,19 +158,11 @@ def _cmd_sweep(args) -> int:
     return 0
 
 
-def _int_options(p, mesh, max_iter: int = 1000):
-    p.add_argument("--intervals", type=int_at_least(1), default=mesh[0],
-                   help=f"mesh intervals (default {mesh[0]}; thesis: 20)")
-    p.add_argument("--degree", type=int_at_least(1), default=mesh[1],
-                   help=f"collocation points per interval (default {mesh[1]}; thesis: 5)")
-    p.add_argument("--max-iter", type=int_at_least(1), default=max_iter, help="IPOPT iteration limit")
-
-
 def _cmd_cache(args) -> int:
     """``gaitlib cache verify``: every entry of a cache checked against its manifest."""
     import shutil
 
-    from . import cache
+    from .. import cache
 
     rows = cache.scan(args.root)
     bad = [(p, fault) for p, fault in rows if fault]
@@ -347,7 +185,7 @@ def _add_cache_parser(sub) -> None:
 
 def _cmd_card(args) -> int:
     """``gaitlib card``: the replication report card from the stored solutions."""
-    from .studies import card
+    from ..studies import card
 
     f = card.write(args.out)
     import pandas as pd
@@ -388,7 +226,7 @@ def _add_debug(p, top: bool = False):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from . import __version__
+    from .. import __version__
 
     p = _Parser(prog="gaitlib", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action="version", version=f"gaitlib {__version__}")
@@ -419,7 +257,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_sweep_parser(sub)
     _add_cache_parser(sub)
     _add_card_parser(sub)
-    from .gap.cli import add_parsers as _add_gap_parsers  # gaitlib gap, gaitlib gap-twin
+    from .gap import add_parsers as _add_gap_parsers  # gaitlib gap, gaitlib gap-twin
 
     _add_gap_parsers(sub)
     for sp in sub.choices.values():
@@ -429,8 +267,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _expected() -> tuple:
     """Exception types whose message is the whole story (no "--debug" hint)."""
-    from .gap.diagnose import BaselineFailed
-    from .ocp import SolveFailedError
+    from ..gap.diagnose import BaselineFailed
+    from ..ocp import SolveFailedError
 
     return (CLIError, ValueError, OSError, BaselineFailed, SolveFailedError)
 
