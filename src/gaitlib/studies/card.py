@@ -199,14 +199,9 @@ def stored_gait(where) -> StoredGait | None:
 
 def gate(sol, name: str = "") -> str:
     """The validity text of a solution: ``"valid"``, or :meth:`gaitlib.validity.Gates.label`
-    (``"not converged (…)"``, ``"invalid: …"``). Without :mod:`gaitlib.validity`: the
-    convergence only (``"not gated (converged)"`` or ``"not converged (status)"``)."""
-    try:
-        from .. import validity
-    except ImportError:
-        ok = bool(getattr(sol, "success", False))
-        status = getattr(sol, "status", None) or getattr(sol, "stats", {}).get("status")
-        return "not gated (converged)" if ok else f"not converged ({status})"
+    (``"not converged (…)"``, ``"invalid: …"``)."""
+    from .. import validity
+
     return validity.label(sol, name=name)
 
 
