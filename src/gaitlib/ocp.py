@@ -26,9 +26,9 @@ default ``SolverOptions(graph="sx")`` the NLP is one SX graph (mapped calls are 
 which is what was measured fastest here (performance-notes.md). With ``graph="mx"`` the NLP
 is an MX graph with a single mapped call per phase, expanded to SX by ``nlpsol``
 (``expand=True``, the default: same speed as SX). ``graph="mx", expand=False`` keeps the
-mapped MX graph: building is ~25× faster but each iteration's function evaluations ~3–4×
-slower (11-link chain, 5,533 variables: build 0.5 s vs 13 s; 172 vs 48 ms per iteration) —
-for quick low-resolution runs and tests, not for production solves.
+mapped MX graph: building is much faster but each iteration's function evaluations are
+slower (environment.md, "Measured choices") — for quick low-resolution runs and tests, not for
+production solves.
 
 Callables receive :class:`Named` views: ``x["knee_r"]``, ``x[["hip_r", "knee_r"]]``,
 ``x.vec`` (the whole column); an unknown name raises ``KeyError``. Callables of the node
@@ -400,8 +400,8 @@ class SolverOptions:
     graph : {"sx", "mx"}
         Build the NLP as one SX graph, or as MX with mapped per-node calls.
     expand : bool
-        With ``graph="mx"``: expand to SX inside nlpsol (recommended; unexpanded MX was
-        ~10 s per iteration on the gait problem).
+        With ``graph="mx"``: expand to SX inside nlpsol (recommended: unexpanded MX
+        evaluates far slower per iteration on the gait problem).
     ipopt : mapping
         Further IPOPT options, applied last (e.g. ``{"nlp_scaling_method": "none"}``).
 

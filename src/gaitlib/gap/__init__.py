@@ -1,4 +1,4 @@
-"""Where the model misses reality: the sim-to-real gap diagnosis (issue 7).
+"""Where the model misses reality: the sim-to-real gap diagnosis.
 
 ``gaitlib.gap.EFFECTS``            the registry of candidate unmodelled effects (:mod:`gaitlib.effects`)
 ``gaitlib.gap.locate(sol, data)``  SD-standardised residual by channel and gait phase (:mod:`.locate`)

@@ -5,5 +5,5 @@ A study turns frozen specs into solutions (via :mod:`gaitlib.problems.gait` /
 command line (``gaitlib run STUDY``) call the same functions; no OCP is set up here that a
 lower layer already defines.
 
-Modules: :mod:`.gait` (natural-gait SK/MSK data tracking, issue 4), :mod:`.jump` (Ch 3).
+Modules: :mod:`.gait` (natural-gait SK/MSK data tracking), :mod:`.jump` (Ch 3).
 """

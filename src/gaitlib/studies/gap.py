@@ -1,4 +1,4 @@
-"""Chapter "Where the model misses reality" (issue 7): the studies behind the gap diagnosis.
+"""Chapter "Where the model misses reality": the studies behind the gap diagnosis.
 
 Functions
 ---------

@@ -103,9 +103,8 @@ def solve(model: str = "MSK", *, guess: str = "msk", root=None, progress: bool =
     excitations through the inverted activation dynamics for GM, VM, SOL and PL, and the
     delayed Schwartz EMG for RF, BF, GAM and TA (:func:`gaitlib.problems.gait.warm_start`);
     ``guess="data"`` — the thesis's guess (Sec 5.3.4: states from the data, excitations from
-    the EMG where we have it). Measured here (2026-11-22, 2 shared cores under load, body
-    "thesis", contact "default", MTG "ch5"): from ``"data"`` IPOPT needed 2,093 iterations
-    (767 s) and stopped at objective 0.694; from ``"msk"`` 240 iterations, objective 0.296.
+    the EMG where we have it). From ``"data"`` IPOPT needs about nine times the iterations
+    and stops at a higher objective (measurements: environment.md, "Measured choices").
     """
     spec = ch5_spec(model, **kw)
     if model == "NMSK" and guess == "msk":

@@ -102,9 +102,9 @@ def default_params() -> dict:
 #: How the runs of each model are started (see :func:`run_guess`): ``"thesis"`` — the
 #: thesis's partial guess of Sec 6.1 (:func:`thesis_guess`); ``"ch5"`` — the whole Ch 5
 #: solution (every state and control, time-scaled for Ch 7). MSK runs use the thesis's guess.
-#: NMSK runs use ``"ch5"``: from the thesis's partial guess, 7 of the 12 NMSK runs at the
-#: full mesh stopped at IPOPT's 1000-iteration limit (Ch 6: DT, SDT3, SP2; Ch 7: all four
-#: classes; measured 2026-11-22) — the chapters show those statuses beside the runs they report.
+#: NMSK runs use ``"ch5"``: from the thesis's partial guess, most NMSK runs at the full mesh
+#: stopped at IPOPT's 1000-iteration limit (environment.md, "Measured choices") — the
+#: chapters show those statuses beside the runs they report.
 GUESS_POLICY = {"MSK": "thesis", "NMSK": "ch5"}
 GUESSES = ("thesis", "ch5")
 
