@@ -50,7 +50,7 @@ def test_null_start_reproduces_the_baseline_point(real):
     T0 = ocp.transcribe(r0.problem, r0.gp.mesh, ocp.SolverOptions(max_iter=0))
     base = gait_ocp.postprocess(r0.gp, T0.solve(r0.data_guess(real.gait), data={"cycle": r0.frame(real.gait)}))
     for name in ("friction", "arm_swing", "hat_com"):
-        r1 = N._NullRunner(D._with_effects(spec, ((name, None),)))
+        r1 = N._NullRunner(D.with_effects(spec, ((name, None),)))
         T1 = ocp.transcribe(r1.problem, r1.gp.mesh, ocp.SolverOptions(max_iter=0))
         w1 = T1.initial_point(N.null_guess(base))
         p = [f"fx.{name}.{q.name}" for q in effects_mod.EFFECTS[name].params]
@@ -96,7 +96,7 @@ def test_nested_candidate_above_the_baseline_is_resolved_or_reported(tmp_path, r
     assert r["rank"] == 1 and r["start"] == "null" and bool(r["nests_baseline"])
     assert r["pct_closed"] >= -100 * D.RETRY_MARGIN
     # the null start forced to fail as well: a failed search
-    bad_sol = D.solve_many({"x": (D._with_effects(spec, ((name, None),)), [("x", real.gait, base)])},
+    bad_sol = D.solve_many({"x": (D.with_effects(spec, ((name, None),)), [("x", real.gait, base)])},
                            root=root, serial=True, progress=False)["x"]
     assert D.needs_retry(name, bad_sol, base)
     monkeypatch.setattr(D, "null_start_many",

@@ -436,10 +436,10 @@ FOOT_CONTACT = Effect(
 _LEFT_REFS = {"ref_hip_l": "hip", "ref_knee_l": "knee", "ref_ankle_l": "ankle",
               "ref_tau_hip_l": "tau_hip", "ref_tau_knee_l": "tau_knee", "ref_tau_ankle_l": "tau_ankle",
               "ref_grf_x_l": "grf_x", "ref_grf_y_l": "grf_y"}
-_FOURIER_ORDER = 5  # thesis Eqs 4.1–4.3 / gaitlib.data.fourier_shift
+FOURIER_ORDER = 5  # thesis Eqs 4.1–4.3 / gaitlib.data.fourier_shift
 
 
-def _fourier_coefficients(x: np.ndarray, order: int = _FOURIER_ORDER):
+def _fourier_coefficients(x: np.ndarray, order: int = FOURIER_ORDER):
     """(c0, a_k, b_k) of the least-squares fit of gaitlib.data.fourier_shift (samples on
     t_j = j/(n−1), both ends included)."""
     x = np.asarray(x, float)
@@ -459,7 +459,7 @@ def _left_shift_columns(ref, tau_grid):
     out = {}
     for col, stem in _LEFT_REFS.items():
         _, a, b = _fourier_coefficients(gait.mean[f"{stem}_r"].to_numpy())
-        for k in range(1, _FOURIER_ORDER + 1):
+        for k in range(1, FOURIER_ORDER + 1):
             ph = 2 * np.pi * k * (np.asarray(tau_grid, float) + shift)
             out[f"fx.left_shift.C{k}.{col}"] = a[k - 1] * np.cos(ph) + b[k - 1] * np.sin(ph)
             out[f"fx.left_shift.S{k}.{col}"] = -a[k - 1] * np.sin(ph) + b[k - 1] * np.cos(ph)
@@ -471,7 +471,7 @@ def _left_shift_reference(d, th, ctx, t):
     out = {}
     for col in _LEFT_REFS:
         v = d[col]
-        for k in range(1, _FOURIER_ORDER + 1):
+        for k in range(1, FOURIER_ORDER + 1):
             v = v + (ca.cos(2 * np.pi * k * delta) - 1) * d[f"fx.left_shift.C{k}.{col}"] \
                 + ca.sin(2 * np.pi * k * delta) * d[f"fx.left_shift.S{k}.{col}"]
         out[col] = v
@@ -499,14 +499,14 @@ def regenerate_left(gait, shift: float, emg: bool | None = None):
         if c.startswith("emg_"):
             gen = emg
             if gen is None:
-                test = data_mod.fourier_shift(gait.mean[cr].to_numpy(), gait.left_shift, _FOURIER_ORDER)
+                test = data_mod.fourier_shift(gait.mean[cr].to_numpy(), gait.left_shift, FOURIER_ORDER)
                 gen = bool(np.allclose(test, gait.mean[c].to_numpy(), atol=1e-9))
             if not gen:
                 continue
         if c.startswith("mtp_"):
             continue
-        mean[c] = data_mod.fourier_shift(gait.mean[cr].to_numpy(), shift, _FOURIER_ORDER)
-        sd[c] = np.abs(data_mod.fourier_shift(gait.sd[cr].to_numpy(), shift, _FOURIER_ORDER))
+        mean[c] = data_mod.fourier_shift(gait.mean[cr].to_numpy(), shift, FOURIER_ORDER)
+        sd[c] = np.abs(data_mod.fourier_shift(gait.sd[cr].to_numpy(), shift, FOURIER_ORDER))
     assert len(mean) == n
     return dataclasses.replace(gait, mean=mean, sd=sd, left_shift=float(shift),
                                notes=tuple(gait.notes) + (f"left leg regenerated at shift {shift:.4f}",))
@@ -518,7 +518,7 @@ def left_generated(gait) -> bool:
     from . import data as data_mod
 
     for stem in ("hip", "knee", "ankle"):
-        test = data_mod.fourier_shift(gait.mean[f"{stem}_r"].to_numpy(), gait.left_shift, _FOURIER_ORDER)
+        test = data_mod.fourier_shift(gait.mean[f"{stem}_r"].to_numpy(), gait.left_shift, FOURIER_ORDER)
         if not np.allclose(test, gait.mean[f"{stem}_l"].to_numpy(), atol=1e-9):
             return False
     return True

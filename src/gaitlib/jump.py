@@ -313,6 +313,12 @@ class JumpModel:
                 pts["toe_tip"] = PlanarTree.point(st[0], (JUMP_SEGMENTS["toe"][1], 0.0))
             return ca.Function(name, [q], [ca.vertcat(*v) for v in pts.values()], ["q"],
                                list(pts))
+        if name == "ellipsoids":
+            q, pc = S["q"], S["p_contact"]
+            frames, _, _ = self._loads(self.tree.kinematics(ca.vertsplit(q)), ca.vertsplit(pc))
+            C = ca.horzcat(*[ca.vertcat(*f["centre"]) for f in frames]).T
+            return ca.Function(name, [q, pc], [C] + [f["R"] for f in frames],
+                               ["q", "p_contact"], ["centres"] + [f"R_{e}" for e in cv.ELLIPSOIDS])
         raise KeyError(name)
 
     def function(self, name: str) -> ca.Function:
@@ -328,6 +334,8 @@ class JumpModel:
           and gravity leave unbalanced: zero if consistent), fn (3,), grf_x, grf_y
         * ``com``: (q, qd) -> com (2,), com_vel (2,); ``energies``: (q, qd) -> kinetic,
           potential_gravity; ``points``: (q) -> mtp, ankle, knee, hip, head, [toe_tip]
+        * ``ellipsoids``: (q, p_contact) -> centres (3, 3: toe, ball, heel × x, y, z, m) and
+          each ellipsoid's rotation matrix (toe model; for drawing)
         """
         cache = self.__dict__.setdefault("_functions", {})
         if name not in cache:

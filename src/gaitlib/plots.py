@@ -302,22 +302,6 @@ def _jump_full_q(jump_model, q) -> np.ndarray:
     return q
 
 
-def _jump_ellipsoid_function(jump_model):
-    """Cached CasADi function q, p_contact -> ellipsoid centres (3, 3) and rotations."""
-    import casadi as ca
-
-    cache = jump_model.__dict__.setdefault("_plot_functions", {})
-    if "ellipsoids" not in cache:
-        q = ca.SX.sym("q", jump_model.n)
-        pc = ca.SX.sym("p_contact", 39)
-        st = jump_model.tree.kinematics(ca.vertsplit(q))
-        frames, _, _ = jump_model._loads(st, ca.vertsplit(pc))
-        C = ca.horzcat(*[ca.vertcat(*f["centre"]) for f in frames]).T
-        cache["ellipsoids"] = ca.Function("jump_ellipsoids", [q, pc],
-                                          [C] + [f["R"] for f in frames])
-    return cache["ellipsoids"]
-
-
 def jump_frame(jump_model, q, p_contact=None, ellipsoids=None) -> dict:
     """Numbers :func:`draw_jump` draws: ``chains`` (one polyline toe tip → MTP → ankle →
     knee → hip → head) and ``ellipses`` (toe, ball, heel outlines; toe-included model)."""
@@ -333,7 +317,7 @@ def jump_frame(jump_model, q, p_contact=None, ellipsoids=None) -> dict:
         from .kinematics import ellipsoid_radii
 
         pc = contact.default_params() if p_contact is None else np.asarray(p_contact, float)
-        res = _jump_ellipsoid_function(jump_model)(q, pc)
+        res = jump_model.function("ellipsoids")(q, pc)
         C = np.asarray(res[0])
         for k, e in enumerate(cv.ELLIPSOIDS):
             out["ellipses"][e] = ellipse_outline(C[k], np.asarray(res[1 + k]),

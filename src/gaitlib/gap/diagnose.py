@@ -76,7 +76,8 @@ from .solve import solve_many
 __all__ = ["BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "Fit", "Diagnosis", "diagnose", "assemble",
            "candidates", "base_spec", "as_dataset", "baseline_fits", "pick_best", "BASELINE_STARTS",
            "COARSE_MESH", "GRF_SD_FACTOR", "RETRY_MARGIN", "grf_weighted", "candidate_fits", "needs_retry",
-           "alternates_of", "lowest_objective", "BaselineFailed", "nesting", "ABOVE_LOCATED", "FIT_STARTS"]
+           "alternates_of", "lowest_objective", "BaselineFailed", "nesting", "ABOVE_LOCATED", "FIT_STARTS",
+           "with_effects"]
 
 
 def base_spec(base=None) -> gait_ocp.GaitSpec:
@@ -577,11 +578,11 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
         if not e.resolve:
             continue
         if e.identify == "nlp":
-            spec = _with_effects(spec0, ((n, None),))
+            spec = with_effects(spec0, ((n, None),))
             groups[n] = (spec, [(f"{k}|{n}", ds.gait, bases[k]) for k, ds in datasets.items() if bases[k] is not None])
         else:
             for m in PROFILE_GRID[n]:
-                spec = _with_effects(spec0, ((n, m),))
+                spec = with_effects(spec0, ((n, m),))
                 groups[f"{n}@{m}"] = (spec, [(f"{k}|{n}@{m}", ds.gait, bases[k]) for k, ds in datasets.items()
                                              if bases[k] is not None])
     kw = dict(root=root, use_cache=use_cache, objective=objective, **sweep_kw)
@@ -594,7 +595,7 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
             e = effects_mod.EFFECTS[n]
             if not (e.resolve and e.identify == "nlp"):
                 continue
-            spec = _with_effects(spec0, ((n, None),))
+            spec = with_effects(spec0, ((n, None),))
             jobs = [(f"{k}|{n}|{st}", ds.gait, alt) for k, ds in datasets.items()
                     if bases[k] is not None and needs_retry(n, res.get(f"{k}|{n}"), bases[k])
                     for st, alt in (alternates.get(k) or {}).items() if alt is not None and alt is not bases[k]]
@@ -620,7 +621,7 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
             jobs = [(f"{k}|{n}|null", ds.gait, bases[k]) for k, ds in datasets.items()
                     if bases[k] is not None and needs_retry(n, pick_best(list(tried(k, n).values())), bases[k])]
             if jobs:
-                null[f"{n}|null"] = (_with_effects(spec0, ((n, None),)), jobs)
+                null[f"{n}|null"] = (with_effects(spec0, ((n, None),)), jobs)
     if null:
         res.update({k: v for k, v in null_start_many(null, **kw).items() if k != "__records__"})
     out = {}
@@ -671,7 +672,7 @@ def alternates_of(detail: dict) -> dict:
             for k, per in detail.items()}
 
 
-def _with_effects(spec0, effects) -> gait_ocp.GaitSpec:
+def with_effects(spec0, effects) -> gait_ocp.GaitSpec:
     import dataclasses
 
     return dataclasses.replace(spec0, effects=tuple(effects))

@@ -97,9 +97,7 @@ def sd_columns(gait, tau_grid) -> dict:
 def fit_problem(gp) -> ocp.Problem:
     """``gp``'s problem with the Fit objective (module docstring)."""
     ph = gp.problem.phases[0]
-    w = gp.spec.term_weights
-    node, fx = gp.functions["node"], gp.functions["effects"]
-    rg = gp.ref.ranges
+    node, fx = gp.node, gp.effects
     chans = _fit_channels()
 
     def fit(x, u, p, t, d):
@@ -141,38 +139,12 @@ class Runner:
         return self._T[warm]
 
     def reference(self, gait):
-        """The spec's reference with ``gait``'s joint angles (hip: thigh in the laboratory),
-        net torques and GRFs; the HAT reference (an estimate from the spec's own data, not
-        data) is kept."""
-        from .. import kinematics
-
-        base = self.gp.ref
-        t = np.asarray(base.q.index, float)
-        if len(t) != len(gait.time) or not np.allclose(t, gait.time):
-            raise ValueError("data set's time grid differs from the spec's data (load it with gaitlib.gap.io)")
-        Q = kinematics.pose_from_data(self.gp.model, gait, t, self.gp.p_contact, penetration=0.002, thigh="lab")
-        q = base.q.copy()
-        for c in gait_ocp.cv.JOINTS:
-            q[c] = Q[:, gait_ocp.cv.COORDS.index(c)]
-        tau = gait.mean[[f"tau_{j}" for j in gait_ocp.LEG_JOINTS]].copy()
-        tau.columns = list(gait_ocp.LEG_JOINTS)
-        grf = gait.mean[list(gait_ocp.GRF_CHANNELS)].copy()
-        deriv = dict(base.deriv)
-        T = float(gait.cycle_time)
-        for c in gait_ocp.cv.JOINTS:
-            deriv[c] = gait_ocp._fourier_derivatives(q[c].to_numpy(), T, 12)
-        return dataclasses.replace(base, gait=gait, q=q, tau=tau, grf=grf, deriv=deriv)
+        """:func:`gaitlib.problems.gait.reference_on` of the built spec."""
+        return gait_ocp.reference_on(self.gp, gait)
 
     def data_guess(self, gait) -> ocp.Guess:
-        """The data-based initial guess (thesis Sec 4.3.2) built from ``gait``'s own curves
-        (HAT: the spec's reference)."""
-        gp = self.gp
-        g = gait_ocp.initial_guess(self.spec, gp.model, self.reference(gait), gp.p_body, gp.p_contact)
-        ph0 = gp.problem.phases[0]
-        if "edot_rest" in ph0.controls:
-            g = gait_ocp._with_edot_rest_guess(g, ph0.states, ph0.controls, gp.problem.parameters, gp.functions["edot"],
-                                         gp.t_stim)
-        return g
+        """:func:`gaitlib.problems.gait.data_guess_on` of the built spec."""
+        return gait_ocp.data_guess_on(self.gp, gait)
 
     def frame(self, gait):
         frame = gait_ocp.tracking_frame(self.spec, self.reference(gait))

@@ -235,7 +235,7 @@ def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), 
         eff = truth[key]["effects"]
         if eff and bases[key] is not None:
             g = "true|" + key.split("#")[0]
-            ref_groups.setdefault(g, (D._with_effects(spec0, eff), []))[1].append((f"true|{key}", ds.gait, bases[key]))
+            ref_groups.setdefault(g, (D.with_effects(spec0, eff), []))[1].append((f"true|{key}", ds.gait, bases[key]))
     ref = solve_many(ref_groups, root=root, use_cache=use_cache, objective=objective, **sweep_kw) if ref_groups else {}
     diags, refs = {}, {}
     for key, ds in datasets.items():

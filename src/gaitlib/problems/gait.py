@@ -120,7 +120,7 @@ import math
 import os
 import socket
 import time
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, replace
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -528,11 +528,14 @@ def hat_reference_of(sol: "GaitSolution", n: int = 100) -> tuple:
 class GaitProblem:
     """A built gait problem: the spec, the ocp Problem, mesh, options and guess.
 
-    ``t_stim`` (NMSK): the stimulation time per muscle (s, :data:`NMSK_MUSCLES` order) held
-    constant in the Mtb term; ``functions``: per-node functions of the formulation
-    (NMSK ``"edot"``: CasADi (x, u, p, t_stim) → Ė and its components, W; ``"node"``: the
-    Python closure (x, u, p) → dict of inverse-dynamics, contact and torque expressions;
-    ``"effects"``: the spec's bound effects, :class:`gaitlib.effects.Bound`, or None).
+    The formulation's per-node pieces, for goals added outside it (:mod:`gaitlib.gap`):
+
+    ``node``: the closure (x, u, p) → dict of the node's expressions (``tau_id``, ``R_id``,
+    ``tau_in``, ``R_in``, ``tau_net``, ``grf`` …; :class:`~gaitlib.ocp.Named` views in);
+    ``effects``: the spec's bound effects (:class:`gaitlib.effects.Bound`) or None;
+    ``edot`` (NMSK): CasADi (x, u, p, t_stim) → Ė and its components (total, activation,
+    maintenance, shortening, basal, work; W), else None; ``t_stim`` (NMSK): the stimulation
+    time per muscle (s, :data:`NMSK_MUSCLES` order) held constant in the Mtb term.
     """
 
     spec: GaitSpec
@@ -545,7 +548,9 @@ class GaitProblem:
     p_body: np.ndarray
     p_contact: np.ndarray
     t_stim: tuple = ()
-    functions: dict = field(default_factory=dict)
+    node: Any = None
+    effects: Any = None
+    edot: Any = None
 
     @property
     def stride(self) -> float:
@@ -794,9 +799,7 @@ def build(spec: GaitSpec) -> GaitProblem:
 
     # ---- initial guess (before the goals: the NMSK Mtb term's t_stim comes from it)
     guess = initial_guess(spec, model, ref, p_body, p_contact)
-    # "node": the per-node closure (x, u, p) → dict (tau_id, R_id, tau_in, R_in, tau_net, grf,
-    # …) and "effects": the bound effects or None — for goals added outside (gaitlib.gap)
-    functions: dict = {"node": node, "effects": fx}
+    edot = None  # NMSK: the metabolic rate per node (GaitProblem.edot)
     t_stim: tuple = ()
     if nmsk:
         if spec.t_stim is not None:
@@ -820,16 +823,16 @@ def build(spec: GaitSpec) -> GaitProblem:
             s1=ap_["s1"], s2=ap_["s2"], mtp_torques={f"mtp_{s}": un_[f"tau_mtp_{s}"] for s in cv.SIDES},
             t_stim={m: ts_[i] for i, m in enumerate(NMSK_MUSCLES)})
         parts = ("total", "activation", "maintenance", "shortening", "basal", "work")
-        functions["edot"] = ca.Function("edot", [xs_, us_, ps_, ts_], [r[k] for k in parts],
+        edot = ca.Function("edot", [xs_, us_, ps_, ts_], [r[k] for k in parts],
                                         ["x", "u", "p", "t_stim"], list(parts))
         basal = float(sum(metabolics.basal_rate(m) for m in NMSK_MUSCLES))
         if "Mtb" in w:
-            guess = _with_edot_rest_guess(guess, states, controls, params, functions["edot"], t_stim)
+            guess = _with_edot_rest_guess(guess, states, controls, params, edot, t_stim)
     t_stim_dm = ca.DM(list(t_stim)) if t_stim else None
 
     def edot_rest(x: Named, u: Named, p: Named):
         """Ȧ + Ṁ + Ṡ + Ẇ (Eq 5.38 without the basal rate), W."""
-        out = functions["edot"](x.vec, u.vec, p.vec, t_stim_dm)
+        out = edot(x.vec, u.vec, p.vec, t_stim_dm)
         return out[1] + out[2] + out[3] + out[5]
 
     if nmsk and "Mtb" in w:
@@ -934,7 +937,8 @@ def build(spec: GaitSpec) -> GaitProblem:
     problem = Problem(phases=(phase,), parameters=tuple(params), name=f"gait_{spec.model}_{spec.cost}".replace(".", ""))
     mesh = Mesh(spec.n_intervals, spec.scheme, spec.degree)
     options = SolverOptions(tol=spec.tol, max_iter=spec.max_iter, hessian=spec.hessian)
-    return GaitProblem(spec, model, ref, problem, mesh, options, guess, p_body, p_contact, t_stim, functions)
+    return GaitProblem(spec, model, ref, problem, mesh, options, guess, p_body, p_contact, t_stim,
+                       node=node, effects=fx, edot=edot)
 
 
 def tracking_frame(spec: GaitSpec, ref: Reference) -> pd.DataFrame:
@@ -1170,7 +1174,7 @@ class GaitSolution:
         return sol
 
 
-def _rmse_table(sol_q, torques, grf, ref: Reference, time_scale: float = 1.0) -> pd.DataFrame:
+def rmse_table(sol_q, torques, grf, ref: Reference, time_scale: float = 1.0) -> pd.DataFrame:
     """RMSE per channel; the data are read at ``time_scale`` × the solution's times (T / t_f
     with a free final time: comparison on normalised time)."""
     gait = ref.gait
@@ -1211,6 +1215,39 @@ def solve(spec: GaitSpec | GaitProblem, guess: "Guess | ocp.Solution | GaitSolut
         options = replace(options, print_level=5, ipopt={**dict(options.ipopt), "print_frequency_iter": 10})
     sol = ocp.solve(gp.problem, gp.mesh, options, warm_start(gp, guess))
     return postprocess(gp, sol)
+
+
+def reference_on(gp: GaitProblem, gait) -> Reference:
+    """``gp``'s reference with another data set's joint angles (hip: the thigh in the
+    laboratory, :func:`gaitlib.kinematics.pose_from_data`), net torques and GRFs, on the same
+    time grid; the HAT reference (an estimate from the spec's own data, not data) is kept.
+    ``gait``: a :class:`~gaitlib.data.GaitData` with the spec's cycle (same time grid)."""
+    base = gp.ref
+    t = np.asarray(base.q.index, float)
+    if len(t) != len(gait.time) or not np.allclose(t, gait.time):
+        raise ValueError("data set's time grid differs from the spec's data (load it with gaitlib.gap.io)")
+    Q = kinematics.pose_from_data(gp.model, gait, t, gp.p_contact, penetration=0.002, thigh="lab")
+    q = base.q.copy()
+    for c in cv.JOINTS:
+        q[c] = Q[:, cv.COORDS.index(c)]
+    tau = gait.mean[[f"tau_{j}" for j in LEG_JOINTS]].copy()
+    tau.columns = list(LEG_JOINTS)
+    grf = gait.mean[list(GRF_CHANNELS)].copy()
+    deriv = dict(base.deriv)
+    T = float(gait.cycle_time)
+    for c in cv.JOINTS:
+        deriv[c] = _fourier_derivatives(q[c].to_numpy(), T, 12)
+    return replace(base, gait=gait, q=q, tau=tau, grf=grf, deriv=deriv)
+
+
+def data_guess_on(gp: GaitProblem, gait) -> Guess:
+    """The data-based initial guess (thesis Sec 4.3.2) of ``gp`` built from another data set's
+    curves (:func:`reference_on`; HAT: the spec's reference)."""
+    g = initial_guess(gp.spec, gp.model, reference_on(gp, gait), gp.p_body, gp.p_contact)
+    ph0 = gp.problem.phases[0]
+    if "edot_rest" in ph0.controls:
+        g = _with_edot_rest_guess(g, ph0.states, ph0.controls, gp.problem.parameters, gp.edot, gp.t_stim)
+    return g
 
 
 def warm_start(gp: GaitProblem, guess) -> Guess:
@@ -1274,8 +1311,7 @@ def warm_start(gp: GaitProblem, guess) -> Guess:
                 parameters=params)
     ph0 = gp.problem.phases[0]
     if "edot_rest" in ph0.controls and "edot_rest" not in ph.controls.columns:
-        out = _with_edot_rest_guess(out, ph0.states, ph0.controls, gp.problem.parameters, gp.functions["edot"],
-                                    gp.t_stim)
+        out = _with_edot_rest_guess(out, ph0.states, ph0.controls, gp.problem.parameters, gp.edot, gp.t_stim)
     return out
 
 
@@ -1340,7 +1376,7 @@ def postprocess(gp: GaitProblem, sol: ocp.Solution) -> GaitSolution:
     torques = active + pd.DataFrame(pas.T, index=q.index, columns=list(cv.JOINTS))
     residuals = U[list(cv.RESIDUALS)].copy()
     time_scale = gp.ref.gait.cycle_time / ph.tf if spec.tf_bounds else 1.0
-    rmse = _rmse_table(q, torques, grf, gp.ref, time_scale)
+    rmse = rmse_table(q, torques, grf, gp.ref, time_scale)
     stats = {
         "status": sol.status, "success": sol.success, "iterations": sol.iterations,
         "solve_time_s": sol.solve_time, "build_time_s": sol.build_time,
@@ -1391,7 +1427,7 @@ def _postprocess_nmsk(gp: GaitProblem, sol: ocp.Solution, Xu, U, q, qd):
                        index=q.index)
     mus = pd.DataFrame(am, index=q.index)
     # metabolic rate with the NLP's own function (the Mtb term's Ė)
-    f = gp.functions["edot"]
+    f = gp.edot
     names_x = list(gp.problem.phases[0].states)
     Xn = Xu[names_x].to_numpy().T
     Un = U[list(gp.problem.phases[0].controls)].to_numpy().T

@@ -544,7 +544,7 @@ def _result_a(prob: InverseDynamicsID, rec: dict, from_cache: bool) -> ApproachR
     best = min(pool, key=lambda i: rows[i]["cost"])
     p = np.array(rows[best]["p"])
     fr = prob.frames(p)
-    rmse = gait_ocp._rmse_table(fr["q"], fr["torques"], fr["grf"], prob.ref)
+    rmse = gait_ocp.rmse_table(fr["q"], fr["torques"], fr["grf"], prob.ref)
     c = prob.cost_function(p)
     its = int(sum(r["iterations"] for r in rows))
     solve_s = float(sum(r["time (s)"] for r in rows))

@@ -221,7 +221,7 @@ def profile_table(diag: D.Diagnosis, effect: str, stems=("emg_TA", "emg_MG", "em
     rows = [{"magnitude": 0.0, "status": diag.baseline.stats["status"], "iterations": diag.baseline.stats.get("iterations"),
              "RSS (all)": diag.located.rss, **_emg_cols(diag.located, stems)}]
     for m, _, _ in f.profile:
-        spec = D._with_effects(diag.spec, ((effect, m),))
+        spec = D.with_effects(diag.spec, ((effect, m),))
         sol = solve_on(spec, diag.data.gait, diag.baseline, objective=diag.objective)
         loc = L.locate(sol, diag.data, thetas=sol.stats.get("effects"))
         rows.append({"magnitude": m, "status": sol.stats["status"], "iterations": sol.stats.get("iterations"),
@@ -251,7 +251,7 @@ def exact_left_leg(gait, order: int | None = None):
     """
     from .. import data as data_mod
 
-    order = effects_mod._FOURIER_ORDER if order is None else order
+    order = effects_mod.FOURIER_ORDER if order is None else order
     tau = gait.time / float(gait.cycle_time)
     shift = float(gait.left_shift)
     mean, sd, replaced = gait.mean.copy(), gait.sd.copy(), []
