@@ -54,10 +54,8 @@ import json
 import time
 import warnings
 from dataclasses import dataclass
-from functools import cached_property
 from pathlib import Path
 
-import casadi as ca
 import numpy as np
 import pandas as pd
 
@@ -70,6 +68,8 @@ from .. import ocp
 from .. import params as params_mod
 from ..problems import gait as gait_ocp
 from ..model import P_BODY_NAMES, P_BODY_UNITS, ChildModel
+from ..problems.contact_id import (MU_RATIO, TRAJOPT_FORMULATION, InverseDynamicsID,  # noqa: F401  (API)
+                                   TrajOptSpec, neutral_start)
 
 __all__ = [
     "APPROACHES", "THESIS_RMSE", "THESIS_GEOMETRY", "THESIS_CONTACT", "THESIS_TIME",
@@ -81,21 +81,16 @@ __all__ = [
     "save_identified", "identified_vs_result",
 ]
 
-#: The three approaches: key → label used in tables and figures.
-#: Version of approach (a)'s trajectory-optimisation problem (:class:`InverseDynamicsID`, its
-#: multistart and solver options): part of its cache keys.
-TRAJOPT_FORMULATION = "contact-trajopt-1"
 #: Version of approaches (b)/(c) on top of :data:`gaitlib.problems.gait.FORMULATION` (their
 #: starts, guesses and continuation): part of their cache keys. Bump either when a change
 #: alters what is solved (tests/test_formulation_versions.py).
 FORMULATION = "contact-id-1"
 
+#: The three approaches: key → label used in tables and figures.
 APPROACHES = {"a": "(a) trajectory optimisation", "b": "(b) optimal control",
               "c": "(c) optimal control + body parameters",
               "c_wide": "(c′) = (c) with Table 4.7 widened to the thesis's (c) values"}
 
-#: Friction-ratio bounds of Eq 4.4 (μ_d / μ_s), thesis Sec 4.3.1.
-MU_RATIO = (0.55, 0.99)
 
 # --------------------------------------------------------------------------------------
 # Thesis values (references, on Bovi 2011 data)
@@ -177,236 +172,6 @@ def _table_scale(name: str) -> float:
     if name in ("gamma", "beta", "alpha"):
         return 1 / cv.DEG
     return 1.0
-
-
-# --------------------------------------------------------------------------------------
-# Starting point
-# --------------------------------------------------------------------------------------
-
-
-def neutral_start() -> np.ndarray:
-    """The neutral start (39,), SI: the centre of each Table 4.7 box, k_v at the geometric
-    centre of its box (√(10⁵·10⁸) ≈ 3.16·10⁶ N/m³), μ_s = 0.40 and μ_d = 0.35 (the thesis's
-    friction guess, Sec 4.3.1: "the required friction coefficient for walking is 0.3")."""
-    lo, hi = contact_mod.bounds()
-    p = 0.5 * (lo + hi)
-    for e in cv.ELLIPSOIDS:
-        i = contact_mod.param_index(e, "k_v")
-        p[i] = float(np.sqrt(lo[i] * hi[i]))
-        p[contact_mod.param_index(e, "mu_s")] = 0.40
-        p[contact_mod.param_index(e, "mu_d")] = 0.35
-    return p
-
-
-# --------------------------------------------------------------------------------------
-# Approach (a): trajectory optimisation on fixed kinematics
-# --------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class TrajOptSpec:
-    """Approach (a): what to solve and how to search.
-
-    Parameters
-    ----------
-    speed_class, source : the data (:func:`gaitlib.data.load_gait_data`).
-    n_time : samples of the cycle, uniform on [0, T) (T the data's cycle time); Eq 4.5's
-        (1/t_f)∫ dt is their mean (exact for the periodic trigonometric polynomials the
-        kinematics are). The thesis sampled 101 points.
-    n_trial : Latin-hypercube trial points scored by the cost (+ a penalty on Eq 4.4).
-    n_local : local solves from the best-scoring trial points (after the one from x0).
-    seed : seed of the scatter (reproducible).
-    tol, max_iter : IPOPT settings of each local solve.
-    """
-
-    speed_class: str = "Free"
-    source: str = "schwartz2008"
-    n_time: int = 100
-    n_trial: int = 200
-    n_local: int = 10
-    seed: int = 0
-    tol: float = 1e-8
-    max_iter: int = 1000
-
-    def to_dict(self) -> dict:
-        return dataclasses.asdict(self)
-
-
-class InverseDynamicsID:
-    """The inverse-dynamics identification problem of approach (a) (Sec 4.3.1).
-
-    With the kinematics fixed to the data, for contact parameters p (39,) at each of the
-    ``n_time`` samples t_k: GRFs from the contact model, joint torques τ and pelvis residuals
-    R from inverse dynamics (:meth:`gaitlib.model.ChildModel.function` ``"inverse_dynamics"``)
-    with the default body parameters (Sec 4.1.1); the net joint torque (actuator + the
-    joints' spring–damper, what the data report) is compared with the data.
-
-    Cost Eq 4.5: ``J(p) = (1/N) Σ_k [¼ Σ_6 ((τ_net − τ_exp)/range)² + ¼ Σ_4 ((GRF − GRF_exp)/range)²]``
-    (ranges = max − min of the data; 6 = hip, knee, ankle of both legs; 4 = tangential and
-    normal force of both feet).
-
-    Scaled variables z ∈ [0, 1]³⁹ (:meth:`p_of_z`): p = lo + (hi − lo) z, except
-    k_v = lo (hi/lo)^z. Constraint Eq 4.4: μ_d − 0.55 μ_s ≥ 0 and 0.99 μ_s − μ_d ≥ 0 per
-    ellipsoid (linear in p).
-    """
-
-    def __init__(self, spec: TrajOptSpec = TrajOptSpec()):
-        self.spec = spec
-        self.model = ChildModel()
-        self.gait = data_mod.load_gait_data(spec.speed_class, spec.source)
-        self.ref = gait_ocp.reference(self.gait, self.model, contact_mod.default_params())
-        T = self.gait.cycle_time
-        N = spec.n_time
-        self.t = np.arange(N) * T / N
-        d = {c: self.ref.deriv[c](self.t) for c in cv.COORDS}
-        self.Q = np.array([d[c][0] for c in cv.COORDS])
-        self.QD = np.array([d[c][1] for c in cv.COORDS])
-        self.QDD = np.array([d[c][2] for c in cv.COORDS])
-        self.p_body = self.model.default_p_body()
-        g = self.gait
-        self.tau_data = np.array([np.interp(self.t, g.time, g.mean[f"tau_{j}"]) for j in gait_ocp.LEG_JOINTS])
-        self.grf_data = np.array([np.interp(self.t, g.time, g.mean[c]) for c in gait_ocp.GRF_CHANNELS])
-        self.tau_range = np.array([self.ref.ranges[f"tau_{j}"] for j in gait_ocp.LEG_JOINTS])
-        self.grf_range = np.array([self.ref.ranges[c] for c in gait_ocp.GRF_CHANNELS])
-        self.lo, self.hi = contact_mod.bounds()
-        self.log = np.zeros(39, bool)
-        for e in cv.ELLIPSOIDS:
-            self.log[contact_mod.param_index(e, "k_v")] = True
-
-    # ---- scaling
-    def p_of_z(self, z):
-        """Parameters (SI) of scaled variables z (numpy or CasADi)."""
-        lo, hi = self.lo, self.hi
-        llo, lhi = np.log(np.where(self.log, lo, 1.0)), np.log(np.where(self.log, hi, 1.0))
-        if isinstance(z, (ca.SX, ca.MX)):
-            lin = ca.DM(lo) + ca.DM(hi - lo) * z
-            ex = ca.exp(ca.DM(llo) + ca.DM(lhi - llo) * z)
-            return ca.vertcat(*[ex[i] if self.log[i] else lin[i] for i in range(39)])
-        z = np.asarray(z, float)
-        return np.where(self.log, np.exp(llo + (lhi - llo) * z), lo + (hi - lo) * z)
-
-    def z_of_p(self, p) -> np.ndarray:
-        """Scaled variables of parameters p (SI)."""
-        p = np.asarray(p, float)
-        lo, hi = self.lo, self.hi
-        z = (p - lo) / (hi - lo)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            zl = np.log(p / lo) / np.log(hi / lo)
-        return np.where(self.log, zl, z)
-
-    # ---- symbolic functions
-    @cached_property
-    def _expressions(self) -> dict:
-        N = self.spec.n_time
-        p = ca.SX.sym("p", 39)
-        P = ca.repmat(p, 1, N)
-        f_id = self.model.function("inverse_dynamics").map(N)
-        f_ct = self.model.function("contact").map(N)
-        f_pas = self.model.function("passive").map(N)
-        tau, R = f_id(self.Q, self.QD, self.QDD, self.p_body, P)
-        ct = dict(zip(self.model.function("contact").name_out(), f_ct(self.Q, self.QD, P)))
-        grf = ca.vertcat(ct["grf_x"][0, :], ct["grf_y"][0, :], ct["grf_x"][1, :], ct["grf_y"][1, :])
-        net = tau + f_pas(self.Q, self.QD, self.p_body)
-        rows = [cv.JOINTS.index(j) for j in gait_ocp.LEG_JOINTS]
-        e_tau = (net[rows, :] - ca.DM(self.tau_data)) / ca.repmat(ca.DM(self.tau_range), 1, N)
-        e_grf = (grf - ca.DM(self.grf_data)) / ca.repmat(ca.DM(self.grf_range), 1, N)
-        j_trq = ca.sumsqr(e_tau) / N
-        j_grf = ca.sumsqr(e_grf) / N
-        return {"p": p, "J": 0.25 * j_trq + 0.25 * j_grf, "Trq": j_trq, "GRF": j_grf, "net": net, "R": R,
-                "grf": grf, "fn": ct["fn"], "fx": ct["fx"], "fn_raw": ct["fn_raw"]}
-
-    @cached_property
-    def cost_function(self) -> ca.Function:
-        """p (39,) SI → J (Eq 4.5), Trq and GRF (the unweighted mean squared normalised errors)."""
-        E = self._expressions
-        return ca.Function("eq4_5", [E["p"]], [E["J"], E["Trq"], E["GRF"]], ["p"], ["J", "Trq", "GRF"])
-
-    @cached_property
-    def gradient_function(self) -> ca.Function:
-        """p (39,) SI → dJ/dp (39,), exact (algorithmic differentiation)."""
-        E = self._expressions
-        return ca.Function("eq4_5_grad", [E["p"]], [ca.gradient(E["J"], E["p"])], ["p"], ["dJdp"])
-
-    @cached_property
-    def frames_function(self) -> ca.Function:
-        E = self._expressions
-        return ca.Function("frames", [E["p"]], [E["net"], E["R"], E["grf"], E["fn"], E["fx"], E["fn_raw"]],
-                           ["p"], ["tau_net", "R", "grf", "fn", "fx", "fn_raw"])
-
-    def cost(self, p) -> float:
-        """Eq 4.5 at p (SI)."""
-        return float(self.cost_function(np.asarray(p, float))[0])
-
-    def ratio_violation(self, p) -> float:
-        """Total violation of Eq 4.4 at p (0 when satisfied)."""
-        p = np.asarray(p, float)
-        v = 0.0
-        for e in cv.ELLIPSOIDS:
-            ms, md = p[contact_mod.param_index(e, "mu_s")], p[contact_mod.param_index(e, "mu_d")]
-            v += max(0.0, MU_RATIO[0] * ms - md) + max(0.0, md - MU_RATIO[1] * ms)
-        return v
-
-    @cached_property
-    def solver(self) -> ca.Function:
-        """IPOPT on z ∈ [0, 1]³⁹ with the Eq 4.4 constraints (exact Hessian)."""
-        z = ca.SX.sym("z", 39)
-        p = self.p_of_z(z)
-        J = ca.substitute(self._expressions["J"], self._expressions["p"], p)
-        g = []
-        for e in cv.ELLIPSOIDS:
-            ms, md = p[contact_mod.param_index(e, "mu_s")], p[contact_mod.param_index(e, "mu_d")]
-            g += [md - MU_RATIO[0] * ms, MU_RATIO[1] * ms - md]
-        opts = {"ipopt": {"tol": self.spec.tol, "max_iter": self.spec.max_iter, "print_level": 0, "sb": "yes",
-                          "mu_strategy": "monotone", "linear_solver": "mumps"},
-                "print_time": False, "error_on_fail": False}
-        return ca.nlpsol("traj_opt", "ipopt", {"x": z, "f": J, "g": ca.vertcat(*g)}, opts)
-
-    def local_solve(self, p0) -> dict:
-        """One local solve from p0 (SI, clipped into the bounds): p, cost, status, iterations, s."""
-        z0 = np.clip(self.z_of_p(np.clip(p0, self.lo, self.hi)), 0.0, 1.0)
-        t0 = time.perf_counter()
-        r = self.solver(x0=z0, lbx=0.0, ubx=1.0, lbg=0.0, ubg=np.inf)
-        dt = time.perf_counter() - t0
-        st = self.solver.stats()
-        p = self.p_of_z(np.clip(np.asarray(r["x"]).ravel(), 0.0, 1.0))
-        return {"p": p, "cost": self.cost(p), "status": str(st["return_status"]), "success": bool(st["success"]),
-                "iterations": int(st["iter_count"]), "time_s": dt, "ratio_violation": self.ratio_violation(p)}
-
-    def scatter(self) -> np.ndarray:
-        """The seeded Latin-hypercube trial points (n_trial, 39), SI. The μ_d coordinate is
-        sampled as the ratio μ_d/μ_s within Eq 4.4's bounds (then clipped to μ_d's box), so
-        that trial points respect Eq 4.4 where the box allows."""
-        from scipy.stats import qmc
-
-        U = qmc.LatinHypercube(d=39, seed=self.spec.seed).random(self.spec.n_trial)
-        P = np.array([self.p_of_z(u) for u in U])
-        for e in cv.ELLIPSOIDS:
-            i_s, i_d = contact_mod.param_index(e, "mu_s"), contact_mod.param_index(e, "mu_d")
-            ratio = MU_RATIO[0] + (MU_RATIO[1] - MU_RATIO[0]) * U[:, i_d]
-            P[:, i_d] = np.clip(ratio * P[:, i_s], self.lo[i_d], self.hi[i_d])
-        return P
-
-    def score(self, p) -> float:
-        """GlobalSearch-style score: cost + 1000 × Eq 4.4 violation."""
-        return self.cost(p) + 1e3 * self.ratio_violation(p)
-
-    def frames(self, p) -> dict:
-        """Frames at p (SI): ``q``, ``torques`` (8 net), ``residuals``, ``grf``, ``ellipsoids``."""
-        from ..model import ELLIPSOID_LABELS
-
-        out = self.frames_function(np.asarray(p, float))
-        idx = pd.Index(self.t, name="time")
-        net, R, grf, fn, fx = (np.asarray(v) for v in out[:5])
-        q = pd.DataFrame(self.Q.T, index=idx, columns=list(cv.COORDS))
-        torques = pd.DataFrame(net.T, index=idx, columns=list(cv.JOINTS))
-        residuals = pd.DataFrame(R.T, index=idx, columns=list(cv.RESIDUALS))
-        grf_f = pd.DataFrame(grf.T, index=idx, columns=list(gait_ocp.GRF_CHANNELS))
-        ell = {}
-        for i, lab in enumerate(ELLIPSOID_LABELS):
-            ell[f"fn_{lab}"] = fn[i]
-            ell[f"fx_{lab}"] = fx[i]
-        return {"q": q, "torques": torques, "residuals": residuals, "grf": grf_f,
-                "ellipsoids": pd.DataFrame(ell, index=idx)}
 
 
 # --------------------------------------------------------------------------------------
