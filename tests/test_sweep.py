@@ -90,7 +90,7 @@ def test_localcluster_gives_bitwise_the_serial_results(serial, tmp_path, capfd):
 
 def test_localcluster_workers_are_single_threaded():
     recs = sw.sweep(os.getenv, {v: v for v in sw.BLAS_ENV}, n_workers=1, progress=False)
-    assert [(r.name, r.value) for r in recs] == [(v, os.environ.get(v, "1")) for v in sw.BLAS_ENV]
+    assert [(r.name, r.value) for r in recs] == [(v, os.environ.get(v, sw.blas.SETTINGS[v])) for v in sw.BLAS_ENV]
 
 
 def test_an_exception_is_a_failed_record_not_a_crash():
@@ -112,7 +112,7 @@ def dask_cluster(tmp_path_factory):
     sched_file, decoy = tmp / "scheduler.json", tmp / "decoy_cache"
     dask_bin = str(Path(sys.executable).parent / "dask")
     env = {**os.environ, "GAITLIB_SOLUTIONS": str(decoy),
-           **{v: "1" for v in sw.BLAS_ENV}}
+           **sw.blas.SETTINGS}
     procs = []
     try:
         procs.append(subprocess.Popen([dask_bin, "scheduler", "--scheduler-file", str(sched_file), "--port", "0",

@@ -47,6 +47,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
+from . import blas
+
 __all__ = ["RunRecord", "sweep", "solve_specs", "ACCEPTED_STATUSES", "BLAS_ENV"]
 
 #: IPOPT return statuses counted as a solved run (``RunRecord.ok``); the status itself is
@@ -54,7 +56,7 @@ __all__ = ["RunRecord", "sweep", "solve_specs", "ACCEPTED_STATUSES", "BLAS_ENV"]
 ACCEPTED_STATUSES = frozenset({"Solve_Succeeded", "Solved_To_Acceptable_Level"})
 
 #: Thread-count variables set for every worker process (one BLAS/OpenMP thread).
-BLAS_ENV = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+BLAS_ENV = tuple(blas.SETTINGS)  # the variables every worker gets (gaitlib.blas)
 
 
 @dataclass(frozen=True)
@@ -122,8 +124,7 @@ def _where() -> str:
 
 def _run_one(func: Callable, name: str, arg) -> RunRecord:
     """Run ``func(arg)`` and wrap the outcome (executed on the worker)."""
-    for v in BLAS_ENV:  # workers of an existing cluster may not have them; casadi loads
-        os.environ.setdefault(v, "1")  # its OpenBLAS at the first solver, after this
+    blas.pin()  # workers of an existing cluster may not have them; casadi loads its OpenBLAS at the first solver
     t0 = time.perf_counter()
     try:
         value = func(arg)
@@ -183,8 +184,8 @@ class _Progress:
 
 
 def _worker_env() -> dict[str, str]:
-    # one thread per BLAS/OpenMP, unless the user set the variables (gaitlib's policy)
-    return {v: os.environ.get(v, "1") for v in BLAS_ENV}
+    # gaitlib.blas's settings, unless the user set the variables
+    return {v: os.environ.get(v, default) for v, default in blas.SETTINGS.items()}
 
 
 def sweep(func: Callable[[Any], Any], items, *, scheduler: str | None = None, n_workers: int | None = None,

@@ -1555,12 +1555,12 @@ def solve_cached(spec: GaitSpec, *, use_cache: bool = True, root=None, guess=Non
     failed — their status is the result. ``guess``: a :class:`~gaitlib.ocp.Guess` or
     another :class:`~gaitlib.ocp.Solution` (warm start; part of the cache key via its
     objective and status only if given, so warm-started runs are cached separately)."""
-    def solve():
+    def fresh():
         sol = solve(spec, guess=guess, progress=progress)
         sol.stats["from_cache"] = False
         return sol
 
-    return cache.solve_or_load(cache_dir(spec, guess=guess, root=root), solve, GaitSolution.from_cache,
+    return cache.solve_or_load(cache_dir(spec, guess=guess, root=root), fresh, GaitSolution.from_cache,
                                marker="spec.json", use_cache=use_cache)
 
 

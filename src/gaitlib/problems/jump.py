@@ -838,10 +838,8 @@ def _trajectory(sp: JumpSpec, model: JumpModel, p_contact, sol: ocp.Solution) ->
             fx = fy = np.zeros(n)
             cop = np.full(n, np.nan)
         else:
-            from ..plots import _jump_ellipsoid_function
-
             f = model.function("contact")
-            ell = _jump_ellipsoid_function(model)
+            ell = model.function("ellipsoids")
             R = [f(Q[k], QD[k], TAU[k], p_contact) for k in range(n)]
             fx = np.array([float(r[2]) for r in R])
             fy = np.array([float(r[3]) for r in R])
