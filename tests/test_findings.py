@@ -166,3 +166,141 @@ def test_co_contraction_text():
     assert "does **not** close" in G.co_contraction_text(diag, emg)
     emg.loc[1, "RSS TA"] = np.nan
     assert G.co_contraction_text(diag, emg) is None
+
+
+# ------------------------------------------------------------------------------ Ch 3
+
+def _jump_sol(label, rise, mu, knee_min_deg, tau_knee, success=True):
+    from gaitlib.studies import jump
+    t = pd.DataFrame({"knee": np.radians([0.0, knee_min_deg, 0.0]), "tau_knee": tau_knee,
+                      "grf_y": [0.0, 2 * 10.0 * cv.G, 0.0]})
+    return SimpleNamespace(spec=SimpleNamespace(label=label), success=success,
+                           stats={"success": success, "status": "Solve_Succeeded" if success else "Infeasible",
+                                  "iterations": 10, "solve_time_s": 1.0},
+                           jump_height={"com_rise_flight": rise, "takeoff_vy": 1.0, "foot_lift": rise},
+                           required_friction=mu, trajectory=t,
+                           model=SimpleNamespace(joints=("knee",), total_mass=10.0),
+                           solution=SimpleNamespace(info={}))
+
+
+def test_jump_torques_at_bound_either_sign():
+    from gaitlib.studies import jump
+    lo, hi = jump.joint_bounds("knee")["tau"]
+    near = _jump_sol("x", 0.1, 1.0, -90, [0.0, 0.995 * hi, 0.0])
+    far = _jump_sol("x", 0.1, 1.0, -90, [0.0, 0.98 * hi, 0.5 * lo])
+    neg = _jump_sol("x", 0.1, 1.0, -90, [0.0, 0.0, 0.999 * lo])
+    assert jump.torques_at_bound(near) == ["knee"]
+    assert jump.torques_at_bound(far) == []
+    assert jump.torques_at_bound(neg) == ["knee"]
+
+
+def test_jump_findings_order_and_friction_verdicts():
+    from gaitlib.studies import jump
+    sols = {"toeless": _jump_sol("A", 0.10, 1.5, -90, [0, 100.0, 0]),
+            "toe": _jump_sol("B", 0.50, 1.0, -120, [0, 200.0, 0]),
+            "ellipsoid": _jump_sol("C", 0.30, 0.5, -140, [0, 300.0, 0], success=False)}
+    params = np.zeros(39)
+    params[[2, 15, 28]] = (0.4, 0.9, 0.6)          # μ_s of the three ellipsoids
+    f = jump.findings(sols, params)
+    assert f[0].startswith("A: converged in 10 iterations, 1 s. COM rise in flight 10 cm")
+    assert "— thesis 14 cm; required μ_s 1.50 — thesis 1.4; deepest knee -90° — thesis -94°." in f[0]
+    assert f[2] == "C: did NOT converge (Infeasible) in 10 iterations, 1 s. COM rise in flight 30 cm (take-off v_y " \
+                   "1.00 m/s), MTP lift 30 cm — thesis 89 cm; required μ_s 0.50 — thesis 0.12; deepest knee -140° — " \
+                   "thesis -150°."
+    assert f[3].startswith("NOT every solve converged")
+    assert f[4] == "Order of jump heights (COM rise): toeless < ellipsoid < toe; thesis: toeless < toe < ellipsoid " \
+                   "— a DIFFERENT order."
+    assert f[5] == "Our COM rise ÷ the thesis's jump height: toeless 0.7×, toe 0.8×, ellipsoid 0.3×"
+    assert "the ellipsoid contact needs LESS than either welded contact" in f[6]
+    assert f[6].endswith("Largest μ_s of its ellipsoids: 0.90.")
+    assert f[7].startswith("Largest joint torque: toeless 100 N·m, toe 200 N·m, ellipsoid 300 N·m")
+    assert "peak F_y toeless 2.0×, toe 2.0×, ellipsoid 2.0× the body weight." in f[7]
+    assert f[8] == "Joint torques at (≥ 99 % of) their Table 3.5 bound: toeless: none; toe: none; ellipsoid: none."
+
+
+# ------------------------------------------------------------------------------ Ch 4
+
+def test_contact_ranking():
+    from gaitlib.studies import contact_id as ci
+    fit = pd.DataFrame({"mean GRF RMSE (N)": [30.0, 12.0, 20.0]},
+                       index=[ci.APPROACHES["a"], ci.APPROACHES["b"], ci.APPROACHES["c"]])
+    assert ci.ranking(fit) == ["(b)", "(c)", "(a)"]
+    fit.iloc[1, 0] = 25.0
+    assert ci.ranking(fit) == list(ci.THESIS_RANKING)
+
+
+# ------------------------------------------------------------------------------ Ch 6 and 7
+
+def _scores(rows):
+    return pd.DataFrame(rows, columns=["model", "case", "kind", "nrmse", "rmse"])
+
+
+def test_mean_nrmse_weighs_kinds_equally():
+    from gaitlib.studies import predictive as pr
+    sc = _scores([("MSK", "DT", "angle", 0.1, 1.0), ("MSK", "DT", "angle", 0.3, 1.0),   # angle mean 0.2
+                  ("MSK", "DT", "torque", 0.4, 1.0), ("MSK", "DT", "grf", 0.6, 1.0),
+                  ("MSK", "DT", "excitation", 9.0, 9.0)])                              # not a headline kind
+    assert pr.kind_nrmse(sc).loc[("MSK", "DT"), "angle"] == pytest.approx(0.2)
+    assert pr.mean_nrmse(sc)[("MSK", "DT")] == pytest.approx((0.2 + 0.4 + 0.6) / 3)
+
+
+def _study(stats, scores, marks_):
+    return SimpleNamespace(stats=lambda: stats, marks=lambda: marks_, converged_scores=lambda: scores)
+
+
+def test_ch6_findings_verdicts():
+    from gaitlib.studies import predictive as pr
+    runs = [f"{m} {c}" for m in ("MSK", "NMSK") for c in ("DT", "SDT3", "FP")]
+    stats = pd.DataFrame({"converged": True, "status": "Solve_Succeeded",
+                          "solve (s)": [10.0, 20.0, 30.0, 40.0, 50.0, 25.0]}, index=runs)
+    rows = []
+    for (m, c), v in {("MSK", "DT"): 0.2, ("MSK", "SDT3"): 0.3, ("MSK", "FP"): 0.5,
+                      ("NMSK", "DT"): 0.25, ("NMSK", "SDT3"): 0.27, ("NMSK", "FP"): 0.4}.items():
+        rows += [(m, c, k, v, v) for k in ("angle", "torque", "grf")]
+    rows += [("NMSK", "DT", "excitation", np.nan, 0.5), ("NMSK", "FP", "excitation", np.nan, 0.3)]
+    tg = pd.DataFrame({"status": ["Solve_Succeeded", "Maximum_Iterations_Exceeded"]}, index=["NMSK DT", "NMSK FP"])
+    f = pr.ch6_findings(_study(stats, _scores(rows), {r: None for r in runs}), tg, {}, None)
+    assert f[0].startswith("- 6 of 6 runs converged (IPOPT Solve_Succeeded). IPOPT solve time per run 10–50 s here")
+    assert f[0].endswith("1 of 2 NMSK runs converged (not: NMSK FP Maximum_Iterations_Exceeded).")
+    assert f[1] == "- Mean NRMSE over angles, torques and forces: MSK DT 0.200 → FP 0.500; NMSK DT 0.250 → FP 0.400."
+    assert f[2].startswith("- NMSK is more accurate than MSK (mean NRMSE) for SDT3, FP (of 3 cost functions where both "
+                           "runs converged and pass the validity gates; not compared: SDT1, SDT2, SP1, SP2, SP3); the "
+                           "thesis")
+    assert "*NMSK FP more accurate than MSK FP*: holds on our data (0.400 vs 0.500)" in f[3]
+    assert "*NMSK FP faster than MSK FP*: holds (25 s vs 30 s;" in f[3]
+    # SDT3 0.27 ≤ 1.1 × 0.25 = 0.275: holds
+    assert f[4] == "- Thesis claim *SDT3 (Trq + Ang) is enough for NMSK*: NMSK SDT3 mean NRMSE 0.270 vs DT 0.250 — " \
+                   "holds (within 10 %)."
+    assert f[5].startswith("- Excitation RMSE vs EMG (mean over mapped muscles, converged NMSK runs): best FP 0.300, "
+                           "worst DT 0.500; FP 0.300 vs DT 0.500 (thesis: FP 12 % better than DT).")
+
+
+def test_ch7_findings_verdicts():
+    from gaitlib.studies import predictive as pr
+    classes = ("Slow", "Fast")
+    runs = [f"{m} {c}" for m in ("MSK", "NMSK") for c in classes]
+    stats = pd.DataFrame({"converged": [True, True, True, False],
+                          "status": ["Solve_Succeeded"] * 3 + ["Maximum_Iterations_Exceeded"],
+                          "solve (s)": [10.0, 20.0, 30.0, 40.0]}, index=runs)
+    rows = []
+    for (m, c), (a, t, g) in {("MSK", "Slow"): (0.2, 0.3, 0.2), ("MSK", "Fast"): (0.2, 0.3, 0.2),
+                              ("NMSK", "Slow"): (0.1, 0.2, 0.4)}.items():   # NMSK Fast: not converged
+        rows += [(m, c, "angle", a, a), (m, c, "torque", t, t), (m, c, "grf", g, g)]
+    control = pd.DataFrame({"angle": [0.15, 0.1], "torque": [0.25, 0.2], "grf": [0.3, 0.3]}, index=list(classes))
+    cot = pd.DataFrame({"mark": ["", "", "", "NOT CONVERGED: x"], "COT (J/kg/m)": [2.0, 1.5, 1.6, 3.0]},
+                       index=["Slow", "Free", "Ch5", "Fast"])
+    f = pr.ch7_findings(_study(stats, _scores(rows), {}), classes, control, cot, {}, "Ch5")
+    assert f[0] == "- 3 of 4 runs converged; not converged: NMSK Fast (Maximum_Iterations_Exceeded); IPOPT solve " \
+                   "time 10–40 s per run here vs 4–18 h in the thesis (Table 7.2)."
+    assert f[1].startswith("- Torque NRMSE: NMSK below MSK for Slow of the 1 classes where both runs converged and pass "
+                           "the validity gates (not compared: Fast)")
+    # NMSK Slow beats the control in angle (0.1 < 0.15) and torque (0.2 < 0.25), not GRF (0.4 > 0.3)
+    assert f[2] == "- The converged NMSK predictions are closer to the untracked class data than the scaled Free data " \
+                   "they tracked in 2 of 3 class × kind cells (Fast left out: not converged)."
+    assert len(f) == 3          # two converged points on the curve: fewer than COT_CURVE_MIN_POINTS, no COT claim
+    cot.loc["Fast", "mark"] = ""
+    f = pr.ch7_findings(_study(stats, _scores(rows), {}), classes, control, cot, {}, "Ch5")
+    assert f[3].startswith("- COT (NMSK DT, converged runs; Free = the Ch 6 NMSK DT run): Slow 2.00, Free 1.50, Fast "
+                           "3.00 J/(kg·m); minimum at Free (the natural speed — a U-curve as the thesis reports). "
+                           "Thesis (Fig 7.5): 2.18, 1.99, 1.53, 1.96, 1.99 at XS, S, N, M, L.")
+    assert f[3].endswith("The Ch 5 NMSK solution (Eq 5.55, its own activation parameters) has 1.60; it is not on the curve.")
