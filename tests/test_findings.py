@@ -12,8 +12,11 @@ import pytest
 from gaitlib import conventions as cv
 from gaitlib.gap import diagnose as D
 from gaitlib.gap import twin
+from gaitlib.studies import contact_id as ci
 from gaitlib.studies import gap as G
+from gaitlib.studies import jump
 from gaitlib.studies import msk
+from gaitlib.studies import predictive as pr
 
 
 # ------------------------------------------------------------------------------ Ch 5
@@ -171,7 +174,6 @@ def test_co_contraction_text():
 # ------------------------------------------------------------------------------ Ch 3
 
 def _jump_sol(label, rise, mu, knee_min_deg, tau_knee, success=True):
-    from gaitlib.studies import jump
     t = pd.DataFrame({"knee": np.radians([0.0, knee_min_deg, 0.0]), "tau_knee": tau_knee,
                       "grf_y": [0.0, 2 * 10.0 * cv.G, 0.0]})
     return SimpleNamespace(spec=SimpleNamespace(label=label), success=success,
@@ -184,7 +186,6 @@ def _jump_sol(label, rise, mu, knee_min_deg, tau_knee, success=True):
 
 
 def test_jump_torques_at_bound_either_sign():
-    from gaitlib.studies import jump
     lo, hi = jump.joint_bounds("knee")["tau"]
     near = _jump_sol("x", 0.1, 1.0, -90, [0.0, 0.995 * hi, 0.0])
     far = _jump_sol("x", 0.1, 1.0, -90, [0.0, 0.98 * hi, 0.5 * lo])
@@ -195,7 +196,6 @@ def test_jump_torques_at_bound_either_sign():
 
 
 def test_jump_findings_order_and_friction_verdicts():
-    from gaitlib.studies import jump
     sols = {"toeless": _jump_sol("A", 0.10, 1.5, -90, [0, 100.0, 0]),
             "toe": _jump_sol("B", 0.50, 1.0, -120, [0, 200.0, 0]),
             "ellipsoid": _jump_sol("C", 0.30, 0.5, -140, [0, 300.0, 0], success=False)}
@@ -221,7 +221,6 @@ def test_jump_findings_order_and_friction_verdicts():
 # ------------------------------------------------------------------------------ Ch 4
 
 def test_contact_ranking():
-    from gaitlib.studies import contact_id as ci
     fit = pd.DataFrame({"mean GRF RMSE (N)": [30.0, 12.0, 20.0]},
                        index=[ci.APPROACHES["a"], ci.APPROACHES["b"], ci.APPROACHES["c"]])
     assert ci.ranking(fit) == ["(b)", "(c)", "(a)"]
@@ -236,7 +235,6 @@ def _scores(rows):
 
 
 def test_mean_nrmse_weighs_kinds_equally():
-    from gaitlib.studies import predictive as pr
     sc = _scores([("MSK", "DT", "angle", 0.1, 1.0), ("MSK", "DT", "angle", 0.3, 1.0),   # angle mean 0.2
                   ("MSK", "DT", "torque", 0.4, 1.0), ("MSK", "DT", "grf", 0.6, 1.0),
                   ("MSK", "DT", "excitation", 9.0, 9.0)])                              # not a headline kind
@@ -249,7 +247,6 @@ def _study(stats, scores, marks_):
 
 
 def test_ch6_findings_verdicts():
-    from gaitlib.studies import predictive as pr
     runs = [f"{m} {c}" for m in ("MSK", "NMSK") for c in ("DT", "SDT3", "FP")]
     stats = pd.DataFrame({"converged": True, "status": "Solve_Succeeded",
                           "solve (s)": [10.0, 20.0, 30.0, 40.0, 50.0, 25.0]}, index=runs)
@@ -276,7 +273,6 @@ def test_ch6_findings_verdicts():
 
 
 def test_ch7_findings_verdicts():
-    from gaitlib.studies import predictive as pr
     classes = ("Slow", "Fast")
     runs = [f"{m} {c}" for m in ("MSK", "NMSK") for c in classes]
     stats = pd.DataFrame({"converged": [True, True, True, False],

@@ -437,11 +437,11 @@ def findings(ident, ident_thesis_tol, params_table: pd.DataFrame, margins: pd.Da
     :func:`cot_breakdown`, and its :func:`excitation_scores` (marked or not). Rows of a
     failed or invalid NMSK solve carry its mark (:func:`gaitlib.marks.mark_rows`)."""
     s0, s1 = ident.stats, ident_thesis_tol.stats
-    out = [f"MTG identification {verdict_text(s0)} in {s0['iterations']} iterations "
-           f"({s0['solve_time_s']:.1f} s solve + {s0['build_time_s']:.1f} s build). "
-           f"Eq 5.23 objective {s0['objective']:.3g}; at the thesis's tolerance 1e-5 the solve "
-           f"({verdict_text(s1)}, {s1['iterations']} it) stops at {s1['objective']:.3g}, "
-           f"{s1['cost_Gamma'] / s0['cost_Gamma']:.0f}× our parameter term."]
+    out = [(f"MTG identification {verdict_text(s0)} in {s0['iterations']} iterations "
+            f"({s0['solve_time_s']:.1f} s solve + {s0['build_time_s']:.1f} s build). "
+            f"Eq 5.23 objective {s0['objective']:.3g}; at the thesis's tolerance 1e-5 the solve "
+            f"({verdict_text(s1)}, {s1['iterations']} it) stops at {s1['objective']:.3g}, "
+            f"{s1['cost_Gamma'] / s0['cost_Gamma']:.0f}× our parameter term.")]
     out.append("Parameters the data move by more than 0.01 (tol 1e-10): "
                + ", ".join(f"{g} {k} = {v:.3g}" for (g, k), v in moved_parameters(params_table).items())
                + "; all others stay at the adult values.")
@@ -456,7 +456,7 @@ def findings(ident, ident_thesis_tol, params_table: pd.DataFrame, margins: pd.Da
     for lab, s, th in (("MSK", msk_sol, "Table 5.4"), ("NMSK", nmsk_sol, "Table 5.11")):
         st = s.stats
 
-        def rng(kind):
+        def rng(kind, s=s):
             return range_text(s.rmse.loc[s.rmse["kind"] == kind, "rmse"])
 
         out.append(f"{lab} {verdict_text(st)}: {st['iterations']} iterations, {st['solve_time_s']:.0f} s solve + "
