@@ -325,51 +325,8 @@ HTML(plots.animation_html(jump.animate(sols["ellipsoid"], max_frames=30, dpi=60,
 # Computed from the solutions above (nothing in this list is typed by hand):
 
 # %%
-def cm(v):
-    return f"{100 * v:.0f} cm"
-
-
-for n, s in sols.items():
-    h, th, st = s.jump_height, jump.THESIS[n], s.stats
-    verdict = "converged" if st["success"] else f"did NOT converge ({st['status']})"
-    print(f"• {s.spec.label}: {verdict} in {st['iterations']} iterations, {st['solve_time_s']:.0f} s. "
-          f"COM rise in flight {cm(h['com_rise_flight'])} (take-off v_y {h['takeoff_vy']:.2f} m/s), "
-          f"MTP lift {cm(h['foot_lift'])} — thesis {th['jump_height_cm']:.0f} cm; "
-          f"required μ_s {s.required_friction:.2f} — thesis {th['mu_s']:g}; deepest knee "
-          f"{np.degrees(s.trajectory['knee'].min()):.0f}° — thesis {th['knee_min_deg']:.0f}°.")
-if not all(s.success for s in sols.values()):
-    print("• NOT every solve converged: the figures and numbers of a failed solve are the last "
-          "iterate of IPOPT, shown for diagnosis only.")
-rise = {n: s.jump_height["com_rise_flight"] for n, s in sols.items()}
-order = sorted(rise, key=rise.get)
-print(f"• Order of jump heights (COM rise): {' < '.join(order)}; thesis: toeless < toe < ellipsoid"
-      f" — {'the same order' if order == ['toeless', 'toe', 'ellipsoid'] else 'a DIFFERENT order'}.")
-ratio = {n: s.jump_height["com_rise_flight"] / (jump.THESIS[n]['jump_height_cm'] / 100)
-         for n, s in sols.items()}
-print("• Our COM rise ÷ the thesis's jump height: "
-      + ", ".join(f"{n} {r:.1f}×" for n, r in ratio.items()))
-mu = {n: s.required_friction for n, s in sols.items()}
-lower = mu["ellipsoid"] < min(mu["toeless"], mu["toe"])
-print(f"• Required static friction: ellipsoid contact {mu['ellipsoid']:.2f}, welded toeless "
-      f"{mu['toeless']:.2f}, welded toe-included {mu['toe']:.2f} — the ellipsoid contact needs "
-      f"{'LESS than either welded contact, as in the thesis' if lower else 'NOT less than both welded contacts, unlike the thesis'}."
-      f" Largest μ_s of its ellipsoids: {max(contact_params[13 * i + 2] for i in range(3)):.2f}.")
-peak = {n: max(s.trajectory[f'tau_{j}'].abs().max() for j in s.model.joints) for n, s in sols.items()}
-print("• Largest joint torque: " + ", ".join(f"{n} {v:.0f} N·m" for n, v in peak.items())
-      + " (Table 3.5 allows 1500–4000 N·m); peak F_y "
-      + ", ".join(f"{n} {s.trajectory['grf_y'].max() / (s.model.total_mass * cv.G):.1f}×"
-                  for n, s in sols.items()) + " the body weight.")
-at_bound = {n: [j for j in s.model.joints
-                if max(s.trajectory[f"tau_{j}"].max() / jump.joint_bounds(j)["tau"][1],
-                       s.trajectory[f"tau_{j}"].min() / jump.joint_bounds(j)["tau"][0]) > 0.99]
-            for n, s in sols.items()}
-print("• Joint torques at (≥ 99 % of) their Table 3.5 bound: "
-      + "; ".join(f"{n}: {', '.join(v) or 'none'}" for n, v in at_bound.items()) + ".")
-coarse = {n: s.solution.info["continuation"][0]["com_rise_flight"] for n, s in sols.items()
-          if s.solution.info.get("continuation")}
-print("• The 5-interval optima the final solves started from: "
-      + ", ".join(f"{n} {cm(v)}" for n, v in coarse.items())
-      + " — local optima of the same problem, far from the 10-interval ones.")
+for line in jump.findings(sols, contact_params):
+    print("• " + line)
 
 # %% [markdown]
 # **Why our heights differ from the thesis's.** Nothing in the thesis's formulation limits

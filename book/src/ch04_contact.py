@@ -334,48 +334,7 @@ print(f"stored file vs this page's (c): largest difference {cmp['max_rel_diff_co
 # Computed from the results above (nothing in this paragraph is typed by hand):
 
 # %%
-def _f(x, d=1):
-    return f"{x:.{d}f}"
-
-st = {k: r.stats for k, r in res.items()}
-for k, r in res.items():
-    s = r.stats
-    ok = "converged (Optimal Solution Found)" if s["success"] else f"did NOT converge ({s['status']})"
-    extra = ""
-    if k == "a":
-        extra = f" — {s['n_converged']} of {s['n_local']} local solves converged, best from {s['best_start']}"
-    if k == "b":
-        bad = b.stages[b.stages["status"] != "Solve_Succeeded"]
-        extra = (f" — final problem {b.stats['iterations_final']} iterations; continuation stages not converged: "
-                 + (", ".join(f"{tuple(x)} ({y})" for x, y in zip(bad["residual bounds (N, N, N·m)"], bad["status"]))
-                    or "none"))
-    print(f"• {ci.APPROACHES[k]} {ok}: {s['iterations']} iterations, {s['wall_s'] / 60:.1f} min wall "
-          f"({1e3 * s['time_per_iteration_s']:.0f} ms/iteration); thesis {ci.THESIS_TIME[k]}{extra}.")
-m = fit["mean GRF RMSE (N)"]
-order = " < ".join(f"{lab.split(' ')[0]} {v:.1f} N" for lab, v in m.sort_values().items())
-print(f"• Mean GRF RMSE, best first: {order}. Thesis (Sec 4.5, tangential / normal): (a) 36.5 / 234.6 N, "
-      f"(b) 14.1 / 26.4 N, (c) 3.0 / 10.3 N.")
-mw = ci.grf_fit({"c_wide": cw})["mean GRF RMSE (N)"].iloc[0]
-ranked = list(m.sort_values().index.str[:3])
-print("• The thesis's ranking (c) better than (b) better than (a) "
-      + ("holds on our data." if ranked == ["(c)", "(b)", "(a)"] else f"does NOT hold on our data: {ranked}."))
-for k in ("b", "c"):
-    lab = ci.APPROACHES[k]
-    print(f"• {lab}: vertical GRF error per foot {dc.loc[lab, 'achieved per foot, y (N)']:.1f} N, of which the "
-          f"kinematics force at least {dc.loc[lab, 'floor per foot, y (N)']:.1f} N (total-force mismatch); "
-          f"tangential {dc.loc[lab, 'achieved per foot, x (N)']:.1f} N vs a floor of "
-          f"{dc.loc[lab, 'floor per foot, x (N)']:.1f} N. Share of the vertical squared error in the data's swing: "
-          + ", ".join(f"{f} {ph.loc[(lab, f), 'share of squared error in swing (%)']:.0f} % "
-                      f"(mean {ph.loc[(lab, f), 'mean simulated force in swing (N)']:.0f} N carried in swing)"
-                      for f in ("right", "left")) + ".")
-for k in res:
-    rr = ci.residual_rms(res[k])
-    print(f"• {ci.APPROACHES[k]}: pelvis residual RMS R_x {_f(rr['R_x'])} N, R_y {_f(rr['R_y'])} N, "
-          f"R_z {_f(rr['R_z'], 2)} N·m (thesis Table 4.9: (a) 94.4 N, 349.0 N, 18.1 N·m; (b) 0).")
-print(f"• With Table 4.7 widened to contain the thesis's (c) values, (c′) {cw.stats['status']} reaches a mean GRF "
-      f"RMSE of {mw:.1f} N ({'better' if mw < m[ci.APPROACHES['b']] else 'not better'} than (b)'s {m[ci.APPROACHES['b']]:.1f} N), "
-      f"objective {cw.stats['objective']:.4f} vs (c) {c.stats['objective']:.4f}.")
-print(f"• (c) total body mass {model.total_mass(c.p_body):.2f} kg (thesis 41.80 kg); "
-      f"{len(ci.at_bounds(c))} of 64 parameters at a bound.")
+for line in ci.findings(res, cw, fit, dc, ph):
+    print("• " + line)
 print(f"• This page ran in {time.perf_counter() - t_chapter:.0f} s "
       f"({'from the solution cache' if all(r.stats['from_cache'] for r in res.values()) else 'solving at least one approach'}).")

@@ -391,69 +391,10 @@ marks.mark_rows(msk.mtb_scale_table(nmsk_sol), marks.failure_label(nmsk_sol))
 # Computed from the results above:
 
 # %%
-def verdict(st):
-    return "converged" if st["success"] else f"did NOT converge ({st['status']})"
-
-def rng(s, kind):
-    r = s.rmse[s.rmse["kind"] == kind]["rmse"]
-    return f"{r.min():.1f}–{r.max():.1f}"
-
-print(f"• MTG identification {verdict(ident.stats)} in {ident.stats['iterations']} iterations "
-      f"({ident.stats['solve_time_s']:.1f} s solve + {ident.stats['build_time_s']:.1f} s build). "
-      f"Eq 5.23 objective {ident.stats['objective']:.3g}; at the thesis's tolerance 1e-5 the solve "
-      f"({verdict(ident_thesis_tol.stats)}, {ident_thesis_tol.stats['iterations']} it) stops at "
-      f"{ident_thesis_tol.stats['objective']:.3g}, "
-      f"{ident_thesis_tol.stats['cost_Gamma'] / ident.stats['cost_Gamma']:.0f}× our parameter term.")
-moved = tab[(tab["ours (tol 1e-10)"] - tab["initial (Eq 5.22)"]).abs() > 1e-2]
-print("• Parameters the data move by more than 0.01 (tol 1e-10): "
-      + ", ".join(f"{g} {k} = {v:.3g}" for (g, k), v in moved["ours (tol 1e-10)"].items())
-      + "; all others stay at the adult values.")
-m0 = margins["Gymnast (Eq 5.22)"]
-short = m0[m0["Eq 5.15"] < 0]["Eq 5.15"]
-print("• With the adult curves, Eq 5.15 fails for " + ", ".join(f"{g} (short by {-v:.1f} N·m)"
-      for g, v in short.items()) + "; thesis Table 5.2 leaves " +
-      (", ".join(f"{g} short by {-v:.1f} N·m" for g, v in margins["thesis Table 5.2"]["Eq 5.15"].items() if v < 0)
-       or "no generator short on our data") + f"; ours: worst Eq 5.15 margin on the fine grid {margins['ours']['Eq 5.15'].min():.2f} N·m "
-      "(constraints hold at the collocation points; between them the push-off peak is sampled more finely).")
-def thesis_rng(model, kind):
-    v = [x for (k, _, _), x in gait.THESIS_RMSE[model].items() if k == kind]
-    return f"{min(v):.1f}–{max(v):.1f}"
-
-for lab, s, th in (("MSK", msk_sol, "Table 5.4"), ("NMSK", nmsk_sol, "Table 5.11")):
-    st = s.stats
-    print(f"• {lab} {verdict(st)}: {st['iterations']} iterations, {st['solve_time_s']:.0f} s solve + "
-          f"{st['build_time_s']:.0f} s build ({1e3 * st['time_per_iteration_s']:.0f} ms/iteration; thesis: 2 h). "
-          f"RMSE angles {rng(s, 'angle')} deg, torques {rng(s, 'torque')} N·m, GRFs {rng(s, 'grf')} N "
-          f"(thesis, {th}: angles {thesis_rng(lab, 'angle')} deg, torques {thesis_rng(lab, 'torque')} N·m, "
-          f"GRFs {thesis_rng(lab, 'grf')} N).")
-act = marks.mark_rows(msk.activation_table(nmsk_sol), marks.failure_label(nmsk_sol))
-print("• Activation parameters (ours): " + ", ".join(
-    f"{k} = {v:.4g}" + (f" (at its {b} bound)" if b else "") for k, v, b in
-    zip(act.index, act["ours"], act["ours at bound"])) + " — thesis Table 5.10: τ_act 0.006 s, c3 0.0001, s1 = s2 = 0.25.")
-c = cot["Eq 5.47 as printed (NLP)"]
-cb = cot["Bhargava F_iso = a τ0 t^A"]
-print(f"• COT {c['total']:.2f} J/(kg·m) (thesis 1.53): shortening heat {c['shortening']:.2f}, activation "
-      f"{c['activation']:.2f}, maintenance {c['maintenance']:.2f}, work {c['work']:.2f}, basal {c['basal']:.3f}; "
-      f"with Bhargava's isometric force the same motion costs {cb['total']:.2f}.")
-best = scores["r (Schwartz)"].dropna()
-print("• Excitation–EMG correlation (Schwartz): " + ", ".join(f"{m} {v:+.2f}" for m, v in best.items())
-      + "; gaitutils: " + ", ".join(f"{m} {v:+.2f}" for m, v in scores["r (gaitutils)"].items()) + ".")
-err = {}
-for j in ("hip_r", "knee_r", "ankle_r", "hip_l", "knee_l", "ankle_l"):
-    ref_j = np.interp(msk_sol.q.index, tracked.time, tracked.mean[j])
-    e = (msk_sol.q[j] - ref_j).abs() / cv.DEG
-    err[j] = (e.max(), 100 * e.idxmax() / free.cycle_time)
-worst_j = max(err, key=lambda k: err[k][0])
-print(f"• The MSK's largest angle error: {worst_j} {err[worst_j][0]:.0f} deg at {err[worst_j][1]:.0f} % of the cycle "
-      f"(right heel strike at 0 %); errors per joint (max deg @ % cycle): "
-      + ", ".join(f"{k} {v[0]:.0f} @ {v[1]:.0f}" for k, v in err.items()) + ".")
-gw = 1 - nmsk_sol.stats["activation_parameters"]["s1"] - nmsk_sol.stats["activation_parameters"]["s2"]
-print(f"• GAM's weight in the ankle extensor (1 − s1 − s2) = {gw:.2g}; mean node-to-node |Δe| of our excitations "
-      f"{scores['mean |Δe| per node (ours)'].mean():.3f} vs {scores['mean |Δ| per node (EMG)'].mean():.3f} for the EMG.")
-mt = marks.mark_rows(msk.mtb_scale_table(nmsk_sol), marks.failure_label(nmsk_sol))
-print(f"• The Mtb term is {100 * mt['w·Mtb (approx.)'].iloc[0] / nmsk_sol.stats['objective']:.1f} % of the NMSK "
-      f"objective with d read as the stride; read as the 50 ms delay it would be "
-      f"{mt['w·Mtb (approx.)'].iloc[1] / nmsk_sol.stats['objective']:.0f}× the whole objective.")
+angle_err = msk.angle_errors(msk_sol.q, tracked.time, tracked.mean, free.cycle_time)
+for line in msk.findings(ident, ident_thesis_tol, mtg_id.table_beside_thesis(ident), margins, msk_sol, nmsk_sol,
+                         angle_err, cot, scores):
+    print("• " + line)
 print(f"• This page's solves and identifications took {time.perf_counter() - T0:.0f} s of wall time "
       f"(from cache where available: MSK {msk_sol.stats.get('from_cache')}, NMSK {nmsk_sol.stats.get('from_cache')}).")
 

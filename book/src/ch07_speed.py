@@ -143,28 +143,7 @@ pd.concat({"scaled Free data vs class data": ctrl, "MSK prediction": _pred("MSK"
 ch6_dt = pr.cost_function_study(("NMSK",), ("DT",), progress=False).solutions.get("NMSK DT")
 CH5_ROW = "Free (Ch 5 Eq 5.55)"
 cot = pr.cot_table(res, {"Free": ch6_dt, CH5_ROW: res.baselines.get("NMSK")})
-curve = cot.drop(index=CH5_ROW, errors="ignore")
-fig, ax = plt.subplots(figsize=(8.0, 3.6), layout="constrained")
-okc = curve[curve["mark"] == ""]
-ax.plot(okc["speed (m/s)"], okc["COT (J/kg/m)"], "o-", color="C1", label="ours (NMSK DT, converged; Free = Ch 6 DT)")
-bad = curve[curve["mark"] != ""]
-if len(bad):
-    ax.plot(bad["speed (m/s)"], bad["COT (J/kg/m)"], "x", color=marks.MARK_COLOR, ms=9, mew=2,
-            label=f"{marks.DAGGER} ours, NOT converged")
-    for name, r in bad.iterrows():
-        ax.annotate(f"{marks.DAGGER} {r['mark']}", (r["speed (m/s)"], r["COT (J/kg/m)"]), fontsize=6,
-                    color=marks.MARK_COLOR, textcoords="offset points", xytext=(-4, -12), ha="right")
-if CH5_ROW in cot.index:
-    r5 = cot.loc[CH5_ROW]
-    ax.plot([r5["speed (m/s)"]], [r5["COT (J/kg/m)"]], "D", mfc="none", color="C2", ms=7,
-            label=marks.run_label("Ch 5 NMSK Eq 5.55 (own activation params)", r5["mark"]))
-th = pd.DataFrame(pr.THESIS_COT_FIG_7_5, columns=["class", "speed", "COT"])
-ax.plot(th["speed"], th["COT"], "s--", color="0.5", label="thesis, Fig 7.5 (different data)")
-for name, r in curve.iterrows():
-    ax.annotate(name, (r["speed (m/s)"], r["COT (J/kg/m)"]), fontsize=7, textcoords="offset points", xytext=(4, 4))
-ax.set_xlabel("walking speed (m/s)")
-ax.set_ylabel("COT (J kg⁻¹ m⁻¹)")
-ax.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.01, 0.5))
+fig = pr.cot_figure(cot, CH5_ROW)
 cot
 
 # %% [markdown]
@@ -189,39 +168,4 @@ for c in classes:
 # reported apart, named).
 
 # %%
-ok = stats["converged"]
-pred_ok = (res.converged_scores().query("kind in ['angle', 'torque', 'grf']")
-           .groupby(["model", "case", "kind"])["nrmse"].mean().unstack("kind"))
-left_out = [k for k, v in run_marks.items() if v]
-lines = [f"- {int(ok.sum())} of {len(ok)} runs converged"
-         + ("" if ok.all() else "; not converged: " + ", ".join(f"{k} ({v})" for k, v in stats.loc[~ok, 'status'].items()))
-         + f"; IPOPT solve time {stats['solve (s)'].min():.0f}–{stats['solve (s)'].max():.0f} s per run here vs 4–18 h in the thesis (Table 7.2)."]
-both = [c for c in classes if ("NMSK", c) in pred_ok.index and ("MSK", c) in pred_ok.index]
-if both:
-    tq = pred_ok["torque"]
-    better = [c for c in both if tq[("NMSK", c)] < tq[("MSK", c)]]
-    lines.append(f"- Torque NRMSE: NMSK below MSK for {', '.join(better) if better else 'no class'} of the "
-                 f"{len(both)} classes where both runs converged and pass the validity gates"
-                 + (f" (not compared: {', '.join(c for c in classes if c not in both)})" if len(both) < len(classes) else "")
-                 + " (thesis: NMSK 2–17 % better at every speed).")
-nm = [c for c in classes if ("NMSK", c) in pred_ok.index]
-beat = [(c, k) for c in nm for k in ("angle", "torque", "grf") if pred_ok.loc[("NMSK", c), k] < ctrl.loc[c, k]]
-lines.append(f"- The converged NMSK predictions are closer to the untracked class data than the scaled Free data they "
-             f"tracked in {len(beat)} of {3 * len(nm)} class × kind cells"
-             + (f" ({', '.join(c for c in classes if c not in nm)} left out: not converged)" if len(nm) < len(classes) else "") + ".")
-cc = curve[curve["mark"] == ""]
-r5 = cot.loc[CH5_ROW] if CH5_ROW in cot.index else None
-if len(cc) >= 3:
-    imin = cc["COT (J/kg/m)"].idxmin()
-    lines.append(f"- COT (NMSK DT, converged runs; Free = the Ch 6 NMSK DT run): "
-                 f"{', '.join(f'{i} {v:.2f}' for i, v in cc['COT (J/kg/m)'].items())} J/(kg·m); minimum at {imin} "
-                 f"({'the natural speed — a U-curve as the thesis reports' if imin == 'Free' else 'not at the natural speed — no U-curve with the minimum at Free'}). "
-                 "Thesis (Fig 7.5): 2.18, 1.99, 1.53, 1.96, 1.99 at XS, S, N, M, L."
-                 + (f" The Ch 5 NMSK solution (Eq 5.55, its own activation parameters) has {r5['COT (J/kg/m)']:.2f}"
-                    + (f" ({r5['mark']})" if r5["mark"] else "") + "; it is not on the curve." if r5 is not None else ""))
-for k, r in inv.items():
-    if k.startswith("NMSK "):
-        lines.append(f"- {k} stopped at 1000 iterations; rerun at 3000 it {'converged' if r.stats['success'] else 'did NOT converge'} "
-                     f"({r.stats['status']}, {r.stats['iterations']} iterations) with COT {r.stats.get('COT', float('nan')):.2f} J/(kg·m) "
-                     "(not in the figure, which keeps the study's own runs).")
-print("\n".join(lines))
+print("\n".join(pr.ch7_findings(res, classes, ctrl, cot, inv, CH5_ROW)))

@@ -31,7 +31,7 @@ import numpy as np
 import pandas as pd
 
 from gaitlib import gap, marks
-from gaitlib.gap import diagnose as D, figures as F, locate as L
+from gaitlib.gap import diagnose as D, figures as F, locate as L, twin
 from gaitlib.studies import gap as G
 from IPython.display import Markdown, display
 
@@ -184,20 +184,17 @@ rows[["twin", "injected", "magnitude", "top", "verdict", "correct", "identified_
       "true_start"]]
 
 # %%
-gen_ok = sum(v["status"] == "Solve_Succeeded" for v in tv.gen_stats.values())
-acc_mid = float(acc.loc["middle", "top-1 accuracy (%)"])
-shr = rows.loc[rows["injected"] != "none", "shrink_injected_top"]
-shr_mean, shr_n = float(shr.clip(upper=100.0).mean()), int(shr.count())
-shr_raw, shr_med = float(shr.mean()), float(shr.median())
-shr_noise = float(rows.loc[rows["injected"] != "none", "shrink_vs_noise_top"].mean())
-wrong = rows[~rows["correct"]]
-none_ok = rows.loc[rows["injected"] == "none", "correct"]
-print(f"twin generation: {gen_ok} of {len(tv.gen_stats)} solves converged; diagnosis runs: {len(rows)}")
-print(f"top-1 accuracy at the middle magnitude: {acc_mid:.0f} % (target ≥ 90 %: {'met' if acc_mid >= 90 else 'NOT met'})")
-print(f"mean shrink of the injected gap over all magnitudes, each twin capped at 100 %: {shr_mean:.0f} % "
-      f"({shr_n} twins where defined; target ≥ 60 %: {'met' if shr_mean >= 60 else 'NOT met'}); "
-      f"uncapped mean {shr_raw:.0f} %, median {shr_med:.0f} %; against the noise floor: {shr_noise:.0f} %")
-print(f"effect-free twins named 'unexplained': {int(none_ok.sum())} of {len(none_ok)}")
+st = tv.summary()
+wrong = tv.misses()
+met = {True: "met", False: "NOT met"}
+print(f"twin generation: {st['gen_converged']} of {st['gen_total']} solves converged; diagnosis runs: {st['twins']}")
+print(f"top-1 accuracy at the middle magnitude: {st['top1_pct']:.0f} % "
+      f"(target ≥ {twin.TARGET_TOP1_PCT:.0f} %: {met[st['top1_met']]})")
+print(f"mean shrink of the injected gap over all magnitudes, each twin capped at 100 %: {st['shrink_pct']:.0f} % "
+      f"({st['shrink_defined']} twins where defined; target ≥ {twin.TARGET_SHRINK_PCT:.0f} %: {met[st['shrink_met']]}); "
+      f"uncapped mean {st['shrink_uncapped_pct']:.0f} %, median {st['shrink_median_pct']:.0f} %; "
+      f"against the noise floor: {st['shrink_vs_noise_pct']:.0f} %")
+print(f"effect-free twins named 'unexplained': {st['free_unexplained']} of {st['free_twins']}")
 print("misnamed twins:")
 wrong[["twin", "injected", "magnitude", "top", "dBIC_top", "dBIC_true", "identified_magnitude"]]
 
@@ -208,14 +205,12 @@ wrong[["twin", "injected", "magnitude", "top", "dBIC_top", "dBIC_true", "identif
 
 # %%
 thr = D.BIC_THRESHOLD
-true_not_better = [(r.twin, r.dBIC_true, r.dBIC_top) for r in wrong.itertuples()
-                   if not (np.isfinite(r.dBIC_true) and r.dBIC_true <= thr
-                           and (not np.isfinite(r.dBIC_top) or r.dBIC_true < r.dBIC_top))]
+true_not_better = wrong[wrong["true_not_named"]]
 print(f"misnamed twins where even the true model, fitted the same way, would not have been named: "
       f"{len(true_not_better)} of {len(wrong)}")
-for t, bt, bn in true_not_better:
-    print(f"  {t}: ΔBIC true = {bt:.1f}, named = {bn:.1f}" if np.isfinite(bn) else
-          f"  {t}: ΔBIC true = {bt:.1f} (threshold {thr:g}), nothing named")
+for r in true_not_better.itertuples():
+    print(f"  {r.twin}: ΔBIC true = {r.dBIC_true:.1f}, named = {r.dBIC_top:.1f}" if np.isfinite(r.dBIC_top) else
+          f"  {r.twin}: ΔBIC true = {r.dBIC_true:.1f} (threshold {thr:g}), nothing named")
 
 # %% [markdown]
 # Where that count equals the number of misnamed twins, the ranking is not what fails:
@@ -238,27 +233,10 @@ rf = tvf.rows
 display(rf[["twin", "injected", "magnitude", "top", "verdict", "correct", "identified_magnitude", "rss_base",
             "base_start", "rss_top", "rss_true_fixed", "rss_gen", "shrink_injected_top", "shrink_vs_noise_top", "dBIC_top",
             "dBIC_true", "retried", "true_start"]])
-inj_f = rf[rf["injected"] != "none"]
-acc_f = 100 * float(inj_f["correct"].mean())
-shr_f = float(inj_f["shrink_injected_top"].clip(upper=100.0).mean())
-shr_f_noise = float(inj_f["shrink_vs_noise_top"].mean())
-none_f = rf.loc[rf["injected"] == "none", "correct"]
-gen_f = sum(v["status"] == "Solve_Succeeded" for v in tvf.gen_stats.values())
-by_seed = ", ".join(f"seed {k}: {100 * v:.0f} %" for k, v in inj_f.groupby("seed")["correct"].mean().items())
-print(f"20 × 5 mesh, middle magnitude: top-1 accuracy {acc_f:.0f} % ({int(inj_f['correct'].sum())} of {len(inj_f)}; "
-      f"{by_seed}); "
-      f"mean shrink of the injected gap (capped at 100 %) {shr_f:.0f} % ({int(inj_f['shrink_injected_top'].count())} "
-      f"defined), against the noise floor {shr_f_noise:.0f} %; effect-free twin named 'unexplained': "
-      f"{int(none_f.sum())} of {len(none_f)}; twin generation {gen_f} of {len(tvf.gen_stats)} converged")
-wrong_f = rf[~rf["correct"]]
-for r in wrong_f.itertuples():
-    if r.injected == "none":
-        print(f"  {r.twin}: named {r.top} (ΔBIC {r.dBIC_top:.1f}) on a baseline fit with RSS {r.rss_base:.1f}, "
-              f"{r.rss_base / r.rss_gen:.1f}× the generating solution's own RSS on its twin")
-    else:
-        print(f"  {r.twin}: named {r.top}; the injected effect's own candidate fit reaches RSS {r.rss_true:.1f} "
-              f"(ΔBIC {r.dBIC_true:+.1f}), the true model with its magnitude fixed {r.rss_true_fixed:.1f}, against the "
-              f"baseline's {r.rss_base:.1f} (start: {r.base_start}) and the generating solution's {r.rss_gen:.1f}")
+head, *misses = G.twin_full_mesh_lines(tvf)
+print(head)
+for line in misses:
+    print("  " + line)
 
 # %% [markdown]
 # **How the method got here.** The earlier versions of this chapter ran the same check
@@ -273,30 +251,7 @@ for r in wrong_f.itertuples():
 # which the retry now catches. What the current method gives:
 
 # %%
-wf = rf[rf["injected"] != "none"]
-base_wins = rf["base_start"].value_counts().to_dict()
-retried_twins = int((rf["retried"] > 0).sum())
-lines_f = [f"Baseline fits kept, by start: {', '.join(f'{k} {v}' for k, v in base_wins.items())}. "
-           f"Twins with at least one candidate re-solved from another start: {retried_twins} of {len(rf)} "
-           f"({int(rf['retried'].sum())} candidate fits); the injected effect's kept fit came from another start "
-           f"than the baseline fit in {int((wf['true_start'].fillna('best') != 'best').sum())} of {len(wf)} twins."]
-if acc_f >= 90 and shr_f >= 60 and bool(none_f.all()):
-    lines_f.append(f"On the 20 × 5 mesh the check **is passed**: {acc_f:.0f} % top-1 at the middle magnitude "
-                   f"(target ≥ 90 %), {shr_f:.0f} % mean shrink (target ≥ 60 %), every effect-free twin "
-                   f"'unexplained'.")
-else:
-    lines_f.append(f"On the 20 × 5 mesh the check is **not passed** ({acc_f:.0f} % top-1 at the middle magnitude, "
-                   f"target ≥ 90 %; {shr_f:.0f} % mean shrink, target ≥ 60 %; effect-free twins 'unexplained' "
-                   f"{int(none_f.sum())} of {len(none_f)}); the real-data results of Sec. 4 are on 20 × 5 and carry "
-                   f"this caveat.")
-for r in wrong_f.itertuples():
-    if r.injected != "none":
-        why = ("its own candidate fit ends above the baseline's even after the retry"
-               if np.isfinite(r.rss_true) and r.rss_true >= r.rss_base else
-               "its own fit closes less of the gap, by the criterion, than the named effect's")
-        lines_f.append(f"The miss {r.twin} (named {r.top}): {why} (RSS {r.rss_true:.1f} against the baseline's "
-                       f"{r.rss_base:.1f}; the true model with its magnitude fixed {r.rss_true_fixed:.1f}).")
-display(Markdown("\n\n".join(lines_f)))
+display(Markdown("\n\n".join(G.twin_full_mesh_verdict(tvf))))
 
 # %% [markdown]
 # ## 4. Findings on the real data
@@ -481,92 +436,5 @@ if len(ch7):
 # ## Findings
 
 # %%
-e0 = emg.set_index("model")
-ta0, mg0 = float(e0.loc["baseline", "RSS TA"]), float(e0.loc["baseline", "RSS MG"])
-cc_row = e0.loc["co_contraction"] if "co_contraction" in e0.index else None
-rk = dN.ranking.set_index("effect")
-lines = []
-lines.append(
-    f"**Twins.** Over {len(rows)} twins ({len(rows) - len(none_ok)} with an injected effect), the diagnosis named the "
-    f"injected effect in {acc_mid:.0f} % of the middle-magnitude twins "
-    f"({', '.join(f'{k}: {v:.0f} %' for k, v in acc['top-1 accuracy (%)'].items())} by magnitude) — the target of "
-    f"90 % is {'met' if acc_mid >= 90 else 'not met'} — and said 'unexplained' for {int(none_ok.sum())} of "
-    f"{len(none_ok)} effect-free twins. The named effects closed on average {shr_mean:.0f} % of the injected gap "
-    f"(against the true model fitted the same way, each twin capped at 100 %, {shr_n} twins; target 60 %: "
-    f"{'met' if shr_mean >= 60 else 'not met'}; median {shr_med:.0f} %), but only {shr_noise:.0f} % of the gap down to "
-    f"the noise floor, which also counts the coarse mesh's own residual: on the 10 × 3 mesh the true model "
-    f"itself does not reach the noise.")
-lines.append(
-    f"**Twins on the thesis's 20 × 5 mesh** (middle magnitude, two seeds): top-1 accuracy {acc_f:.0f} % — the 90 % "
-    f"target is {'met' if acc_f >= 90 else '**not met** on this mesh'} — effect-free twin 'unexplained' "
-    f"{int(none_f.sum())} of {len(none_f)}, mean shrink of the injected gap {shr_f:.0f} % (capped), {shr_f_noise:.0f} % "
-    f"against the noise floor. "
-    + ("The method is validated on both meshes, including the one of the real-data diagnoses below."
-       if acc_f >= 90 and shr_f >= 60 and bool(none_f.all()) else
-       "The validated configuration is the 10 × 3 mesh; on 20 × 5 the fits, not the criterion, limit the "
-       "diagnosis, and the real-data findings below carry that caveat."))
-lines.append(
-    f"**Schwartz 2008 Free.** The SK baseline fit leaves {sS['significant_cells']} of {sS['cells']} channel × phase "
-    f"cells significantly outside the band (RMS z = {sS['rms_z']:.2f}); the largest cell is "
-    f"{G.top_cells(dS.located, 1).iloc[0]['channel']} in {G.top_cells(dS.located, 1).iloc[0]['phase']}. "
-    + (f"The diagnosis names **{sS['top']}** ({sS['verdict']}): it closes {sS['best_pct']:.0f} % of the RSS "
-       f"(95 % interval {sS['interval'][0]:.0f}–{sS['interval'][1]:.0f} %, ΔBIC = {sS['best_dBIC']:.1f})."
-       if sS["top"] != "unexplained" else
-       f"No candidate passes the criterion: **unexplained** (best {sS['best']}, {sS['best_pct']:.0f} % closed, "
-       f"ΔBIC = {sS['best_dBIC']:.1f}; threshold {D.BIC_THRESHOLD:g})."))
-lines.append(
-    f"**gaitutils.** On angles and moments only, RMS z = {sU['rms_z']:.2f}; "
-    + (f"the diagnosis names **{sU['top']}** ({sU['verdict']}, {sU['best_pct']:.0f} % closed, "
-       f"interval {sU['interval'][0]:.0f}–{sU['interval'][1]:.0f} %)."
-       if sU["top"] != "unexplained" else
-       f"**unexplained** (best {sU['best']}, {sU['best_pct']:.0f} % closed, ΔBIC = {sU['best_dBIC']:.1f}; threshold {D.BIC_THRESHOLD:g})."))
-def _flip(c):
-    r = c["ranking"]
-    f = r[(r["% closed (data as tracked)"] >= 5) & (r["% closed (left leg shifted exactly)"] <= 0)]["effect"]
-    return ", ".join(f)
-
-
-def _left_line(lab, c, d):
-    r = c["ranking"]
-    top_x, top_t = r.iloc[0], r.sort_values("% closed (data as tracked)", ascending=False).iloc[0]
-    gen_share = 100 * (1 - c["rss"]["left leg shifted exactly"] / c["rss"]["data as tracked"])
-    return (f"{lab}: against the exactly shifted left leg the baseline's RSS is "
-            f"{c['rss']['left leg shifted exactly']:.0f} instead of {c['rss']['data as tracked']:.0f} "
-            f"({'−' if gen_share > 0 else '+'}{abs(gen_share):.0f} %); the best candidate fit is then "
-            f"{top_x['effect']} ({top_x['% closed (left leg shifted exactly)']:.0f} % closed), against "
-            f"{top_t['effect']} ({top_t['% closed (data as tracked)']:.0f} %) on the data as tracked")
-
-
-lines.append("**The generated left leg.** " + _left_line("Schwartz 2008 Free", chkS, dS) + "; "
-             + _left_line("gaitutils", chkU, dU) + ". "
-             + " ".join(f"On {lab}, {_flip(c)} closes ≥ 5 % of the gap as tracked but nothing against the exact "
-                        f"shift: it was fitting the generated left leg, not a property of the children."
-                        for lab, c in (("Schwartz 2008", chkS), ("gaitutils", chkU)) if _flip(c))
-             + " The data's left leg is part of what any tracking study measures; this diagnosis makes it visible.")
-_c = conv.sort_values("RMS z, angles/torques/GRFs")
-lines.append(
-    f"**The book's Ch 5–7 solutions.** {len(conv)} of {len(bg)} converged. Their RMS z over angles, torques and "
-    f"GRFs runs from {_c.iloc[0]['RMS z, angles/torques/GRFs']:.1f} ({_c.iloc[0]['chapter']} {_c.iloc[0]['model']} "
-    f"{_c.iloc[0]['case']}) to {_c.iloc[-1]['RMS z, angles/torques/GRFs']:.1f} ({_c.iloc[-1]['chapter']} "
-    f"{_c.iloc[-1]['model']} {_c.iloc[-1]['case']}), against {sS['rms_z']:.2f} for the SK model fitted by the "
-    f"diagnosis's SD-standardised objective: the thesis's cost functions normalise each channel's error by its "
-    f"range (max − min), not by the data's SD, so their fits leave the band where the band is narrow. The largest cell is a left-leg channel in "
-    f"{left_top:.0f} % of them.")
-if cc_row is not None and np.isfinite(cc_row.get("RSS TA", np.nan)):
-    ta1, mg1 = float(cc_row["RSS TA"]), float(cc_row["RSS MG"])
-    closes = (ta1 + mg1) < 0.5 * (ta0 + mg0)
-    lines.append(
-        f"**Co-contraction (thesis Sec 5.3.5).** On the Ch 5 NMSK solution the TA excitation is on average "
-        f"{abs(float(e0.loc['baseline', 'mean z TA'])):.1f} SD {'below' if e0.loc['baseline', 'mean z TA'] < 0 else 'above'} "
-        f"its EMG and the MG/GAM excitation {abs(float(e0.loc['baseline', 'mean z MG'])):.1f} SD "
-        f"{'below' if e0.loc['baseline', 'mean z MG'] < 0 else 'above'}. The best co-contraction "
-        f"({cc_row['parameters']}, {cc_row['status']}) changes the TA + MG RSS from {ta0 + mg0:.0f} to {ta1 + mg1:.0f} "
-        f"({100 * (1 - (ta1 + mg1) / (ta0 + mg0)):.0f} % closed) and the whole gap by "
-        f"{float(rk.loc['co_contraction', 'pct_closed']):.0f} % (ΔBIC = {float(rk.loc['co_contraction', 'dBIC']):.0f}): "
-        + ("co-contraction **does** close most of the TA/GAM gap, as the thesis suspected."
-           if closes else "co-contraction does **not** close the TA/GAM gap — the thesis's suspicion is not borne out "
-                          "on these data.")
-        + (f" The NMSK diagnosis names **{dN.top_effect}** ({dN.verdict})." if dN.top_effect != "unexplained" else
-           " No muscle-level candidate passes the criterion on the NMSK solution: its gap stays **unexplained**."))
-display(Markdown("\n\n".join(lines)))
+display(Markdown("\n\n".join(G.findings(tv, tvf, dS, dU, dN, chkS, chkU, bg, emg))))
 print(f"notebook time: {time.perf_counter() - T0:.0f} s")

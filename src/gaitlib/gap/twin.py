@@ -254,6 +254,12 @@ def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), 
         "n_subjects": real.n, "noise_length": NOISE_LENGTH, "baseline_failed": base_failed})
 
 
+#: Target of the twin check: top-1 accuracy (%) at the middle magnitude.
+TARGET_TOP1_PCT = 90.0
+#: Target of the twin check: mean shrink of the injected gap (%, each twin capped at 100 %).
+TARGET_SHRINK_PCT = 60.0
+
+
 def TWIN_EFFECTS_DEFAULT():
     from ..effects import TWIN_EFFECTS
 
@@ -378,6 +384,62 @@ class TwinValidation:
                             "mean shrink vs noise floor (%)": g["shrink_vs_noise_top"].mean()})
         out.index = out.index.map({0: "small", 1: "middle", 2: "large"})
         return out
+
+    def summary(self) -> dict:
+        """The twin check's numbers and verdicts for the text (percentages in %).
+
+        ``twins``, ``injected`` (twins with an effect); ``gen_converged`` of ``gen_total``
+        twin-generating solves converged; ``top1_pct`` top-1 accuracy at the middle
+        magnitude (level 1) and ``top1_by_seed`` (seed → % over every injected twin of that
+        seed); ``shrink_pct`` the mean shrink of the injected gap over every magnitude,
+        each twin capped at 100 %, over ``shrink_defined`` twins, ``shrink_uncapped_pct``,
+        ``shrink_median_pct``, ``shrink_vs_noise_pct``; ``free_unexplained`` of
+        ``free_twins`` effect-free twins named "unexplained"; ``top1_met``
+        (≥ :data:`TARGET_TOP1_PCT`), ``shrink_met`` (≥ :data:`TARGET_SHRINK_PCT`) and
+        ``passed`` (both, and every effect-free twin "unexplained"); ``base_starts`` (start
+        → baseline fits kept from it), ``retried_twins`` / ``retried_fits`` (candidate fits
+        re-solved from another start) and ``true_other_start`` (injected twins whose
+        injected effect's kept fit came from another start than the baseline fit)."""
+        r = self.rows
+        inj = r[r["injected"] != "none"]
+        free = r.loc[r["injected"] == "none", "correct"]
+        shr = inj["shrink_injected_top"]
+        top1 = 100 * float(inj.loc[inj["level"] == 1, "correct"].mean())
+        shrink = float(shr.clip(upper=100.0).mean())
+        retried = r["retried"] if "retried" in r else pd.Series(0, index=r.index)
+        true_start = inj["true_start"] if "true_start" in inj else pd.Series(None, index=inj.index, dtype=object)
+        out = {"twins": len(r), "injected": len(inj),
+               "gen_converged": sum(v["status"] == "Solve_Succeeded" for v in self.gen_stats.values()),
+               "gen_total": len(self.gen_stats), "top1_pct": top1,
+               "top1_by_seed": {k: 100 * v for k, v in inj.groupby("seed")["correct"].mean().items()},
+               "correct": int(inj["correct"].sum()),
+               "shrink_pct": shrink, "shrink_defined": int(shr.count()), "shrink_uncapped_pct": float(shr.mean()),
+               "shrink_median_pct": float(shr.median()),
+               "shrink_vs_noise_pct": float(inj["shrink_vs_noise_top"].mean()),
+               "free_unexplained": int(free.sum()), "free_twins": len(free),
+               "top1_met": top1 >= TARGET_TOP1_PCT, "shrink_met": shrink >= TARGET_SHRINK_PCT,
+               "base_starts": r["base_start"].value_counts().to_dict() if "base_start" in r else {},
+               "retried_twins": int((retried > 0).sum()), "retried_fits": int(retried.sum()),
+               "true_other_start": int((true_start.fillna("best") != "best").sum())}
+        out["passed"] = bool(out["top1_met"] and out["shrink_met"] and bool(free.all()))
+        return out
+
+    def misses(self) -> pd.DataFrame:
+        """The misnamed twins (rows of :attr:`rows` with ``correct`` False) with two
+        diagnoses of why: ``fit_failed`` — an injected effect whose own candidate fit ends at
+        or above the baseline fit's RSS (the fit, not the criterion, failed);
+        ``true_not_named`` — the injected effect would not have been named even with its own
+        fit's ΔBIC (not below :data:`gaitlib.gap.diagnose.BIC_THRESHOLD`, or not below the
+        named effect's)."""
+        from .diagnose import BIC_THRESHOLD
+
+        w = self.rows[~self.rows["correct"].astype(bool)].copy()
+        inj = w["injected"] != "none"
+        rt, rb = w["rss_true"].astype(float), w["rss_base"].astype(float)
+        w["fit_failed"] = inj & np.isfinite(rt) & (rt >= rb)
+        bt, bn = w["dBIC_true"].astype(float), w["dBIC_top"].astype(float)
+        w["true_not_named"] = ~(np.isfinite(bt) & (bt <= BIC_THRESHOLD) & (~np.isfinite(bn) | (bt < bn)))
+        return w
 
     def to_dict(self) -> dict:
         return {"rows": json.loads(self.rows.to_json(orient="records")),

@@ -78,7 +78,7 @@ __all__ = [
     "optimal_control_body", "run_all",
     "rmse_table", "rmse_beside_thesis", "solver_table", "geometry_table", "contact_table",
     "body_table", "at_bounds", "friction_ratios", "residual_rms", "grf_fit", "dynamic_consistency", "grf_error_by_phase",
-    "save_identified", "identified_vs_result",
+    "save_identified", "identified_vs_result", "THESIS_RANKING", "ranking", "findings",
 ]
 
 #: Version of approaches (b)/(c) on top of :data:`gaitlib.problems.gait.FORMULATION` (their
@@ -771,3 +771,70 @@ def identified_vs_result(res: ApproachResult, name: str = "ch4_child") -> dict:
     db = np.max(np.abs(stored["p_body"] - res.p_body) / np.maximum(bhi - blo, 1e-12))
     return {"max_rel_diff_contact": float(dc), "max_rel_diff_body": float(db), "provenance": stored["provenance"],
             "path": str(stored["path"])}
+
+
+# --------------------------------------------------------------------------------------
+# What the chapter found
+# --------------------------------------------------------------------------------------
+
+#: The thesis's ranking of the approaches by mean GRF RMSE, best first (Sec 4.5).
+THESIS_RANKING = ("(c)", "(b)", "(a)")
+
+
+def ranking(fit: pd.DataFrame) -> list[str]:
+    """The approaches' short labels ("(a)", "(b)", …) ordered by mean GRF RMSE, best first
+    (``fit`` = :func:`grf_fit`, rows labelled as :data:`APPROACHES`)."""
+    return list(fit["mean GRF RMSE (N)"].sort_values().index.str[:3])
+
+
+def findings(results: dict[str, ApproachResult], widened: ApproachResult, fit: pd.DataFrame,
+             consistency: pd.DataFrame, by_phase: pd.DataFrame) -> list[str]:
+    """The chapter's findings, one sentence group per item, every number from the results:
+    each approach's solve (``results`` keyed "a", "b", "c"), the GRF fit (:func:`grf_fit`)
+    and whether the thesis's ranking :data:`THESIS_RANKING` holds, the floor the kinematics
+    put under (b)'s and (c)'s GRF error (:func:`dynamic_consistency`) and the swing-phase
+    share of it (:func:`grf_error_by_phase`), the pelvis residuals, (c) re-identified within
+    widened bounds (``widened``), and (c)'s body mass and parameters at a bound."""
+    out = []
+    for k, r in results.items():
+        s = r.stats
+        ok = "converged (Optimal Solution Found)" if s["success"] else f"did NOT converge ({s['status']})"
+        extra = ""
+        if k == "a":
+            extra = f" — {s['n_converged']} of {s['n_local']} local solves converged, best from {s['best_start']}"
+        if k == "b":
+            bad = r.stages[r.stages["status"] != "Solve_Succeeded"]
+            extra = (f" — final problem {s['iterations_final']} iterations; continuation stages not converged: "
+                     + (", ".join(f"{tuple(x)} ({y})" for x, y in zip(bad["residual bounds (N, N, N·m)"], bad["status"]))
+                        or "none"))
+        out.append(f"{APPROACHES[k]} {ok}: {s['iterations']} iterations, {s['wall_s'] / 60:.1f} min wall "
+                   f"({1e3 * s['time_per_iteration_s']:.0f} ms/iteration); thesis {THESIS_TIME[k]}{extra}.")
+    m = fit["mean GRF RMSE (N)"]
+    order = " < ".join(f"{lab.split(' ')[0]} {v:.1f} N" for lab, v in m.sort_values().items())
+    out.append(f"Mean GRF RMSE, best first: {order}. Thesis (Sec 4.5, tangential / normal): (a) 36.5 / 234.6 N, "
+               f"(b) 14.1 / 26.4 N, (c) 3.0 / 10.3 N.")
+    ranked = ranking(fit)
+    out.append(f"The thesis's ranking {' better than '.join(THESIS_RANKING)} "
+               + ("holds on our data." if ranked == list(THESIS_RANKING) else f"does NOT hold on our data: {ranked}."))
+    for k in ("b", "c"):
+        lab = APPROACHES[k]
+        out.append(f"{lab}: vertical GRF error per foot {consistency.loc[lab, 'achieved per foot, y (N)']:.1f} N, of "
+                   f"which the kinematics force at least {consistency.loc[lab, 'floor per foot, y (N)']:.1f} N "
+                   f"(total-force mismatch); tangential {consistency.loc[lab, 'achieved per foot, x (N)']:.1f} N vs a "
+                   f"floor of {consistency.loc[lab, 'floor per foot, x (N)']:.1f} N. Share of the vertical squared "
+                   "error in the data's swing: "
+                   + ", ".join(f"{f} {by_phase.loc[(lab, f), 'share of squared error in swing (%)']:.0f} % "
+                               f"(mean {by_phase.loc[(lab, f), 'mean simulated force in swing (N)']:.0f} N carried in swing)"
+                               for f in ("right", "left")) + ".")
+    for k, r in results.items():
+        rr = residual_rms(r)
+        out.append(f"{APPROACHES[k]}: pelvis residual RMS R_x {rr['R_x']:.1f} N, R_y {rr['R_y']:.1f} N, "
+                   f"R_z {rr['R_z']:.2f} N·m (thesis Table 4.9: (a) 94.4 N, 349.0 N, 18.1 N·m; (b) 0).")
+    mw = grf_fit({"c_wide": widened})["mean GRF RMSE (N)"].iloc[0]
+    mb, c = m[APPROACHES["b"]], results["c"]
+    out.append(f"With Table 4.7 widened to contain the thesis's (c) values, (c′) {widened.stats['status']} reaches a "
+               f"mean GRF RMSE of {mw:.1f} N ({'better' if mw < mb else 'not better'} than (b)'s {mb:.1f} N), "
+               f"objective {widened.stats['objective']:.4f} vs (c) {c.stats['objective']:.4f}.")
+    out.append(f"(c) total body mass {ChildModel().total_mass(c.p_body):.2f} kg (thesis 41.80 kg); "
+               f"{len(at_bounds(c))} of {len(c.p_contact) + len(c.p_body)} parameters at a bound.")
+    return out

@@ -5,6 +5,7 @@ results beside the thesis's (labelled references), the channel figures and the a
 
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
 
 from .. import conventions as cv
@@ -12,7 +13,8 @@ from ..problems.jump import (FORMULATION, LABELS, SPECS, TABLE_3_5, THESIS, Jump
                              JumpSpec, build, cache_location, initial_guess, joint_bounds, meshes, solve, spec)
 
 __all__ = ["solve_all", "results_table", "stats_table", "plot_channels", "animate", "THESIS", "SPECS",
-           "JumpSpec", "JumpSolution", "joint_bounds", "spec", "solve", "build", "cache_location"]
+           "JumpSpec", "JumpSolution", "joint_bounds", "spec", "solve", "build", "cache_location",
+           "THESIS_HEIGHT_ORDER", "AT_BOUND", "torques_at_bound", "findings"]
 
 
 def solve_all(names=("toeless", "toe", "ellipsoid"), use_cache: bool = False,
@@ -135,3 +137,75 @@ def animate(s: JumpSolution, **kw):
     title = s.spec.label + ("" if s.success else f" — FAILED: {s.status}")
     return plots.animate_jump(s.model, t, Q, p_contact=s.p_contact, grf=grf,
                               cop=tr["cop_x"].to_numpy(float), title=title, **kw)
+
+
+# --------------------------------------------------------------------------------------
+# What the chapter found
+# --------------------------------------------------------------------------------------
+
+#: The thesis's order of the jump heights, lowest first (Sec 3.4.4).
+THESIS_HEIGHT_ORDER = ("toeless", "toe", "ellipsoid")
+#: A joint torque counts as at its Table 3.5 bound from this fraction of the bound on.
+AT_BOUND = 0.99
+
+
+def torques_at_bound(sol, fraction: float = AT_BOUND) -> list[str]:
+    """Joints of a jump solution whose torque reaches ``fraction`` of its Table 3.5 bound
+    (:func:`joint_bounds`, either sign) somewhere in the motion."""
+    out = []
+    for j in sol.model.joints:
+        lo, hi = joint_bounds(j)["tau"]
+        tau = sol.trajectory[f"tau_{j}"]
+        if max(tau.max() / hi, tau.min() / lo) > fraction:
+            out.append(j)
+    return out
+
+
+def findings(sols: dict, contact_params) -> list[str]:
+    """The chapter's findings, one sentence group per item, every number from the solutions
+    (``sols``: name → :class:`JumpSolution` for "toeless", "toe", "ellipsoid"): per solve the
+    convergence, COM rise, MTP lift, required friction and deepest knee beside :data:`THESIS`;
+    the order of the heights against :data:`THESIS_HEIGHT_ORDER`; the friction each contact
+    needs; the largest torques and peak vertical GRF (body weights); the torques at their
+    bound (:func:`torques_at_bound`); and the heights of the coarse continuation optima.
+    ``contact_params``: the ellipsoid contact's parameter vector (13 per ellipsoid, μ_s third)."""
+    def cm(v):
+        return f"{100 * v:.0f} cm"
+
+    out = []
+    for n, s in sols.items():
+        h, th, st = s.jump_height, THESIS[n], s.stats
+        verdict = "converged" if st["success"] else f"did NOT converge ({st['status']})"
+        out.append(f"{s.spec.label}: {verdict} in {st['iterations']} iterations, {st['solve_time_s']:.0f} s. "
+                   f"COM rise in flight {cm(h['com_rise_flight'])} (take-off v_y {h['takeoff_vy']:.2f} m/s), "
+                   f"MTP lift {cm(h['foot_lift'])} — thesis {th['jump_height_cm']:.0f} cm; "
+                   f"required μ_s {s.required_friction:.2f} — thesis {th['mu_s']:g}; deepest knee "
+                   f"{np.degrees(s.trajectory['knee'].min()):.0f}° — thesis {th['knee_min_deg']:.0f}°.")
+    if not all(s.success for s in sols.values()):
+        out.append("NOT every solve converged: the figures and numbers of a failed solve are the last "
+                   "iterate of IPOPT, shown for diagnosis only.")
+    rise = {n: s.jump_height["com_rise_flight"] for n, s in sols.items()}
+    order = sorted(rise, key=rise.get)
+    out.append(f"Order of jump heights (COM rise): {' < '.join(order)}; thesis: {' < '.join(THESIS_HEIGHT_ORDER)}"
+               f" — {'the same order' if order == list(THESIS_HEIGHT_ORDER) else 'a DIFFERENT order'}.")
+    out.append("Our COM rise ÷ the thesis's jump height: "
+               + ", ".join(f"{n} {rise[n] / (THESIS[n]['jump_height_cm'] / 100):.1f}×" for n in sols))
+    mu = {n: s.required_friction for n, s in sols.items()}
+    lower = mu["ellipsoid"] < min(mu["toeless"], mu["toe"])
+    out.append(f"Required static friction: ellipsoid contact {mu['ellipsoid']:.2f}, welded toeless "
+               f"{mu['toeless']:.2f}, welded toe-included {mu['toe']:.2f} — the ellipsoid contact needs "
+               f"{'LESS than either welded contact, as in the thesis' if lower else 'NOT less than both welded contacts, unlike the thesis'}."
+               f" Largest μ_s of its ellipsoids: {max(contact_params[13 * i + 2] for i in range(3)):.2f}.")
+    peak = {n: max(s.trajectory[f'tau_{j}'].abs().max() for j in s.model.joints) for n, s in sols.items()}
+    out.append("Largest joint torque: " + ", ".join(f"{n} {v:.0f} N·m" for n, v in peak.items())
+               + " (Table 3.5 allows 1500–4000 N·m); peak F_y "
+               + ", ".join(f"{n} {s.trajectory['grf_y'].max() / (s.model.total_mass * cv.G):.1f}×"
+                           for n, s in sols.items()) + " the body weight.")
+    out.append("Joint torques at (≥ 99 % of) their Table 3.5 bound: "
+               + "; ".join(f"{n}: {', '.join(torques_at_bound(s)) or 'none'}" for n, s in sols.items()) + ".")
+    coarse = {n: s.solution.info["continuation"][0]["com_rise_flight"] for n, s in sols.items()
+              if s.solution.info.get("continuation")}
+    out.append("The 5-interval optima the final solves started from: "
+               + ", ".join(f"{n} {cm(v)}" for n, v in coarse.items())
+               + " — local optima of the same problem, far from the 10-interval ones.")
+    return out

@@ -17,6 +17,8 @@ Functions
                             two readings of the shortening heat.
 :func:`mtb_scale_table`     the size of the Mtb term under its normalisation (Eq 5.56).
 :func:`excitation_figure`   thesis Fig 5.11.
+:func:`angle_errors`        the largest angle error per joint and where in the cycle.
+:func:`findings`            the chapter's findings as sentences, every number from the results.
 
 EMG: our data are not the thesis's (Bovi 2011, eight muscles with SD). Schwartz et al.
 2008 give rectus femoris, medial and lateral hamstrings, tibialis anterior and medial
@@ -37,6 +39,7 @@ import pandas as pd
 from .. import activation
 from .. import conventions as cv
 from .. import data as data_mod
+from .. import marks
 from .. import metabolics
 from .. import params as params_mod
 from ..problems import gait as gait_ocp
@@ -44,7 +47,9 @@ from . import gait as sg
 
 __all__ = ["EMG_MAP", "THESIS_TABLE_5_10", "THESIS_COT", "THESIS_HOURS", "parameter_sets", "ch5_spec", "solve",
            "emg_table", "emg_reference", "excitation_scores", "activation_table", "cot_breakdown",
-           "mtb_scale_table", "excitation_figure", "saturation", "synergy_cost_table"]
+           "mtb_scale_table", "excitation_figure", "saturation", "synergy_cost_table", "MOVED_TOL",
+           "verdict_text", "range_text", "thesis_rmse_range", "moved_parameters", "short_generators",
+           "angle_errors", "findings"]
 
 #: Thesis muscle → (Schwartz 2008 channel stem, gaitutils channel stem, note). Channel stems
 #: are :class:`gaitlib.data.GaitData` columns without ``_r``/``_l``.
@@ -364,3 +369,122 @@ def mtb_scale_table(sol: gait_ocp.GaitSolution) -> pd.DataFrame:
         rows.append({"reading": lab, "mean Ė (W)": ebar, "Ė_max − Ė_min (W)": de, "t_f⁶/(BM² d⁴)": f,
                      "w·Mtb (approx.)": w * term, "objective": float(sol.stats["objective"])})
     return pd.DataFrame(rows).set_index("reading")
+
+
+# --------------------------------------------------------------------------------------
+# What the chapter found
+# --------------------------------------------------------------------------------------
+
+#: A parameter counts as moved by the data when it leaves Eq 5.22's adult value by more than
+#: this (Table 5.2's units: Δ^P in degrees, the rest dimensionless).
+MOVED_TOL = 1e-2
+#: Thesis Table 5.10's identified activation parameters, as the chapter quotes them.
+THESIS_ACTIVATION_TEXT = "τ_act 0.006 s, c3 0.0001, s1 = s2 = 0.25"
+
+
+def verdict_text(stats: dict) -> str:
+    """``"converged"`` or ``"did NOT converge (<IPOPT status>)"`` from a solve's stats."""
+    return "converged" if stats["success"] else f"did NOT converge ({stats['status']})"
+
+
+def range_text(values) -> str:
+    """``"min–max"`` of ``values`` with one decimal (e.g. an RMSE range)."""
+    v = pd.Series(list(values), dtype=float)
+    return f"{v.min():.1f}–{v.max():.1f}"
+
+
+def thesis_rmse_range(model: str, kind: str) -> str:
+    """Range of the thesis's RMSEs of ``model`` (Table 5.4: MSK, 5.11: NMSK) for one
+    ``kind`` (``"angle"`` deg, ``"torque"`` N·m, ``"grf"`` N)."""
+    return range_text(x for (k, _, _), x in sg.THESIS_RMSE[model].items() if k == kind)
+
+
+def moved_parameters(table: pd.DataFrame, tol: float = MOVED_TOL, ours: str = "ours",
+                     initial: str = "initial (Eq 5.22)") -> pd.Series:
+    """The identified parameters (rows of :func:`gaitlib.studies.mtg_id.table_beside_thesis`)
+    that differ from the adult value by more than ``tol``: (generator, parameter) → ours."""
+    return table.loc[(table[ours] - table[initial]).abs() > tol, ours]
+
+
+def short_generators(margins: pd.DataFrame, label: str, equation: str = "Eq 5.15") -> pd.Series:
+    """Generators whose smallest margin of ``equation`` (N·m, :func:`mtg_id.margins_table`)
+    is negative for parameter set ``label``: generator → margin (< 0)."""
+    m = margins[label][equation]
+    return m[m < 0]
+
+
+def angle_errors(q: pd.DataFrame, ref_time, ref_mean, cycle_time: float) -> pd.DataFrame:
+    """Largest |q − data mean| per joint of a gait solution's angles ``q`` (rad, index time s)
+    against the tracked mean ``ref_mean[joint]`` (rad at ``ref_time``, interpolated to the
+    solution's times): ``max error (deg)`` and where, ``at (% cycle)`` (0 % = right heel
+    strike, cycle ``cycle_time`` s). Rows: the six leg joints."""
+    rows = {}
+    for j in ("hip_r", "knee_r", "ankle_r", "hip_l", "knee_l", "ankle_l"):
+        e = (q[j] - np.interp(q.index, ref_time, ref_mean[j])).abs() / cv.DEG
+        rows[j] = {"max error (deg)": e.max(), "at (% cycle)": 100 * e.idxmax() / cycle_time}
+    return pd.DataFrame.from_dict(rows, orient="index")
+
+
+def findings(ident, ident_thesis_tol, params_table: pd.DataFrame, margins: pd.DataFrame, msk_sol, nmsk_sol,
+             angle_err: pd.DataFrame, cot: pd.DataFrame, scores: pd.DataFrame) -> list[str]:
+    """The chapter's findings, one sentence group per item, every number from the results:
+    the MTG identifications (``ident`` at tol 1e-10, ``ident_thesis_tol`` at 1e-5), their
+    parameter table (:func:`mtg_id.table_beside_thesis` of ``ident``) and constraint margins
+    (:func:`mtg_id.margins_table` with sets "Gymnast (Eq 5.22)", "thesis Table 5.2",
+    "ours"), the MSK and NMSK solutions, the MSK's :func:`angle_errors`, the NMSK's
+    :func:`cot_breakdown`, and its :func:`excitation_scores` (marked or not). Rows of a
+    failed or invalid NMSK solve carry its mark (:func:`gaitlib.marks.mark_rows`)."""
+    s0, s1 = ident.stats, ident_thesis_tol.stats
+    out = [(f"MTG identification {verdict_text(s0)} in {s0['iterations']} iterations "
+            f"({s0['solve_time_s']:.1f} s solve + {s0['build_time_s']:.1f} s build). "
+            f"Eq 5.23 objective {s0['objective']:.3g}; at the thesis's tolerance 1e-5 the solve "
+            f"({verdict_text(s1)}, {s1['iterations']} it) stops at {s1['objective']:.3g}, "
+            f"{s1['cost_Gamma'] / s0['cost_Gamma']:.0f}× our parameter term.")]
+    out.append("Parameters the data move by more than 0.01 (tol 1e-10): "
+               + ", ".join(f"{g} {k} = {v:.3g}" for (g, k), v in moved_parameters(params_table).items())
+               + "; all others stay at the adult values.")
+    short = short_generators(margins, "Gymnast (Eq 5.22)")
+    short_th = short_generators(margins, "thesis Table 5.2")
+    out.append("With the adult curves, Eq 5.15 fails for "
+               + ", ".join(f"{g} (short by {-v:.1f} N·m)" for g, v in short.items()) + "; thesis Table 5.2 leaves "
+               + (", ".join(f"{g} short by {-v:.1f} N·m" for g, v in short_th.items())
+                  or "no generator short on our data")
+               + f"; ours: worst Eq 5.15 margin on the fine grid {margins['ours']['Eq 5.15'].min():.2f} N·m "
+               "(constraints hold at the collocation points; between them the push-off peak is sampled more finely).")
+    for lab, s, th in (("MSK", msk_sol, "Table 5.4"), ("NMSK", nmsk_sol, "Table 5.11")):
+        st = s.stats
+
+        def rng(kind, s=s):
+            return range_text(s.rmse.loc[s.rmse["kind"] == kind, "rmse"])
+
+        out.append(f"{lab} {verdict_text(st)}: {st['iterations']} iterations, {st['solve_time_s']:.0f} s solve + "
+                   f"{st['build_time_s']:.0f} s build ({1e3 * st['time_per_iteration_s']:.0f} ms/iteration; thesis: "
+                   f"{THESIS_HOURS[lab]:g} h). RMSE angles {rng('angle')} deg, torques {rng('torque')} N·m, "
+                   f"GRFs {rng('grf')} N (thesis, {th}: angles {thesis_rmse_range(lab, 'angle')} deg, torques "
+                   f"{thesis_rmse_range(lab, 'torque')} N·m, GRFs {thesis_rmse_range(lab, 'grf')} N).")
+    act = marks.mark_rows(activation_table(nmsk_sol), marks.failure_label(nmsk_sol))
+    out.append("Activation parameters (ours): " + ", ".join(
+        f"{k} = {v:.4g}" + (f" (at its {b} bound)" if b else "") for k, v, b in
+        zip(act.index, act["ours"], act["ours at bound"])) + f" — thesis Table 5.10: {THESIS_ACTIVATION_TEXT}.")
+    c, cb = cot["Eq 5.47 as printed (NLP)"], cot["Bhargava F_iso = a τ0 t^A"]
+    out.append(f"COT {c['total']:.2f} J/(kg·m) (thesis {THESIS_COT:g}): shortening heat {c['shortening']:.2f}, "
+               f"activation {c['activation']:.2f}, maintenance {c['maintenance']:.2f}, work {c['work']:.2f}, "
+               f"basal {c['basal']:.3f}; with Bhargava's isometric force the same motion costs {cb['total']:.2f}.")
+    out.append("Excitation–EMG correlation (Schwartz): "
+               + ", ".join(f"{m} {v:+.2f}" for m, v in scores["r (Schwartz)"].dropna().items())
+               + "; gaitutils: " + ", ".join(f"{m} {v:+.2f}" for m, v in scores["r (gaitutils)"].items()) + ".")
+    e = angle_err["max error (deg)"]
+    worst = e.idxmax()
+    out.append(f"The MSK's largest angle error: {worst} {e[worst]:.0f} deg at "
+               f"{angle_err.loc[worst, 'at (% cycle)']:.0f} % of the cycle (right heel strike at 0 %); errors per "
+               "joint (max deg @ % cycle): "
+               + ", ".join(f"{k} {v:.0f} @ {p:.0f}" for k, v, p in zip(angle_err.index, e, angle_err["at (% cycle)"]))
+               + ".")
+    ap = nmsk_sol.stats["activation_parameters"]
+    out.append(f"GAM's weight in the ankle extensor (1 − s1 − s2) = {1 - ap['s1'] - ap['s2']:.2g}; mean node-to-node "
+               f"|Δe| of our excitations {scores['mean |Δe| per node (ours)'].mean():.3f} vs "
+               f"{scores['mean |Δ| per node (EMG)'].mean():.3f} for the EMG.")
+    mt, obj = mtb_scale_table(nmsk_sol)["w·Mtb (approx.)"], nmsk_sol.stats["objective"]
+    out.append(f"The Mtb term is {100 * mt.iloc[0] / obj:.1f} % of the NMSK objective with d read as the stride; "
+               f"read as the 50 ms delay it would be {mt.iloc[1] / obj:.0f}× the whole objective.")
+    return out

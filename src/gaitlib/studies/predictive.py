@@ -46,7 +46,8 @@ __all__ = ["CH6_COSTS", "CH7_CLASSES", "THESIS_CLASS", "THESIS_HOURS_TABLE_6_3",
            "THESIS_COT_FIG_7_5", "THESIS_FP_GAIN_PCT", "THESIS_FP_EXCITATION_GAIN_PCT",
            "THESIS_TORQUE_GAIN_PCT_CH7", "BASELINE_COST", "GUESS_POLICY", "baseline", "default_params", "thesis_guess", "run_guess", "ch6_specs", "ch7_specs",
            "score", "excitation_score", "StudyResult", "cost_function_study", "speed_study", "cot_table",
-           "times_table"]
+           "times_table", "SDT3_ENOUGH_FACTOR", "COT_CURVE_MIN_POINTS", "kind_nrmse", "mean_nrmse", "ch6_findings",
+           "ch7_findings", "cot_figure"]
 
 CH6_COSTS = ("DT", "SDT1", "SDT2", "SDT3", "SP1", "SP2", "SP3", "FP")
 CH7_CLASSES = ("VerySlow", "Slow", "Fast", "VeryFast")
@@ -461,3 +462,193 @@ def times_table(result: StudyResult, thesis_hours: dict, label_of=lambda spec: s
                      "ms/iteration": 1e3 * st.get("time_per_iteration_s", np.nan), "thesis (h)": h,
                      "speed-up": 3600 * h / t if t and np.isfinite(t) else np.nan})
     return pd.DataFrame(rows)
+
+
+# ======================================================================================
+# What the chapters found
+# ======================================================================================
+#: The thesis's claim "SDT3 (torques + angles) is enough for NMSK" counts as holding when the
+#: NMSK SDT3 run's mean NRMSE is at most this factor times the NMSK DT run's (within 10 %).
+SDT3_ENOUGH_FACTOR = 1.1
+#: The COT curve needs at least this many converged points to speak of its minimum.
+COT_CURVE_MIN_POINTS = 3
+#: Scored kinds of the headline NRMSEs.
+_KINDS = ["angle", "torque", "grf"]
+
+
+def kind_nrmse(scores: pd.DataFrame) -> pd.DataFrame:
+    """Mean NRMSE per run and kind: rows (model, case), columns angle, grf, torque (the
+    kinds present), from a :attr:`StudyResult.scores`-like long table."""
+    return scores[scores["kind"].isin(_KINDS)].groupby(["model", "case", "kind"])["nrmse"].mean().unstack("kind")
+
+
+def mean_nrmse(scores: pd.DataFrame) -> pd.Series:
+    """(model, case) → the mean over angles, torques and GRFs of their mean NRMSE (every
+    kind weighs the same, whatever its number of channels)."""
+    return kind_nrmse(scores).mean(axis=1)
+
+
+def _converged_line(stats: pd.DataFrame, extra: str = "") -> str:
+    ok = stats["converged"]
+    return (f"- {int(ok.sum())} of {len(ok)} runs converged{extra}"
+            + ("" if ok.all() else "; not converged: " + ", ".join(f"{k} ({v})" for k, v in stats.loc[~ok, 'status'].items())))
+
+
+def ch6_findings(res: StudyResult, thesis_guess_stats: pd.DataFrame, reruns: dict,
+                 gait: data_mod.GaitData) -> list[str]:
+    """Ch 6's findings as Markdown list items, every number from the runs: convergence and
+    times, mean NRMSE (:func:`mean_nrmse` of the converged and valid runs only) per model and
+    cost function, the thesis's claims (NMSK more accurate than MSK per cost function, NMSK FP
+    more accurate and faster than MSK FP, SDT3 enough for NMSK — within
+    :data:`SDT3_ENOUGH_FACTOR`, using the converged 3000-iteration rerun of ``reruns`` when the
+    study's own run did not converge), and the excitation RMSE against the EMG.
+    ``thesis_guess_stats``: :meth:`StudyResult.stats` of the NMSK runs from the thesis's
+    partial guess; ``gait``: the data the runs are scored against."""
+    stats, run_marks = res.stats(), res.marks()
+    csc = res.converged_scores()
+    nr = mean_nrmse(csc)
+
+    def _nr(model, case):
+        return nr.get((model, case), np.nan)
+
+    def _f(model, case):
+        v = _nr(model, case)
+        return f"{v:.3f}" if np.isfinite(v) else f"— ({run_marks.get(f'{model} {case}') or 'no result'})"
+
+    tg = thesis_guess_stats
+    tg_ok = tg["status"] == "Solve_Succeeded"
+    lines = [_converged_line(stats, " (IPOPT Solve_Succeeded)")
+             + f". IPOPT solve time per run {stats['solve (s)'].min():.0f}–{stats['solve (s)'].max():.0f} s here, "
+             f"against 1–15 h in the thesis (Table 6.3). NMSK runs start from the whole Ch 5 NMSK solution; from the "
+             f"thesis's partial guess {int(tg_ok.sum())} of {len(tg)} NMSK runs converged"
+             + ("" if tg_ok.all() else " (not: " + ", ".join(f"{k} {v}" for k, v in tg.loc[~tg_ok, 'status'].items()) + ")")
+             + ".",
+             f"- Mean NRMSE over angles, torques and forces: MSK DT {_f('MSK', 'DT')} → FP {_f('MSK', 'FP')}; "
+             f"NMSK DT {_f('NMSK', 'DT')} → FP {_f('NMSK', 'FP')}."]
+    both = [c for c in CH6_COSTS if np.isfinite(_nr("NMSK", c)) and np.isfinite(_nr("MSK", c))]
+    better = [c for c in both if _nr("NMSK", c) < _nr("MSK", c)]
+    skipped = [c for c in CH6_COSTS if c not in both]
+    lines.append(f"- NMSK is more accurate than MSK (mean NRMSE) for {', '.join(better) if better else 'no cost function'}"
+                 + (f" (of {len(both)} cost functions where both runs converged and pass the validity gates; not "
+                    f"compared: {', '.join(skipped)})" if skipped else "")
+                 + "; the thesis found NMSK better for SDT1, SP2 and FP, MSK better for SDT2 and SP3, similar for DT, "
+                   "SDT3 and SP1 (Sec 6.2.3).")
+    if "FP" in both:
+        t_n, t_m = stats.loc["NMSK FP", "solve (s)"], stats.loc["MSK FP", "solve (s)"]
+        lines.append(f"- Thesis claim *NMSK FP more accurate than MSK FP*: "
+                     f"{'holds' if _nr('NMSK', 'FP') < _nr('MSK', 'FP') else 'does not hold'} on our data "
+                     f"({_f('NMSK', 'FP')} vs {_f('MSK', 'FP')}). *NMSK FP faster than MSK FP*: "
+                     f"{'holds' if t_n < t_m else 'does not hold'} ({t_n:.0f} s vs {t_m:.0f} s; not a like-for-like "
+                     "comparison: the NMSK runs start from the whole Ch 5 solution, the MSK runs from the thesis's "
+                     "partial guess).")
+    else:
+        lines.append("- Thesis claims *NMSK FP more accurate / faster than MSK FP*: not tested — "
+                     f"MSK FP {_f('MSK', 'FP')}, NMSK FP {_f('NMSK', 'FP')}.")
+    sdt3_val, note = _nr("NMSK", "SDT3"), ""
+    if not stats.loc["NMSK SDT3", "converged"]:
+        r = reruns.get("NMSK SDT3")
+        if r is not None and r.stats["success"]:
+            d = score(r, gait)
+            sdt3_val = d[d["kind"].isin(_KINDS)].groupby("kind")["nrmse"].mean().mean()
+            note = (f" (the study's 1000-iteration run did not converge; this is its converged 3000-iteration rerun, "
+                    f"{r.stats['iterations']} iterations)")
+    if np.isfinite(sdt3_val) and np.isfinite(_nr("NMSK", "DT")):
+        holds = sdt3_val <= _nr("NMSK", "DT") * SDT3_ENOUGH_FACTOR
+        lines.append(f"- Thesis claim *SDT3 (Trq + Ang) is enough for NMSK*: NMSK SDT3 mean NRMSE {sdt3_val:.3f}{note} "
+                     f"vs DT {_nr('NMSK', 'DT'):.3f} — "
+                     f"{f'holds (within {100 * (SDT3_ENOUGH_FACTOR - 1):.0f} %)' if holds else 'does not hold'}.")
+    else:
+        lines.append(f"- Thesis claim *SDT3 (Trq + Ang) is enough for NMSK*: not tested — NMSK SDT3 {_f('NMSK', 'SDT3')}, "
+                     f"DT {_f('NMSK', 'DT')}.")
+    exc = csc[csc["kind"] == "excitation"].groupby("case")["rmse"].mean()
+    not_conv = [c for c in CH6_COSTS if run_marks.get(f"NMSK {c}")]
+    if len(exc):
+        lines.append("- Excitation RMSE vs EMG (mean over mapped muscles, converged NMSK runs"
+                     + (f"; {', '.join(not_conv)} left out: not converged" if not_conv else "") + "): "
+                     f"best {exc.idxmin()} {exc.min():.3f}, worst {exc.idxmax()} {exc.max():.3f}; "
+                     f"FP {exc.get('FP', np.nan):.3f} vs DT {exc.get('DT', np.nan):.3f} (thesis: FP "
+                     f"{THESIS_FP_EXCITATION_GAIN_PCT:.0f} % better than DT).")
+    return lines
+
+
+def ch7_findings(res: StudyResult, classes, control: pd.DataFrame, cot: pd.DataFrame, reruns: dict,
+                 ch5_row: str | None = None) -> list[str]:
+    """Ch 7's findings as Markdown list items, every number from the runs: convergence and
+    times; torque NRMSE of NMSK against MSK per class (converged and valid runs only);
+    how often the NMSK predictions are closer to the untracked class data than the
+    time-scaled Free data they tracked (``control``: class × kind NRMSE of that data against
+    the class's); the COT curve (:func:`cot_table`; its minimum, with at least
+    :data:`COT_CURVE_MIN_POINTS` converged points; row ``ch5_row`` is the Ch 5 solution,
+    off the curve); and the 3000-iteration ``reruns`` of NMSK runs."""
+    stats = res.stats()
+    pred_ok = kind_nrmse(res.converged_scores())
+    lines = [_converged_line(stats)
+             + f"; IPOPT solve time {stats['solve (s)'].min():.0f}–{stats['solve (s)'].max():.0f} s per run here vs "
+               "4–18 h in the thesis (Table 7.2)."]
+    both = [c for c in classes if ("NMSK", c) in pred_ok.index and ("MSK", c) in pred_ok.index]
+    if both:
+        tq = pred_ok["torque"]
+        better = [c for c in both if tq[("NMSK", c)] < tq[("MSK", c)]]
+        lines.append(f"- Torque NRMSE: NMSK below MSK for {', '.join(better) if better else 'no class'} of the "
+                     f"{len(both)} classes where both runs converged and pass the validity gates"
+                     + (f" (not compared: {', '.join(c for c in classes if c not in both)})" if len(both) < len(classes) else "")
+                     + " (thesis: NMSK 2–17 % better at every speed).")
+    nm = [c for c in classes if ("NMSK", c) in pred_ok.index]
+    beat = [(c, k) for c in nm for k in _KINDS if pred_ok.loc[("NMSK", c), k] < control.loc[c, k]]
+    lines.append(f"- The converged NMSK predictions are closer to the untracked class data than the scaled Free data "
+                 f"they tracked in {len(beat)} of {3 * len(nm)} class × kind cells"
+                 + (f" ({', '.join(c for c in classes if c not in nm)} left out: not converged)" if len(nm) < len(classes) else "")
+                 + ".")
+    curve = cot.drop(index=ch5_row, errors="ignore") if ch5_row else cot
+    cc = curve[curve["mark"] == ""]
+    r5 = cot.loc[ch5_row] if ch5_row and ch5_row in cot.index else None
+    if len(cc) >= COT_CURVE_MIN_POINTS:
+        imin = cc["COT (J/kg/m)"].idxmin()
+        thesis = ", ".join(f"{c:.2f}" for _, _, c in THESIS_COT_FIG_7_5)
+        thesis_classes = ", ".join(k for k, _, _ in THESIS_COT_FIG_7_5)
+        lines.append(f"- COT (NMSK DT, converged runs; Free = the Ch 6 NMSK DT run): "
+                     f"{', '.join(f'{i} {v:.2f}' for i, v in cc['COT (J/kg/m)'].items())} J/(kg·m); minimum at {imin} "
+                     f"({'the natural speed — a U-curve as the thesis reports' if imin == 'Free' else 'not at the natural speed — no U-curve with the minimum at Free'}). "
+                     f"Thesis (Fig 7.5): {thesis} at {thesis_classes}."
+                     + (f" The Ch 5 NMSK solution (Eq 5.55, its own activation parameters) has {r5['COT (J/kg/m)']:.2f}"
+                        + (f" ({r5['mark']})" if r5["mark"] else "") + "; it is not on the curve." if r5 is not None else ""))
+    for k, r in reruns.items():
+        if k.startswith("NMSK "):
+            lines.append(f"- {k} stopped at 1000 iterations; rerun at 3000 it "
+                         f"{'converged' if r.stats['success'] else 'did NOT converge'} ({r.stats['status']}, "
+                         f"{r.stats['iterations']} iterations) with COT {r.stats.get('COT', float('nan')):.2f} J/(kg·m) "
+                         "(not in the figure, which keeps the study's own runs).")
+    return lines
+
+
+def cot_figure(cot: pd.DataFrame, ch5_row: str | None = None):
+    """Thesis Fig 7.5: COT (J kg⁻¹ m⁻¹) against walking speed (m/s) from :func:`cot_table` —
+    the converged points joined, the marked ones as labelled crosses, the ``ch5_row`` point
+    (the Ch 5 solution) apart, and the thesis's points at their own speeds."""
+    import matplotlib.pyplot as plt
+
+    from .. import marks
+
+    curve = cot.drop(index=ch5_row, errors="ignore") if ch5_row else cot
+    fig, ax = plt.subplots(figsize=(8.0, 3.6), layout="constrained")
+    okc = curve[curve["mark"] == ""]
+    ax.plot(okc["speed (m/s)"], okc["COT (J/kg/m)"], "o-", color="C1", label="ours (NMSK DT, converged; Free = Ch 6 DT)")
+    bad = curve[curve["mark"] != ""]
+    if len(bad):
+        ax.plot(bad["speed (m/s)"], bad["COT (J/kg/m)"], "x", color=marks.MARK_COLOR, ms=9, mew=2,
+                label=f"{marks.DAGGER} ours, NOT converged")
+        for name, r in bad.iterrows():
+            ax.annotate(f"{marks.DAGGER} {r['mark']}", (r["speed (m/s)"], r["COT (J/kg/m)"]), fontsize=6,
+                        color=marks.MARK_COLOR, textcoords="offset points", xytext=(-4, -12), ha="right")
+    if ch5_row and ch5_row in cot.index:
+        r5 = cot.loc[ch5_row]
+        ax.plot([r5["speed (m/s)"]], [r5["COT (J/kg/m)"]], "D", mfc="none", color="C2", ms=7,
+                label=marks.run_label("Ch 5 NMSK Eq 5.55 (own activation params)", r5["mark"]))
+    th = pd.DataFrame(THESIS_COT_FIG_7_5, columns=["class", "speed", "COT"])
+    ax.plot(th["speed"], th["COT"], "s--", color="0.5", label="thesis, Fig 7.5 (different data)")
+    for name, r in curve.iterrows():
+        ax.annotate(name, (r["speed (m/s)"], r["COT (J/kg/m)"]), fontsize=7, textcoords="offset points", xytext=(4, 4))
+    ax.set_xlabel("walking speed (m/s)")
+    ax.set_ylabel("COT (J kg⁻¹ m⁻¹)")
+    ax.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.01, 0.5))
+    return fig
