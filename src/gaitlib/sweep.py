@@ -1,21 +1,16 @@
 """Sweeps of independent runs (e.g. the Ch 6 cost functions × Ch 7 speed classes) on
-dask.distributed, or serially in-process.
+dask.distributed, or serially in-process: a pure executor that knows nothing of the
+problems it runs (the gait problem's batch solve is :func:`gaitlib.problems.gait.solve_specs`).
 
-Functions
----------
-:func:`sweep`        run ``func(arg)`` for every named item; one :class:`RunRecord` per item,
-                     in the items' order, failures included (never dropped, never raised).
-:func:`solve_specs`  the same for gait OCPs: every worker calls
-                     :func:`gaitlib.studies.gait.solve_cached` (cached solutions reused, new
-                     ones stored under an explicitly passed cache root).
+:func:`sweep` runs ``func(arg)`` for every named item; one :class:`RunRecord` per item, in
+the items' order, failures included (never dropped, never raised).
 
 Where the runs go
 -----------------
 * default: a :class:`distributed.LocalCluster` with ``n_workers`` (default
   ``os.cpu_count()``) worker *processes* of one thread each, and one BLAS/OpenMP thread
-  per process (``OPENBLAS_NUM_THREADS`` = ``OMP_NUM_THREADS`` = ``MKL_NUM_THREADS`` = 1, set
-  for the workers before they are spawned — IPOPT/MUMPS takes timing-dependent paths with
-  more threads, see :mod:`gaitlib`); the cluster is closed afterwards.
+  per process (:data:`gaitlib.blas.SETTINGS`, set for the workers before they are spawned —
+  IPOPT/MUMPS takes timing-dependent paths with more threads); the cluster is closed afterwards.
 * ``scheduler="tcp://host:port"`` (or the path of a ``--scheduler-file``): an existing
   cluster, e.g. ``dask scheduler`` + ``dask worker ADDRESS --nthreads 1``; only the client
   is closed afterwards, never the cluster.
@@ -49,7 +44,7 @@ from typing import Any, Callable
 
 from . import blas
 
-__all__ = ["RunRecord", "sweep", "solve_specs", "ACCEPTED_STATUSES", "BLAS_ENV"]
+__all__ = ["RunRecord", "sweep", "ACCEPTED_STATUSES", "BLAS_ENV"]
 
 #: IPOPT return statuses counted as a solved run (``RunRecord.ok``); the status itself is
 #: always kept, so an acceptable-level stop stays visible.
