@@ -225,7 +225,6 @@ class JumpModel:
 
     def _build(self, name):
         S = self._sym
-        nj = len(self.joints)
         tree = self.tree
         B = self.damping
         if name in ("flight", "contact"):

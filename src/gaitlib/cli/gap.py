@@ -44,7 +44,7 @@ def cmd_gap(args) -> int:
     Data that fail the reader's checks (:func:`gaitlib.gap.io.read_data`,
     :mod:`gaitlib.plausibility`): one line on stderr, exit 2, nothing built or written."""
     from . import common as cli
-    from ..gap import diagnose as D
+    from ..gap import diagnose
     from ..gap import io as gio
 
     effects = effect_names(args.effects)
@@ -62,7 +62,7 @@ def cmd_gap(args) -> int:
         print(f"gaitlib gap: {ds.label} ({ds.base}, {ds.gait.speed_class}, n = {ds.n} from {ds.n_source}); "
               f"baseline {args.model} {args.cost} {args.intervals} x {args.degree}, objective {args.objective}",
               flush=True)
-        d = D.diagnose(ds, base=base, effects=effects, objective=args.objective, resamples=args.resamples,
+        d = diagnose.diagnose(ds, base=base, effects=effects, objective=args.objective, resamples=args.resamples,
                        seed=args.seed, root=root, use_cache=not args.no_cache, serial=args.serial,
                        n_workers=args.workers, scheduler=args.scheduler, progress=True)
         d.save(o.tmp, figures=not args.no_figures)

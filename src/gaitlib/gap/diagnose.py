@@ -67,7 +67,7 @@ from ..problems import gait as gait_ocp
 from ..ocp import _json_default  # the same JSON encoding as saved solutions
 from .. import effects as effects_mod
 from . import io as gio
-from . import locate as L
+from . import locate
 from .method import BIC_THRESHOLD, DEFAULT_BASE, EXPLAINED_PCT, PROFILE_GRID
 from .noise import smooth_noise
 from .nullstart import null_start_many
@@ -125,7 +125,7 @@ class Fit:
     effect: str
     solution: object | None
     thetas: dict
-    located: L.Located | None
+    located: locate.Located | None
     n_params: int
     identify: str
     status: str
@@ -181,7 +181,7 @@ def _root(ch: str) -> str:
     return ch[:-2] + "_r" if ch.endswith("_l") else ch
 
 
-def _resampled_rss(loc: L.Located, ds, fns: dict, left_shift: float, generated: bool) -> np.ndarray:
+def _resampled_rss(loc: locate.Located, ds, fns: dict, left_shift: float, generated: bool) -> np.ndarray:
     """RSS of ``loc`` for each noise draw (B,): data mean + SD*/√n · g; a generated left
     leg takes its right leg's draw at τ + ``left_shift``."""
     n = max(ds.n, 1)
@@ -212,7 +212,7 @@ class Diagnosis:
     spec: gait_ocp.GaitSpec
     objective: str
     baseline: object
-    located: L.Located
+    located: locate.Located
     fits: dict
     ranking: pd.DataFrame
     top_effect: str
@@ -221,7 +221,7 @@ class Diagnosis:
     intervals: dict
     skipped: dict
     settings: dict
-    solution_located: L.Located | None = None  # the gap of a given (e.g. thesis) solution
+    solution_located: locate.Located | None = None  # the gap of a given (e.g. thesis) solution
 
     def to_dict(self) -> dict:
         def rec(df):
@@ -290,16 +290,16 @@ class Diagnosis:
 
             matplotlib.use("Agg")
             from .. import marks
-            from . import figures as F
+            from . import figures as gap_figures
 
             m0 = marks.failure_label(self.baseline)
-            F.gap_heatmap(self.located, title=f"gap of the baseline fit — {self.data.label}", mark=m0).savefig(
+            gap_figures.gap_heatmap(self.located, title=f"gap of the baseline fit — {self.data.label}", mark=m0).savefig(
                 out / "gap_heatmap.png", dpi=110)
-            F.ranking_bars(self.ranking, top=self.top_effect, mark=m0).savefig(out / "ranking.png", dpi=110)
+            gap_figures.ranking_bars(self.ranking, top=self.top_effect, mark=m0).savefig(out / "ranking.png", dpi=110)
             if self.shrink:
                 first = next(iter(self.shrink))
                 m1 = marks.failure_label(self.fits[first].solution or self.fits[first].status)
-                F.shrink_heatmaps(self.located, self.fits[first].located, first, marks=(m0, m1)).savefig(
+                gap_figures.shrink_heatmaps(self.located, self.fits[first].located, first, marks=(m0, m1)).savefig(
                     out / "shrink.png", dpi=110)
         return out
 
@@ -343,7 +343,7 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
     baseline's (:data:`ABOVE_LOCATED`). So a ranked candidate that nests the baseline
     (``nests_baseline``, :func:`nesting`) closes ≥ −100 :data:`RETRY_MARGIN` % of the RSS;
     only a non-nesting one can show a negative % closed."""
-    loc0 = L.locate(base_sol, ds)
+    loc0 = locate.locate(base_sol, ds)
     n_eff = loc0.n_eff
     rows = []
     for name, f in fits.items():
@@ -400,14 +400,14 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
     if intervals:
         ranking["pct_closed_lo"] = ranking["effect"].map(lambda k: intervals.get(k, [np.nan, np.nan])[0])
         ranking["pct_closed_hi"] = ranking["effect"].map(lambda k: intervals.get(k, [np.nan, np.nan])[1])
-    sol_loc = L.locate(solution, ds) if solution is not None else None
+    sol_loc = locate.locate(solution, ds) if solution is not None else None
     st = dict(settings or {})
     st.update({"resamples": resamples, "seed": seed, "bic_threshold": BIC_THRESHOLD})
     return Diagnosis(ds, spec0, objective, base_sol, loc0, fits, ranking, top_effect, verdict, shrink, intervals,
                      dict(skipped or {}), st, sol_loc)
 
 
-def _shrink_table(loc0: L.Located, lk: L.Located) -> pd.DataFrame:
+def _shrink_table(loc0: locate.Located, lk: locate.Located) -> pd.DataFrame:
     a = loc0.table[["channel", "kind", "side", "phase", "n", "rms_z", "mean_z", "significant"]].rename(
         columns={"rms_z": "rms_before", "mean_z": "mean_before", "significant": "significant_before"})
     b = lk.table[["channel", "phase", "rms_z", "mean_z", "significant"]].rename(
@@ -537,7 +537,7 @@ def _nlp_fit(n: str, sol, ds, error: bool = False) -> Fit:
     if sol is None and error:
         st = "error"
     th = sol.stats.get("effects", {}) if sol is not None else {}
-    loc = L.locate(sol, ds, thetas=th) if sol is not None else None
+    loc = locate.locate(sol, ds, thetas=th) if sol is not None else None
     return Fit(n, sol, th, loc, e.n_params, e.identify, st, ok)
 
 
@@ -653,7 +653,7 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
                         prof.append((m, np.nan, st))
                         continue
                     th = sol.stats.get("effects", {})
-                    loc = L.locate(sol, ds, thetas=th)
+                    loc = locate.locate(sol, ds, thetas=th)
                     prof.append((m, loc.rss, st))
                     if ok and (best is None or loc.rss < best[2].rss):
                         best = (sol, th, loc, st)
@@ -684,19 +684,19 @@ def _comparison_fit(name: str, base_sol, ds) -> Fit:
 
     e = effects_mod.EFFECTS[name]
     p = e.magnitude
-    sim = L.sim_channels(base_sol, ds.gait.source)
+    sim = locate.sim_channels(base_sol, ds.gait.source)
 
     def rss(v):
         th = e.null_theta()
         th[p.name] = float(v)
-        return L.locate(sim, ds, thetas={name: th}).rss
+        return locate.locate(sim, ds, thetas={name: th}).rss
 
     r = minimize_scalar(rss, bounds=(p.lower, p.upper), method="bounded", options={"xatol": 1e-4})
     # the null value is a member of the search range: kept when the search ends above it
     x = float(r.x) if float(r.fun) <= rss(p.null) else float(p.null)
     th = e.null_theta()
     th[p.name] = x
-    loc = L.locate(sim, ds, thetas={name: th})
+    loc = locate.locate(sim, ds, thetas={name: th})
     return Fit(name, base_sol, {name: th}, loc, e.n_params, e.identify, "Solve_Succeeded (comparison only)", True,
                start="baseline (no re-solve)")
 

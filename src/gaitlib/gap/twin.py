@@ -32,7 +32,7 @@ from .. import conventions as cv
 from .noise import NOISE_LENGTH, smooth_noise
 from ..problems import gait as gait_ocp
 from . import io as gio
-from . import locate as L
+from . import locate
 from ..effects import EFFECTS
 
 __all__ = ["NOISE_LENGTH", "smooth_noise", "twin_spec", "twin_frame", "make_twin", "write_twin", "DEFAULT_BASE"]
@@ -171,7 +171,7 @@ def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), 
     :func:`gaitlib.sweep.sweep` (one item per spec, built once and re-solved on every twin
     by swapping the NLP's data).
     """
-    from . import diagnose as D
+    from . import diagnose
     from .solve import solve_many, solve_on
 
     effects = tuple(effects or TWIN_EFFECTS_DEFAULT())
@@ -212,9 +212,9 @@ def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), 
                     frame.to_csv(p, index=False, float_format="%.8g")
                     datasets[key] = gio.read_data(p)
             truth[key] = {"effects": v, "seed": seed, "level": (int(k.split("@")[1]) if "@" in k else None)}
-    # 2. the baseline fits (every start of D.BASELINE_STARTS; warm: the baseline's fit of the real data)
+    # 2. the baseline fits (every start of diagnose.BASELINE_STARTS; warm: the baseline's fit of the real data)
     warm = solve_on(spec0, real.gait, root=root, use_cache=use_cache, objective=objective)
-    detail = D.baseline_fits(spec0, datasets, warm, objective=objective, root=root, use_cache=use_cache, detail=True,
+    detail = diagnose.baseline_fits(spec0, datasets, warm, objective=objective, root=root, use_cache=use_cache, detail=True,
                              **sweep_kw)
     bases = {k: v["best"] for k, v in detail.items()}
     # twins none of whose baseline starts converged have no baseline: no diagnosis, listed
@@ -224,9 +224,9 @@ def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), 
     fitted = {k: ds for k, ds in datasets.items() if bases[k] is not None}
     # 3. candidates: every twin effect, re-solved on every twin (a failed or worse-than-
     #    baseline fit again from the baseline's other starts)
-    names, _ = D.candidates(spec0, next(iter(datasets.values())).gait, effects)
-    fits = D.candidate_fits(spec0, fitted, bases, names, objective=objective, root=root, use_cache=use_cache,
-                            alternates=D.alternates_of({k: detail[k] for k in fitted}), **sweep_kw) if fitted else {}
+    names, _ = diagnose.candidates(spec0, next(iter(datasets.values())).gait, effects)
+    fits = diagnose.candidate_fits(spec0, fitted, bases, names, objective=objective, root=root, use_cache=use_cache,
+                            alternates=diagnose.alternates_of({k: detail[k] for k in fitted}), **sweep_kw) if fitted else {}
     # 4. the reference of the shrink: the true model (injected effect fixed at its injected
     #    magnitude) fitted by the same method (warm-started from the baseline fit), and the
     #    generating solution's own RSS (noise only)
@@ -235,18 +235,18 @@ def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), 
         eff = truth[key]["effects"]
         if eff and bases[key] is not None:
             g = "true|" + key.split("#")[0]
-            ref_groups.setdefault(g, (D.with_effects(spec0, eff), []))[1].append((f"true|{key}", ds.gait, bases[key]))
+            ref_groups.setdefault(g, (diagnose.with_effects(spec0, eff), []))[1].append((f"true|{key}", ds.gait, bases[key]))
     ref = solve_many(ref_groups, root=root, use_cache=use_cache, objective=objective, **sweep_kw) if ref_groups else {}
     diags, refs = {}, {}
     for key, ds in datasets.items():
         if bases[key] is None:
             continue
-        diags[key] = D.assemble(ds, spec0, bases[key], fits[key], objective=objective, resamples=resamples,
+        diags[key] = diagnose.assemble(ds, spec0, bases[key], fits[key], objective=objective, resamples=resamples,
                                 settings={"twin": key})
         sol_t = ref.get(f"true|{key}")
         gen_sol = res.get(f"gen|{key.split('#')[0]}")
-        refs[key] = {"rss_gen": L.locate(gen_sol, ds).rss if gen_sol is not None else np.nan,
-                     "rss_true_fixed": L.locate(sol_t, ds).rss if sol_t is not None else np.nan,
+        refs[key] = {"rss_gen": locate.locate(gen_sol, ds).rss if gen_sol is not None else np.nan,
+                     "rss_true_fixed": locate.locate(sol_t, ds).rss if sol_t is not None else np.nan,
                      "status_true_fixed": sol_t.stats["status"] if sol_t is not None else ("n/a" if not truth[key]["effects"] else "error")}
     return TwinValidation.build(diags, truth, mags, gen_stats, refs=refs, settings={
         "base": spec0.to_dict(), "objective": objective, "gen_objective": gen_objective, "seeds": list(seeds),

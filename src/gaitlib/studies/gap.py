@@ -34,10 +34,10 @@ import numpy as np
 import pandas as pd
 
 from ..problems import gait as gait_ocp
-from ..gap import diagnose as D
+from ..gap import diagnose
 from .. import effects as effects_mod
 from ..gap import io as gio
-from ..gap import locate as L
+from ..gap import locate
 from ..gap import twin
 
 __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "NMSK_CANDIDATES", "effect_table", "twin_validation",
@@ -77,7 +77,7 @@ def twin_validation(seeds=TWIN_SEEDS, base: dict | None = None, serial: bool = T
 
 
 def sk_diagnosis(source: str = "schwartz2008", speed_class: str = "Free", resamples: int = 200,
-                 serial: bool = True, **kw) -> D.Diagnosis:
+                 serial: bool = True, **kw) -> diagnose.Diagnosis:
     """The SK diagnosis (:func:`gaitlib.gap.diagnose`) of a committed data set. gaitutils has
     no GRFs: they are taken from Schwartz 2008 (same class) to make the problem complete and
     excluded from the gap (:func:`gaitlib.gap.io.load_real` ``fill_from``)."""
@@ -87,7 +87,7 @@ def sk_diagnosis(source: str = "schwartz2008", speed_class: str = "Free", resamp
     if not serial and ds.filled:
         raise ValueError("a filled data set is solved in this process only (serial=True): see own_data")
     with own_data(ds.gait if ds.filled else None):
-        return D.diagnose(ds, base=base, resamples=resamples, serial=serial, progress=False, **kw)
+        return diagnose.diagnose(ds, base=base, resamples=resamples, serial=serial, progress=False, **kw)
 
 
 @contextlib.contextmanager
@@ -121,7 +121,7 @@ def own_data(gait):
 
 
 def nmsk_attribution(candidates=NMSK_CANDIDATES, resamples: int = 200, serial: bool = True,
-                     root=None) -> D.Diagnosis:
+                     root=None) -> diagnose.Diagnosis:
     """Muscle-level candidates on the Ch 5 NMSK solution (thesis Sec 5.3.5's question: does
     co-contraction close the TA/GAM gap?).
 
@@ -136,14 +136,14 @@ def nmsk_attribution(candidates=NMSK_CANDIDATES, resamples: int = 200, serial: b
     base_sol = msk.solve("NMSK", root=root)
     spec0 = base_sol.spec
     ds = gio.load_real(spec0.speed_class, spec0.source)
-    names, skipped = D.candidates(spec0, ds.gait, candidates)
-    fits = D.candidate_fits(spec0, {"data": ds}, {"data": base_sol}, names, objective="cost", root=root,
+    names, skipped = diagnose.candidates(spec0, ds.gait, candidates)
+    fits = diagnose.candidate_fits(spec0, {"data": ds}, {"data": base_sol}, names, objective="cost", root=root,
                             serial=serial, progress=False)["data"]
-    return D.assemble(ds, spec0, base_sol, fits, objective="cost", resamples=resamples, skipped=skipped,
+    return diagnose.assemble(ds, spec0, base_sol, fits, objective="cost", resamples=resamples, skipped=skipped,
                       settings={"objective": "cost", "candidates": names, "baseline": "Ch 5 NMSK solution"})
 
 
-def _emg_rss(loc: L.Located, stems) -> dict:
+def _emg_rss(loc: locate.Located, stems) -> dict:
     ch = loc.channels
     out = {}
     for s in stems:  # channel names of EMG are "<stem without emg_>_<side>", e.g. "TA_r"
@@ -152,7 +152,7 @@ def _emg_rss(loc: L.Located, stems) -> dict:
     return out
 
 
-def emg_gap_table(diag: D.Diagnosis, stems=("emg_TA", "emg_MG", "emg_RF", "emg_LH")) -> pd.DataFrame:
+def emg_gap_table(diag: diagnose.Diagnosis, stems=("emg_TA", "emg_MG", "emg_RF", "emg_LH")) -> pd.DataFrame:
     """The EMG channels' RSS (both legs, SD-standardised, :mod:`gaitlib.gap.locate`) of the
     baseline and of each candidate's best fit, with the identified magnitude and status;
     ``mean_z`` of TA and MG tells the sign (model below/above the EMG)."""
@@ -179,13 +179,13 @@ def emg_gap_table(diag: D.Diagnosis, stems=("emg_TA", "emg_MG", "emg_RF", "emg_L
     return pd.DataFrame(rows)
 
 
-def top_cells(loc: L.Located, n: int = 6) -> pd.DataFrame:
+def top_cells(loc: locate.Located, n: int = 6) -> pd.DataFrame:
     """The ``n`` channel × phase cells with the largest RMS SD-standardised residual."""
     t = loc.table.sort_values("rms_z", ascending=False).head(n)
     return t[["channel", "phase", "rms_z", "mean_z", "frac_out", "p_min", "significant"]].reset_index(drop=True)
 
 
-def ranking_table(diag: D.Diagnosis) -> pd.DataFrame:
+def ranking_table(diag: diagnose.Diagnosis) -> pd.DataFrame:
     """The ranking for printing: effect, k, identified values, where the kept fit started,
     whether the effect nests the baseline, status, % closed (with its 95 % resampling
     interval where computed), ΔAIC, ΔBIC. Unranked rows (no rank: failed search, a nested
@@ -197,7 +197,7 @@ def ranking_table(diag: D.Diagnosis) -> pd.DataFrame:
     return r[cols]
 
 
-def summary(diag: D.Diagnosis) -> dict:
+def summary(diag: diagnose.Diagnosis) -> dict:
     """Numbers for the text: baseline RSS, n_eff, significant cells, top effect, verdict, its
     % closed and interval."""
     s = {"label": diag.data.label, "rss": diag.located.rss, "n_eff": diag.located.n_eff,
@@ -213,7 +213,7 @@ def summary(diag: D.Diagnosis) -> dict:
     return s
 
 
-def profile_table(diag: D.Diagnosis, effect: str, stems=("emg_TA", "emg_MG", "emg_RF", "emg_LH")) -> pd.DataFrame:
+def profile_table(diag: diagnose.Diagnosis, effect: str, stems=("emg_TA", "emg_MG", "emg_RF", "emg_LH")) -> pd.DataFrame:
     """Every profile point of a profiled effect (``identify="profile"``) of ``diag``: its
     magnitude, IPOPT status and iterations, the whole gap's RSS and the EMG channels' RSS
     and mean z — the solutions reloaded from the cache (:func:`gaitlib.gap.solve.solve_on`
@@ -224,15 +224,15 @@ def profile_table(diag: D.Diagnosis, effect: str, stems=("emg_TA", "emg_MG", "em
     rows = [{"magnitude": 0.0, "status": diag.baseline.stats["status"], "iterations": diag.baseline.stats.get("iterations"),
              "RSS (all)": diag.located.rss, **_emg_cols(diag.located, stems)}]
     for m, _, _ in f.profile:
-        spec = D.with_effects(diag.spec, ((effect, m),))
+        spec = diagnose.with_effects(diag.spec, ((effect, m),))
         sol = solve_on(spec, diag.data.gait, diag.baseline, objective=diag.objective)
-        loc = L.locate(sol, diag.data, thetas=sol.stats.get("effects"))
+        loc = locate.locate(sol, diag.data, thetas=sol.stats.get("effects"))
         rows.append({"magnitude": m, "status": sol.stats["status"], "iterations": sol.stats.get("iterations"),
                      "RSS (all)": loc.rss, **_emg_cols(loc, stems)})
     return pd.DataFrame(rows)
 
 
-def _emg_cols(loc: L.Located, stems) -> dict:
+def _emg_cols(loc: locate.Located, stems) -> dict:
     r = _emg_rss(loc, stems)
     out = {f"RSS {s[4:]}": r[s] for s in stems}
     m = loc.points.groupby("channel")["z"].mean()
@@ -273,7 +273,7 @@ def exact_left_leg(gait, order: int | None = None):
     return replace(gait, mean=mean, sd=sd, notes=tuple(gait.notes) + (note,)), replaced
 
 
-def left_leg_check(diag: D.Diagnosis) -> dict:
+def left_leg_check(diag: diagnose.Diagnosis) -> dict:
     """How much of ``diag``'s located gap is the left leg's generation rather than the model.
 
     The data's left leg is the right leg phase-shifted through a 5th-order Fourier fit
@@ -292,10 +292,10 @@ def left_leg_check(diag: D.Diagnosis) -> dict:
     ds = diag.data
     gait_x, replaced = exact_left_leg(ds.gait)
     ds_x = replace(ds, gait=gait_x)
-    loc_x = L.locate(diag.baseline, ds_x)
+    loc_x = locate.locate(diag.baseline, ds_x)
     view = gait_ocp.tracking_data(ds.gait)
     gen_sim = view.mean.set_axis(pd.Index(view.time / float(view.cycle_time), name="tau"), axis=0)
-    gen = L.locate(gen_sim, ds_x)
+    gen = locate.locate(gen_sim, ds_x)
     g = gen.channels[gen.channels["side"] == "l"][["channel", "rss", "rms_z", "significant"]]
     cells = diag.located.table[["channel", "phase", "rms_z", "significant"]].merge(
         loc_x.table[["channel", "phase", "rms_z", "significant"]], on=["channel", "phase"],
@@ -306,7 +306,7 @@ def left_leg_check(diag: D.Diagnosis) -> dict:
             continue
         # data-model effects (left_shift) read the data differently: adjust, then shift exactly
         gait_f = effects_mod.adjust_data(ds.gait, f.thetas) if f.thetas else ds.gait
-        lx = L.locate(f.solution, replace(ds, gait=exact_left_leg(gait_f)[0]))
+        lx = locate.locate(f.solution, replace(ds, gait=exact_left_leg(gait_f)[0]))
         rows.append({"effect": n, "status": f.status,
                      "RSS (data as tracked)": f.located.rss,
                      "% closed (data as tracked)": 100 * (1 - f.located.rss / diag.located.rss),
@@ -353,7 +353,7 @@ def book_gaps(root=None) -> pd.DataFrame:
             ds = gio.load_real(cls, "schwartz2008")
             data[cls] = (ds, replace(ds, gait=exact_left_leg(ds.gait)[0]))
         ds, ds_x = data[cls]
-        loc, loc_x = L.locate(sol, ds), L.locate(sol, ds_x)
+        loc, loc_x = locate.locate(sol, ds), locate.locate(sol, ds_x)
         ch, chx = loc.channels, loc_x.channels
         t = loc.table[loc.table["kind"] != "emg"]
         top = t.sort_values("rms_z", ascending=False).iloc[0]
@@ -445,7 +445,7 @@ def _diagnosis_text(s: dict, full: bool) -> str:
                     f"(95 % interval {s['interval'][0]:.0f}–{s['interval'][1]:.0f} %, ΔBIC = {s['best_dBIC']:.1f}).")
         return (f"the diagnosis names **{s['top']}** ({s['verdict']}, {s['best_pct']:.0f} % closed, "
                 f"interval {s['interval'][0]:.0f}–{s['interval'][1]:.0f} %).")
-    what = f"best {s['best']}, {s['best_pct']:.0f} % closed, ΔBIC = {s['best_dBIC']:.1f}; threshold {D.BIC_THRESHOLD:g}"
+    what = f"best {s['best']}, {s['best_pct']:.0f} % closed, ΔBIC = {s['best_dBIC']:.1f}; threshold {diagnose.BIC_THRESHOLD:g}"
     return (f"No candidate passes the criterion: **unexplained** ({what})." if full else f"**unexplained** ({what}).")
 
 
@@ -470,7 +470,7 @@ def _left_line(lab: str, c: dict) -> str:
             f"{top_t['effect']} ({top_t['% closed (data as tracked)']:.0f} %) on the data as tracked")
 
 
-def findings(tv, tv_full, diag_s: D.Diagnosis, diag_u: D.Diagnosis, diag_n: D.Diagnosis, check_s: dict,
+def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis, diag_n: diagnose.Diagnosis, check_s: dict,
              check_u: dict, gaps: pd.DataFrame, emg: pd.DataFrame) -> list[str]:
     """The chapter's findings as Markdown paragraphs, every number and verdict from the
     results: the twin checks (``tv`` on the coarse mesh, :func:`twin_validation`;
@@ -528,7 +528,7 @@ def findings(tv, tv_full, diag_s: D.Diagnosis, diag_u: D.Diagnosis, diag_n: D.Di
     return out
 
 
-def co_contraction_text(diag_n: D.Diagnosis, emg: pd.DataFrame, closes_most: float = 0.5) -> str | None:
+def co_contraction_text(diag_n: diagnose.Diagnosis, emg: pd.DataFrame, closes_most: float = 0.5) -> str | None:
     """The thesis's co-contraction suspicion (Sec 5.3.5) tested on the NMSK solution: how far
     the TA and MG excitations sit from their EMG (mean z), and whether the best
     co-contraction fit closes most — more than ``closes_most`` of the TA + MG RSS — of the
