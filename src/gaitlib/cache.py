@@ -51,6 +51,7 @@ import uuid
 import warnings
 from functools import lru_cache
 from pathlib import Path
+from . import data
 
 __all__ = ["fingerprint", "key", "default_dir", "store_dir", "find", "lookup", "save", "verify", "scan",
            "clear", "only", "solve_or_load", "MANIFEST", "CacheWarning", "CorruptEntry", "NotCached"]
@@ -123,8 +124,6 @@ def _formulations(formulation) -> list[str]:
 
 
 def _data_digest(identified: tuple | None) -> str:
-    from . import data
-
     h = hashlib.sha256()
     data_dir = Path(data.DATA_DIR)
     files = []

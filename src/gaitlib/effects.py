@@ -44,6 +44,10 @@ import casadi as ca
 import numpy as np
 
 from . import conventions as cv
+from .model import P_BODY_NAMES
+from .contact import param_index
+from . import data as data_mod
+from .ocp import Parameter
 
 __all__ = ["EffectParam", "Effect", "EFFECTS", "TWIN_EFFECTS", "Context", "Bound", "bind", "validate",
            "data_columns", "adjust_data", "theta_of", "ARM"]
@@ -129,14 +133,10 @@ class Effect:
 # ======================================================================================
 
 def _idx(name: str) -> int:
-    from .model import P_BODY_NAMES
-
     return P_BODY_NAMES.index(name)
 
 
 def _contact_idx(ell: str, name: str) -> int:
-    from .contact import param_index
-
     return param_index(ell, name)
 
 
@@ -486,8 +486,6 @@ def regenerate_left(gait, shift: float, emg: bool | None = None):
     by comparing with the right leg shifted by the data's own shift)."""
     import dataclasses
 
-    from . import data as data_mod
-
     mean, sd = gait.mean.copy(), gait.sd.copy()
     n = len(mean)
     for c in gait.mean.columns:
@@ -515,8 +513,6 @@ def regenerate_left(gait, shift: float, emg: bool | None = None):
 def left_generated(gait) -> bool:
     """Whether ``gait``'s left-leg angles are the right leg's shifted by ``left_shift``
     (order-5 Fourier, as :func:`gaitlib.data.load_gait_data` generates them)."""
-    from . import data as data_mod
-
     for stem in ("hip", "knee", "ankle"):
         test = data_mod.fourier_shift(gait.mean[f"{stem}_r"].to_numpy(), gait.left_shift, FOURIER_ORDER)
         if not np.allclose(test, gait.mean[f"{stem}_l"].to_numpy(), atol=1e-9):
@@ -793,8 +789,6 @@ class _DataView:
 def bind(spec, ctx: Context) -> Bound:
     """Bind ``spec.effects`` to a problem: NLP parameters for free effects (``fx.<effect>.
     <param>`` within the parameter's bounds, starting at its null value)."""
-    from .ocp import Parameter
-
     items = [(EFFECTS[n], m) for n, m in validate(spec.effects, spec.model)]
     # an effect fixed at its null value is the baseline model: leave it out entirely, so the
     # NLP is the baseline's (not merely equal in value)

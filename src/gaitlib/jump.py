@@ -70,6 +70,7 @@ from gaitlib.model import (
     foot_angles,
     solve_spd,
 )
+from gaitlib import contact
 
 __all__ = ["JUMP_SEGMENTS", "JumpModel"]
 
@@ -189,8 +190,6 @@ class JumpModel:
 
     @cached_property
     def _smoothing(self):
-        from gaitlib import contact
-
         return self.smoothing if self.smoothing is not None else contact.Smoothing()
 
     # ------------------------------------------------------------ graph
@@ -357,8 +356,6 @@ class JumpModel:
     def contact_dynamics(self, q, qd, tau, p_contact=None) -> dict:
         """Free model with ellipsoid contact: ``qdd``, ``fn`` (3,), ``grf_x``, ``grf_y``."""
         if p_contact is None:
-            from gaitlib import contact
-
             p_contact = contact.default_params()
         return _call(self.function("contact"), [q, qd, tau, p_contact])
 

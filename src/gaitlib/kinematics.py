@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from gaitlib import conventions as cv
+from gaitlib import contact
 
 __all__ = [
     "shape_matrix",
@@ -46,8 +47,6 @@ def ellipsoid_bottom(centre, R, radii) -> float:
 def ellipsoid_radii(p_contact=None) -> np.ndarray:
     """Radii (a, b, c) of the six ellipsoids of the child model, (6, 3) m, in the order
     :data:`gaitlib.model.ELLIPSOID_LABELS` (right foot first; the mirror keeps the radii)."""
-    from gaitlib import contact
-
     p = contact.default_params() if p_contact is None else np.asarray(p_contact, dtype=float)
     abc = np.array([p[contact.param_index(e, "a"):contact.param_index(e, "c") + 1]
                     for e in cv.ELLIPSOIDS])
@@ -178,6 +177,4 @@ def height_for_load(model, Q, load, p_contact=None, below: float = 0.06, above: 
 
 def contact_default(p_contact):
     """``p_contact`` or the default contact parameters (39,)."""
-    from gaitlib import contact
-
     return contact.default_params() if p_contact is None else np.asarray(p_contact, dtype=float)

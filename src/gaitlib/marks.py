@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from . import validity
 
 __all__ = ["CONVERGED", "MARK_COLOR", "HATCH", "DAGGER", "MARK_GID", "status_of", "failure_label",
            "use_validity_check",
@@ -81,7 +82,6 @@ def validity_verdict(obj):
     hit = _verdicts.get(id(obj))
     if hit is not None and hit[0] is obj:
         return hit[1]
-    from . import validity
 
     try:
         lab = validity.check(obj).label()

@@ -81,6 +81,7 @@ import casadi as ca
 import numpy as np
 
 from gaitlib import conventions as cv
+from gaitlib import contact
 
 __all__ = [
     "PlanarBody",
@@ -452,8 +453,6 @@ def ellipsoid_frame(state: _BodyState, body: int, offset, params, right: bool = 
     dict with ``body``, ``R`` (3x3, ellipsoid -> ground), ``centre`` (x, y, z), ``vel``
     (vx, vy, 0), ``omega`` and ``params`` (the first 7 parameters: k_v ... c).
     """
-    from gaitlib import contact
-
     gam, bet, alp = params[10], params[11], params[12]
     r = ca.vertcat(params[7], params[8], params[9])
     R_loc = contact.ellipsoid_to_segment(gam, bet, alp)
@@ -476,8 +475,6 @@ def ellipsoid_frame(state: _BodyState, body: int, offset, params, right: bool = 
 
 def ellipsoid_contact(frame: dict, smoothing) -> dict:
     """``gaitlib.contact.ellipsoid_plane`` outputs for an :func:`ellipsoid_frame`."""
-    from gaitlib import contact
-
     k_v, a_v, mu_s, mu_d, a, b, c = frame["params"]
     return contact.ellipsoid_plane(
         frame["R"], ca.vertcat(*frame["centre"]), ca.vertcat(*frame["vel"]), frame["omega"],
@@ -688,8 +685,6 @@ class ChildModel:
 
     # ------------------------------------------------------------ contact geometry
     def _contact_module(self):
-        from gaitlib import contact
-
         return contact
 
     @cached_property

@@ -31,6 +31,9 @@ from pathlib import Path
 import numpy as np
 
 from . import data as data_mod
+from . import contact
+from .model import P_BODY_NAMES
+from .model import ChildModel
 
 __all__ = ["IDENTIFIED_DIR", "identified_path", "load_identified", "contact_params", "body_params"]
 
@@ -56,9 +59,6 @@ def _vector(d: dict, names, what: str, path: Path) -> np.ndarray:
 
 @lru_cache(maxsize=8)
 def _load(path_str: str, mtime_ns: int) -> dict:
-    from . import contact
-    from .model import P_BODY_NAMES
-
     path = Path(path_str)
     try:
         raw = json.loads(path.read_text())
@@ -111,8 +111,6 @@ def contact_params(which: str = "default") -> np.ndarray:
     """The 39 contact parameters (SI, left foot): ``"default"`` — the thesis's identified
     values (Tables 4.17–4.18, :func:`gaitlib.contact.default_params`); ``"ch4"`` — ours
     (approach (c) of Ch 4, :func:`load_identified`)."""
-    from . import contact
-
     if which == "default":
         return contact.default_params()
     if which == "ch4":
@@ -124,8 +122,6 @@ def body_params(which: str = "default", model=None) -> np.ndarray:
     """The 25 body/joint parameters (SI): ``"default"`` — Tables 4.1–4.3 scaled (Sec 4.1.1);
     ``"thesis"`` — the thesis's identified values (Tables 4.15–4.16); ``"ch4"`` — ours
     (approach (c) of Ch 4, :func:`load_identified`)."""
-    from .model import ChildModel
-
     model = ChildModel() if model is None else model
     if which == "default":
         return model.default_p_body()

@@ -11,6 +11,12 @@ import re
 import numpy as np
 
 from . import conventions as cv
+from .kinematics import shape_matrix
+from .kinematics import ellipsoid_bottom, ellipsoid_radii
+from .model import ELLIPSOID_LABELS
+from . import contact
+from . import marks as mk
+from .model import ChildModel
 
 #: How a model channel is shown: (label, scale from SI, display unit).
 DISPLAY = {
@@ -125,8 +131,6 @@ def ellipse_outline(centre, R, radii, n: int = 64) -> np.ndarray:
     projects onto the ellipse ``{x : (x − c_xy)ᵀ A⁻¹ (x − c_xy) ≤ 1}`` whose shape matrix
     ``A`` is the top-left 2×2 block of ``R D² Rᵀ``; its outline is ``c_xy + A^½ (cos s, sin s)``.
     """
-    from .kinematics import shape_matrix
-
     A = shape_matrix(R, radii)[:2, :2]
     w, V = np.linalg.eigh(A)
     half = V @ np.diag(np.sqrt(np.clip(w, 0.0, None))) @ V.T  # symmetric square root
@@ -200,9 +204,6 @@ def model_frame(model, q, qd=None, p_contact=None, p_body=None) -> dict:
     :data:`gaitlib.model.ELLIPSOID_LABELS`), ``contact`` (the :meth:`ChildModel.contact`
     outputs) and ``bottoms`` (6,) lowest ellipsoid points, m.
     """
-    from .kinematics import ellipsoid_bottom, ellipsoid_radii
-    from .model import ELLIPSOID_LABELS
-
     q = np.asarray(q, dtype=float)
     qd = np.zeros_like(q) if qd is None else np.asarray(qd, dtype=float)
     segs = model.segments(q, p_body)
@@ -272,8 +273,6 @@ def draw_model(ax, model, q, qd=None, p_contact=None, p_body=None, grf=True, ell
     (side → FancyArrowPatch), ``ground`` and the numbers drawn (``frame``, see
     :func:`model_frame`). Pass it to :func:`update_model` to move the figure.
     """
-    from .model import ELLIPSOID_LABELS
-
     if grf_min is None:
         grf_min = 0.04 * model.body_mass * model.g
     artists = {"chains": {}, "ellipsoids": {}, "grf": {}, "grf_min": grf_min,
@@ -305,8 +304,6 @@ def _jump_full_q(jump_model, q) -> np.ndarray:
 def jump_frame(jump_model, q, p_contact=None, ellipsoids=None) -> dict:
     """Numbers :func:`draw_jump` draws: ``chains`` (one polyline toe tip → MTP → ankle →
     knee → hip → head) and ``ellipses`` (toe, ball, heel outlines; toe-included model)."""
-    from . import contact
-
     q = _jump_full_q(jump_model, q)
     P = jump_model.points(q)
     order = (["toe_tip"] if jump_model.toe else []) + ["mtp", "ankle", "knee", "hip", "head"]
@@ -314,8 +311,6 @@ def jump_frame(jump_model, q, p_contact=None, ellipsoids=None) -> dict:
     if ellipsoids is None:
         ellipsoids = jump_model.toe
     if ellipsoids and jump_model.toe:
-        from .kinematics import ellipsoid_radii
-
         pc = contact.default_params() if p_contact is None else np.asarray(p_contact, float)
         res = jump_model.function("ellipsoids")(q, pc)
         C = np.asarray(res[0])
@@ -430,8 +425,6 @@ def animate_gait(model, t, Q, Qd=None, p_contact=None, p_body=None, fps: float =
 
 
 def _mark_animation(ax, mark):
-    from . import marks as mk
-
     if mark:
         mk.mark_axes(ax, mark)
         ax.set_title(f"{mark} — {ax.get_title()}" if ax.get_title() else mark, fontsize=9, color=mk.MARK_COLOR,
@@ -485,8 +478,6 @@ def tracking_figure(gait, sims: dict, channels=GAIT_CHANNELS, ncols: int = 4, co
         title starts with it in red (:mod:`gaitlib.marks`).
     """
     import matplotlib.pyplot as plt
-
-    from . import marks as mk
 
     channels = list(channels)
     marks = {lab: m for lab, m in (marks or {}).items() if m and lab in sims}
@@ -608,8 +599,6 @@ def score_bars(scores, kind: str, value: str = "rmse", cases=None, models=None, 
     """
     import matplotlib.pyplot as plt
 
-    from . import marks as mk
-
     df = scores[scores["kind"] == kind]
     run_marks = {}
     if "mark" in df.columns:
@@ -689,8 +678,6 @@ def foot_contact_geometry(param_sets: dict, model=None, colors=None, styles=None
     """
     import matplotlib.pyplot as plt
 
-    from .model import ChildModel
-
     model = ChildModel() if model is None else model
     q = np.zeros(len(cv.COORDS))
     q[cv.COORDS.index("pelvis_ty")] = model.standing_leg_length
@@ -706,8 +693,6 @@ def foot_contact_geometry(param_sets: dict, model=None, colors=None, styles=None
     ax_s.axhline(0.0, color=FIGURE_COLORS["ground"], lw=1.0, zorder=0)
     ax_s.plot(1e3 * skel[:, 0], 1e3 * skel[:, 1], "-o", color="0.3", lw=2.0, ms=3, zorder=1)
     ax_t.plot(1e3 * skel[[0, 3], 0], [0.0, 0.0], "-", color="0.3", lw=2.0, zorder=1)
-    from .kinematics import ellipsoid_radii
-    from .model import ELLIPSOID_LABELS
 
     for lab in labels:
         p = np.asarray(param_sets[lab], float)

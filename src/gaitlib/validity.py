@@ -105,6 +105,11 @@ import pandas as pd
 from . import conventions as cv
 from . import mtg
 from .sweep import ACCEPTED_STATUSES
+from . import data as data_mod
+from . import params as params_mod
+from .model import ChildModel
+from .problems import gait as gait_ocp
+from .jump import JUMP_SEGMENTS
 
 __all__ = ["CONVERGED_STATUSES", "SWING_LOAD_BW", "SWING_MARGIN", "DOUBLE_SUPPORT_MAX", "DOUBLE_SUPPORT_WALKING",
            "RESIDUAL_FORCE_FRACTION", "RESIDUAL_MOMENT_FRACTION", "ROM_DEG", "ROM_TOL_DEG", "PERIODICITY_TOL",
@@ -439,8 +444,6 @@ def _gait_kind(spec) -> str:
 
 @lru_cache(maxsize=16)
 def _gait_data(speed_class: str, source: str = "schwartz2008"):
-    from . import data as data_mod
-
     return data_mod.load_gait_data(speed_class, source)
 
 
@@ -466,9 +469,6 @@ def data_rom(gait) -> dict:
 
 def _com_height(q: pd.DataFrame, body_params: str = "default") -> float:
     """Mean COM height over the frames (m), model COM with the spec's body parameters."""
-    from . import params as params_mod
-    from .model import ChildModel
-
     m = ChildModel()
     pb = params_mod.body_params(body_params, m)
     f = m.function("com").map(len(q))
@@ -489,8 +489,6 @@ def _gait_periodicity(sol, stride: float) -> tuple[float, str]:
 
 
 def _check_gait(sol, kind, data, name) -> Gates:
-    from .problems import gait as gait_ocp
-
     spec = sol.spec
     kind = kind or _gait_kind(spec)
     events, shift, stride, rom = _tracked_data(spec, data)
@@ -508,8 +506,6 @@ def _check_gait(sol, kind, data, name) -> Gates:
 
 
 def _check_contact_a(res, name) -> Gates:
-    from .problems import gait as gait_ocp
-
     g = _gait_data("Free")
 
     return check_frames(status=res.stats["status"] if res.stats["success"] else f"{res.stats['status']} "
@@ -525,8 +521,6 @@ def _check_contact_a(res, name) -> Gates:
 def _jump_height(model) -> float:
     """Standing height of the jump model's top (m): the ankle's height above the MTP point
     (foot length × sin incline) + shank + thigh + HT (thesis Table 3.1)."""
-    from .jump import JUMP_SEGMENTS
-
     L = {k: v[1] for k, v in JUMP_SEGMENTS.items()}
     return float(L["foot"] * math.sin(model.incline) + L["shank"] + L["thigh"] + L["ht"])
 

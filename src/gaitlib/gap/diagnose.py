@@ -72,6 +72,8 @@ from .method import BIC_THRESHOLD, DEFAULT_BASE, EXPLAINED_PCT, PROFILE_GRID
 from .noise import smooth_noise
 from .nullstart import null_start_many
 from .solve import solve_many
+from .. import marks
+from . import figures as gap_figures
 
 __all__ = ["BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "Fit", "Diagnosis", "diagnose", "assemble",
            "candidates", "base_spec", "as_dataset", "baseline_fits", "pick_best", "BASELINE_STARTS",
@@ -289,8 +291,6 @@ class Diagnosis:
             import matplotlib
 
             matplotlib.use("Agg")
-            from .. import marks
-            from . import figures as gap_figures
 
             m0 = marks.failure_label(self.baseline)
             gap_figures.gap_heatmap(self.located, title=f"gap of the baseline fit — {self.data.label}", mark=m0).savefig(

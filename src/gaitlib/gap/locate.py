@@ -51,6 +51,8 @@ from scipy.stats import norm
 from .. import activation
 from .. import conventions as cv
 from ..problems import gait as gait_ocp
+from .. import effects as effects_mod
+from .io import DataSet, filled_channels
 
 __all__ = ["PHASES", "PHASE_NAMES", "N_GRID", "phase_edges", "phase_of", "sim_channels", "Located", "locate",
            "resels", "ALPHA", "SD_FLOOR"]
@@ -210,9 +212,6 @@ def locate(sim, ds, thetas: dict | None = None, exclude=()) -> Located:
     (:func:`gaitlib.effects.adjust_data`). ``exclude``: model channels not to count
     (default: those a DataSet filled from another data set).
     """
-    from .. import effects as effects_mod
-    from .io import DataSet, filled_channels
-
     n = 1
     if isinstance(ds, DataSet):
         exclude = set(exclude) | filled_channels(ds)

@@ -36,6 +36,7 @@ from .. import ocp
 from ..problems import gait as gait_ocp
 from .solve import FORMULATION as FIT_FORMULATION
 from .solve import Lazy, Runner, _check_same_cycle, solve_or_load, sweep_groups
+from .io import signature
 
 __all__ = ["NULL_START_IPOPT", "FORMULATION", "null_start_on", "null_start_many", "null_guess"]
 
@@ -58,8 +59,6 @@ def null_guess(base) -> ocp.Guess:
 
 
 def _where(spec, gait, base, root, objective) -> Path:
-    from .io import signature
-
     desc = {"kind": "gap-null-start", "spec": spec.to_dict(), "data": signature(gait),
             "guess": gait_ocp.guess_signature(base), "objective": objective, "ipopt": dict(NULL_START_IPOPT)}
     return cache.lookup("gap", desc, root, formulation=(gait_ocp.FORMULATION, FIT_FORMULATION, FORMULATION),

@@ -35,6 +35,9 @@ import numpy as np
 from .. import cache
 from .. import ocp
 from ..problems import gait as gait_ocp
+from .io import signature
+from .locate import SD_FLOOR
+from .. import sweep
 
 __all__ = ["Runner", "Lazy", "solve_on", "solve_or_load", "solve_many", "FORMULATION", "OBJECTIVES", "FIT_WEIGHT",
            "fit_problem"]
@@ -56,8 +59,6 @@ FORMULATION = "gap-fit-1"
 
 
 def _where(spec: gait_ocp.GaitSpec, gait, guess, root, objective="fit") -> Path:
-    from .io import signature
-
     desc = {"kind": "gap-solve", "spec": spec.to_dict(), "data": signature(gait), "guess": gait_ocp.guess_signature(guess),
             "objective": objective}
     return cache.lookup("gap", desc, root, formulation=(gait_ocp.FORMULATION, FORMULATION),
@@ -80,8 +81,6 @@ def _fit_channels():
 
 def sd_columns(gait, tau_grid) -> dict:
     """``sd_<channel>`` columns (SD* of :mod:`gaitlib.gap.locate`) on ``tau_grid``."""
-    from .locate import SD_FLOOR
-
     view = gait_ocp.tracking_data(gait)
     t = np.asarray(view.time, float) / float(view.cycle_time)
     out = {}
@@ -228,8 +227,6 @@ def sweep_groups(work, groups: dict, *, root=None, use_cache: bool = True, objec
                  **sweep_kw) -> dict:
     """``work((spec, jobs, root, use_cache, objective))`` per group through
     :func:`gaitlib.sweep.sweep`; key → GaitSolution plus ``"__records__"``."""
-    from .. import sweep
-
     root = str(Path(root if root is not None else cache.default_dir()).resolve())
     items = {name: (spec, jobs, root, use_cache, objective) for name, (spec, jobs) in groups.items()}
     recs = sweep.sweep(work, items, **sweep_kw)

@@ -34,6 +34,14 @@ from ..problems import gait as gait_ocp
 from . import io as gio
 from . import locate
 from ..effects import EFFECTS
+from .locate import sim_channels
+from .solve import solve_on
+from ..ocp import SolveFailedError
+from ..sweep import ACCEPTED_STATUSES
+from . import diagnose
+from .solve import solve_many
+from ..effects import TWIN_EFFECTS
+from .diagnose import BIC_THRESHOLD
 
 __all__ = ["NOISE_LENGTH", "smooth_noise", "twin_spec", "twin_frame", "make_twin", "write_twin", "DEFAULT_BASE"]
 
@@ -58,8 +66,6 @@ def twin_frame(sol: gait_ocp.GaitSolution, real: gio.DataSet, seed: int | None, 
 
     SD = the real data's SD of the same channel (left leg: the real data's, as generated);
     noise as :func:`smooth_noise` × SD/√n (``seed``; ``noise=False``: the clean curves)."""
-    from .locate import sim_channels
-
     gait = real.gait
     sim = sim_channels(sol, gait.source)
     tau = np.linspace(0.0, 1.0, 51)
@@ -116,8 +122,6 @@ def make_twin(effects, seed: int = 0, *, base: dict | None = None, real: gio.Dat
     objective : ``"fit"`` (the model with the effect fitted to the real data) or ``"cost"``
         (the spec's cost function), :mod:`gaitlib.gap.solve`.
     """
-    from .solve import solve_on
-
     spec = twin_spec(effects, base)
     real = real or gio.load_real(spec.speed_class, spec.source)
     sol = solve_on(spec, real.gait, root=root, use_cache=use_cache, objective=objective)
@@ -133,9 +137,6 @@ def write_twin(path, effects, seed: int = 0, **kw) -> Path:
     """Write a twin's tidy CSV to ``path`` and its truth to ``<path stem>.truth.json``.
     Raises :class:`gaitlib.ocp.SolveFailedError` (nothing written) when the generating solve
     did not converge: its curves are not the model's gait."""
-    from ..ocp import SolveFailedError
-    from ..sweep import ACCEPTED_STATUSES
-
     frame, truth = make_twin(effects, seed, **kw)
     if truth["status"] not in ACCEPTED_STATUSES:
         raise SolveFailedError(f"the twin's generating solve did not converge ({truth['status']}, "
@@ -171,9 +172,6 @@ def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), 
     :func:`gaitlib.sweep.sweep` (one item per spec, built once and re-solved on every twin
     by swapping the NLP's data).
     """
-    from . import diagnose
-    from .solve import solve_many, solve_on
-
     effects = tuple(effects or TWIN_EFFECTS_DEFAULT())
     base = dict(DEFAULT_BASE if base is None else base)
     spec0 = gait_ocp.GaitSpec(**base)
@@ -261,8 +259,6 @@ TARGET_SHRINK_PCT = 60.0
 
 
 def TWIN_EFFECTS_DEFAULT():
-    from ..effects import TWIN_EFFECTS
-
     return TWIN_EFFECTS
 
 
@@ -431,8 +427,6 @@ class TwinValidation:
         ``true_not_named`` — the injected effect would not have been named even with its own
         fit's ΔBIC (not below :data:`gaitlib.gap.diagnose.BIC_THRESHOLD`, or not below the
         named effect's)."""
-        from .diagnose import BIC_THRESHOLD
-
         w = self.rows[~self.rows["correct"].astype(bool)].copy()
         inj = w["injected"] != "none"
         rt, rb = w["rss_true"].astype(float), w["rss_base"].astype(float)

@@ -26,6 +26,7 @@ from .. import conventions as cv
 from .. import data as data_mod
 from ..model import ChildModel
 from . import gait as gait_ocp
+from ..model import ELLIPSOID_LABELS
 
 __all__ = ["TRAJOPT_FORMULATION", "MU_RATIO", "TrajOptSpec", "InverseDynamicsID", "neutral_start"]
 
@@ -250,8 +251,6 @@ class InverseDynamicsID:
 
     def frames(self, p) -> dict:
         """Frames at p (SI): ``q``, ``torques`` (8 net), ``residuals``, ``grf``, ``ellipsoids``."""
-        from ..model import ELLIPSOID_LABELS
-
         out = self.frames_function(np.asarray(p, float))
         idx = pd.Index(self.t, name="time")
         net, R, grf, fn, fx = (np.asarray(v) for v in out[:5])

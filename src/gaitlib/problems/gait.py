@@ -140,6 +140,10 @@ from ..model import ChildModel
 from ..ocp import Goal, Guess, Named, Parameter, PathConstraint, Periodic, Phase, PhaseGuess, Problem, SolverOptions
 from .. import ocp
 from .. import sweep
+from .. import mtg
+from .. import activation
+from .. import effects as effects_mod
+from .. import metabolics
 
 #: Version of the gait formulation (this module with the physics, the collocation engine, the
 #: data references, the effect library, bounds, initial guesses and solver options): part of
@@ -346,9 +350,7 @@ class GaitSpec:
             if len(self.hat_reference) != 4 or len({len(v) for v in self.hat_reference}) != 1:
                 raise ValueError("hat_reference must be () or four equal-length tuples (tau, dx, y, tilt)")
         if self.effects:
-            from .. import effects as _fx
-
-            object.__setattr__(self, "effects", _fx.validate(self.effects, self.model))
+            object.__setattr__(self, "effects", effects_mod.validate(self.effects, self.model))
 
     @property
     def term_weights(self) -> dict[str, float]:
@@ -580,8 +582,6 @@ def load_mtg_params(path) -> dict:
     """MTG fitting parameters from a JSON file ``{"params": {generator: {Eq 5.9 name: value}},
     "provenance": …}`` (written by :func:`gaitlib.studies.mtg_id.save_params`; Δ^P in rad)
     → generator → :class:`gaitlib.mtg.MTGParams`. Errors name the file and the entry."""
-    from .. import mtg
-
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"MTG parameter file {path} not found: it is written by "
@@ -609,8 +609,6 @@ def mtg_params_of(spec_or_name) -> dict | None:
     :func:`gaitlib.mtg.joint_torque` takes: None for ``"default"`` (Eq 5.22), else
     generator → MTGParams (``"ch5"``: ``data/identified/ch5_mtg.json``; ``"thesis"``:
     Table 5.2). A missing file is an error (no fallback)."""
-    from .. import mtg
-
     name = spec_or_name.mtg_params if isinstance(spec_or_name, GaitSpec) else spec_or_name
     if name == "default":
         return None
@@ -624,8 +622,6 @@ def mtg_params_of(spec_or_name) -> dict | None:
 def activation_values(spec: GaitSpec) -> dict[str, float]:
     """Numeric activation parameters γ (Eq 5.53) of an NMSK spec: Table 5.10's identified
     values, or its initial guesses when ``free_activation`` (then they are NLP variables)."""
-    from .. import activation
-
     src = activation.ACTIVATION_INITIAL if spec.free_activation else activation.ACTIVATION_IDENTIFIED
     return {k: float(src[k]) for k in ACTIVATION_PARAMS}
 
@@ -684,8 +680,6 @@ def build(spec: GaitSpec) -> GaitProblem:
         params.append(Parameter("t_f", float(spec.tf_bounds[0]), float(spec.tf_bounds[1]),
                                 float(np.clip(T, *spec.tf_bounds))))
     if nmsk:
-        from .. import activation, metabolics
-
         act_fixed = activation_values(spec)
         if spec.free_activation:
             for k in ACTIVATION_PARAMS:
@@ -693,8 +687,6 @@ def build(spec: GaitSpec) -> GaitProblem:
 
     fx = None  # candidate unmodelled effects (gaitlib.effects)
     if spec.effects:
-        from .. import effects as effects_mod
-
         fx = effects_mod.bind(spec, effects_mod.Context(spec, model, ref, T, p_body, p_contact))
         params += fx.parameters
 
@@ -735,8 +727,6 @@ def build(spec: GaitSpec) -> GaitProblem:
         if spec.model == "SK":
             tau_in = ca.vertcat(*[u[f"tau_{j}"] for j in cv.JOINTS])
         elif spec.model == "MSK":
-            from .. import mtg
-
             tin = {}
             for s in cv.SIDES:
                 for j in ("hip", "knee", "ankle"):
@@ -746,7 +736,6 @@ def build(spec: GaitSpec) -> GaitProblem:
             tau_in = ca.vertcat(*[tin[j] for j in cv.JOINTS])
             extra["a_gen"] = {k[2:]: u[k] for k in MTG_CONTROLS}
         else:  # NMSK: muscle activations → 12 generator activations (Eq 5.54) → MTGs
-            from .. import mtg
 
             am = muscle_activations(x, p)
             ap = act_of(p)
@@ -951,8 +940,6 @@ def tracking_frame(spec: GaitSpec, ref: Reference) -> pd.DataFrame:
     dat.update({f"ref_tau_{j}": ref.tau[j].to_numpy() for j in LEG_JOINTS})
     dat.update({f"ref_{g}": ref.grf[g].to_numpy() for g in GRF_CHANNELS})
     if spec.effects:
-        from .. import effects as effects_mod
-
         dat.update(effects_mod.data_columns(spec, ref, tau_grid))
     return pd.DataFrame(dat, index=tau_grid)
 
@@ -979,8 +966,6 @@ def initial_guess(spec: GaitSpec, model: ChildModel, ref: Reference, p_body, p_c
         for j in cv.JOINTS:
             C[f"tau_{j}"] = tau.get(j, np.zeros_like(t))
     else:
-        from .. import mtg
-
         for s in cv.SIDES:
             C[f"tau_mtp_{s}"] = np.zeros_like(t)
             for j in ("hip", "knee", "ankle"):
@@ -997,8 +982,6 @@ def initial_guess(spec: GaitSpec, model: ChildModel, ref: Reference, p_body, p_c
 
 def _invert_muscle_activation(a, c3: float, delta: float = 1e-4):
     """u with neural_to_muscle_activation(u, c3) = a (Eq 5.37 inverted; monotone), 1."""
-    from .. import activation
-
     ug = np.linspace(0.0, 1.0, 20001)
     return np.interp(a, activation.neural_to_muscle_activation(ug, c3, delta), ug)
 
@@ -1026,8 +1009,6 @@ def _nmsk_guess(spec: GaitSpec, ref: Reference, t, a_gen: dict):
     (:func:`gaitlib.activation.simulate_activation`), so the guess satisfies the activation
     dynamics.
     """
-    from .. import activation
-
     t = np.asarray(t, float)
     T = ref.gait.cycle_time
     ap = activation_values(spec)
@@ -1282,8 +1263,6 @@ def warm_start(gp: GaitProblem, guess) -> Guess:
         if k in names_u:
             C[k] = np.interp(base.time, tc, ph.controls[k])
     if gp.spec.model in ("MSK", "NMSK") and "tau_hip_r" in ph.controls.columns:
-        from .. import mtg
-
         for s_ in cv.SIDES:
             C[f"tau_mtp_{s_}"] = np.interp(base.time, tc, ph.controls[f"tau_mtp_{s_}"])
             for j in ("hip", "knee", "ankle"):
@@ -1333,7 +1312,6 @@ def postprocess(gp: GaitProblem, sol: ocp.Solution) -> GaitSolution:
     pb = np.array([sol.parameters[f"b.{n}"] for n in model.p_body_names]) if spec.free_body else gp.p_body
     pc = np.array([sol.parameters[f"c.{n}"] for n in contact_mod.param_names()]) if spec.free_contact else gp.p_contact
     if spec.effects:  # effects acting on body/contact parameters, at the solution's values
-        from .. import effects as effects_mod
 
         ctx = effects_mod.Context(spec, model, gp.ref, gp.ref.gait.cycle_time, gp.p_body, gp.p_contact)
         pb, pc = effects_mod.numeric_body_contact(spec, ctx, sol.parameters, pb, pc)
@@ -1356,8 +1334,6 @@ def postprocess(gp: GaitProblem, sol: ocp.Solution) -> GaitSolution:
         torques = pd.DataFrame({j: U[f"tau_{j}"].to_numpy() for j in cv.JOINTS}, index=q.index)
         acts = None
     elif spec.model == "MSK":
-        from .. import mtg
-
         tq = {}
         for s in cv.SIDES:
             for j in ("hip", "knee", "ankle"):
@@ -1392,16 +1368,12 @@ def postprocess(gp: GaitProblem, sol: ocp.Solution) -> GaitSolution:
 
 
 def _effects_values(spec: GaitSpec, sol: ocp.Solution) -> dict:
-    from .. import effects as effects_mod
-
     return effects_mod.theta_of(spec, sol.parameters)
 
 
 def _postprocess_nmsk(gp: GaitProblem, sol: ocp.Solution, Xu, U, q, qd):
     """NMSK frames: MTG torques from the states' muscle activations, generator activations,
     excitations e(t) = ẽ(t + d), muscle activations, metabolic rate and COT."""
-    from .. import activation, metabolics, mtg
-
     ph = sol.phase("cycle")
     tf = float(ph.tf)
     t_u = U.index.to_numpy()

@@ -70,6 +70,7 @@ from .. import ocp
 from . import gait as gait_ocp
 from ..collocation import Mesh
 from ..model import ChildModel
+from .. import params as params_mod
 
 __all__ = ["IdentSpec", "MTGIdentification", "chapter_spec", "GAMMA", "W1", "W2", "THESIS_RMSE_DEG", "PARAMS_FILE",
            "split", "demanded_torques", "build", "identify"]
@@ -127,8 +128,6 @@ def chapter_spec(**kw) -> IdentSpec:
     """The book's identification spec: the defaults, with the body parameters the Ch 5 gait
     solves use — ours from Ch 4 (``"ch4"``, ``data/identified/ch4_child.json``) if that file
     exists, else the thesis's identified ones (``"thesis"``). ``kw`` override fields."""
-    from .. import params as params_mod
-
     body = "ch4" if params_mod.identified_path("ch4_child").is_file() else "thesis"
     return IdentSpec(**{"body_params": body, **kw})
 
@@ -149,8 +148,6 @@ def split(joint: str, tau):
 
 
 def _body_params(model: ChildModel, name: str) -> np.ndarray:
-    from .. import params as params_mod
-
     return np.asarray(params_mod.body_params(name, model), float)
 
 

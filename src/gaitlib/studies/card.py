@@ -48,6 +48,16 @@ from .. import conventions as cv
 from .. import data as data_mod
 from .. import ocp
 from ..problems import gait as gait_ocp
+from .. import validity
+from . import jump
+from ..model import ChildModel
+from . import contact_id as ci
+from .. import mtg
+from . import gait as sg
+from . import msk
+from . import mtg_id
+from .. import activation
+from . import predictive as pr
 
 __all__ = ["COLUMNS", "VERDICTS", "REL_TOL", "ABS_TOL", "RULE", "verdict", "Row", "StoredGait", "stored_gait",
            "gate", "build", "counts", "write", "PHYSIOLOGICAL_JUMP_RISE_M"]
@@ -200,8 +210,6 @@ def stored_gait(where) -> StoredGait | None:
 def gate(sol, name: str = "") -> str:
     """The validity text of a solution: ``"valid"``, or :meth:`gaitlib.validity.Gates.label`
     (``"not converged (…)"``, ``"invalid: …"``)."""
-    from .. import validity
-
     return validity.label(sol, name=name)
 
 
@@ -239,8 +247,6 @@ def _hours(st: dict) -> float:
 # Chapter 3: jumps
 # ======================================================================================
 def _ch3() -> list[Row]:
-    from . import jump
-
     rows, sols, valid = [], {}, {}
     for n in jump.THESIS:
         sp = jump.SPECS[n]
@@ -290,9 +296,6 @@ def _ch3() -> list[Row]:
 # Chapter 4: contact identification
 # ======================================================================================
 def _ch4() -> list[Row]:
-    from ..model import ChildModel
-    from . import contact_id as ci
-
     res = {}
     try:
         with cache.only("the card reads stored solutions only"):
@@ -357,11 +360,6 @@ def _total_mass(p, idx, names) -> float:
 # Chapter 5: MTG identification, MSK and NMSK tracking, COT
 # ======================================================================================
 def _ch5(bases: dict) -> list[Row]:
-    from .. import mtg
-    from . import gait as sg
-    from . import msk
-    from . import mtg_id
-
     rows = []
     # Table 5.2 / Sec 5.1.2: the stored identified MTG set and its provenance
     f = mtg_id.PARAMS_FILE
@@ -395,7 +393,6 @@ def _ch5(bases: dict) -> list[Row]:
     s = bases.get("NMSK")
     valid = gate(s, "NMSK") if s is not None else ""
     ap = s.stats.get("activation_parameters", {}) if s is not None else {}
-    from .. import activation
 
     for k, tv in msk.THESIS_TABLE_5_10["identified"].items():
         ours = ap.get(k, np.nan)
@@ -419,8 +416,6 @@ def _ch5(bases: dict) -> list[Row]:
 
 def _ch5_bases() -> dict:
     """The Ch 5 MSK and NMSK solutions (Eq 5.33, Eq 5.55) as :class:`StoredGait`."""
-    from . import msk
-
     out = {}
     b = stored_gait(gait_ocp.cache_dir(msk.ch5_spec("MSK")))
     if b is not None:
@@ -437,8 +432,6 @@ def _ch5_bases() -> dict:
 def _runs(bases: dict, which: str) -> dict:
     """name → StoredGait (or None) of the Ch 6 (``which="ch6"``) or Ch 7 runs, found as
     :func:`gaitlib.studies.predictive.cost_function_study` / ``speed_study`` store them."""
-    from . import predictive as pr
-
     out = {}
     for m, base in bases.items():
         if which == "ch6":
@@ -480,8 +473,6 @@ def _short(label: str) -> str:
 
 
 def _ch6(bases: dict, runs: dict, valid: dict) -> list[Row]:
-    from . import predictive as pr
-
     rows = []
     status = _anchor("ch06_costfun", "Did every run converge? Solver statistics and Table 6.3")
     for model, hours in pr.THESIS_HOURS_TABLE_6_3.items():
@@ -550,8 +541,6 @@ def _time_ratio_row(chapter: int, item: str, th: dict, runs: dict, names, soluti
 
 
 def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict) -> list[Row]:
-    from . import predictive as pr
-
     rows = []
     inv = {v: k for k, v in pr.THESIS_CLASS.items()}
     status = _anchor("ch07_speed", "Compute times (thesis Table 7.2)")

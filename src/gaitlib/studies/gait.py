@@ -22,6 +22,9 @@ import pandas as pd
 from .. import conventions as cv
 from ..problems import gait as gait_ocp
 from ..problems.gait import solve_cached, tracking_data
+from .. import marks
+from .. import data as data_mod
+from .. import plots
 
 __all__ = ["THESIS_RMSE", "natural_gait", "natural_gait_spec", "rmse_beside_thesis",
            "channels_frame", "sims_and_marks", "write_outputs", "stats_table"]
@@ -99,8 +102,6 @@ def sims_and_marks(solutions: dict) -> tuple[dict, dict]:
     """``{label: GaitSolution}`` → (``{label: channels_frame}``, ``{label: failure label}``):
     the ``sims`` and ``marks`` arguments of :func:`gaitlib.plots.tracking_figure`
     (:func:`gaitlib.marks.failure_label`; None for a converged solve)."""
-    from .. import marks
-
     return ({k: channels_frame(s) for k, s in solutions.items()},
             {k: marks.failure_label(s) for k, s in solutions.items()})
 
@@ -108,8 +109,6 @@ def sims_and_marks(solutions: dict) -> tuple[dict, dict]:
 def stats_table(solutions: dict) -> pd.DataFrame:
     """One row of solver statistics per labelled solution; ``mark`` is its failure label
     (:func:`gaitlib.marks.failure_label`, empty when converged)."""
-    from .. import marks
-
     rows = []
     for label, s in solutions.items():
         st = s.stats
@@ -132,8 +131,6 @@ def write_outputs(sol: gait_ocp.GaitSolution, out, figures: bool = True) -> Path
         import matplotlib
 
         matplotlib.use("Agg")
-        from .. import data as data_mod
-        from .. import plots
 
         gait = tracking_data(data_mod.load_gait_data(sol.spec.speed_class, sol.spec.source))
         sims, marks = sims_and_marks({f"{sol.spec.model} {sol.spec.cost}": sol})

@@ -39,6 +39,11 @@ from .. import effects as effects_mod
 from ..gap import io as gio
 from ..gap import locate
 from ..gap import twin
+from .. import data as data_mod
+from . import msk
+from ..gap.solve import solve_on
+from ..marks import failure_label
+from . import predictive as pr
 
 __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "NMSK_CANDIDATES", "effect_table", "twin_validation",
            "sk_diagnosis", "nmsk_attribution", "emg_gap_table", "exact_left_leg", "left_leg_check",
@@ -104,7 +109,6 @@ def own_data(gait):
     if gait is None:
         yield
         return
-    from .. import data as data_mod
 
     orig = data_mod.load_gait_data
 
@@ -131,8 +135,6 @@ def nmsk_attribution(candidates=NMSK_CANDIDATES, resamples: int = 200, serial: b
     warm-started from it, on the same mesh; profiled effects on their grid
     (:data:`gaitlib.gap.diagnose.PROFILE_GRID`), activation timing on the comparison only.
     Ranked as :func:`gaitlib.gap.diagnose.assemble` does."""
-    from . import msk
-
     base_sol = msk.solve("NMSK", root=root)
     spec0 = base_sol.spec
     ds = gio.load_real(spec0.speed_class, spec0.source)
@@ -218,8 +220,6 @@ def profile_table(diag: diagnose.Diagnosis, effect: str, stems=("emg_TA", "emg_M
     magnitude, IPOPT status and iterations, the whole gap's RSS and the EMG channels' RSS
     and mean z — the solutions reloaded from the cache (:func:`gaitlib.gap.solve.solve_on`
     with the same warm start; nothing is solved if :func:`nmsk_attribution` ran)."""
-    from ..gap.solve import solve_on
-
     f = diag.fits[effect]
     rows = [{"magnitude": 0.0, "status": diag.baseline.stats["status"], "iterations": diag.baseline.stats.get("iterations"),
              "RSS (all)": diag.located.rss, **_emg_cols(diag.located, stems)}]
@@ -252,8 +252,6 @@ def exact_left_leg(gait, order: int | None = None):
 
     Returns ``(gait_exact, replaced)``: a new GaitData and the replaced column names.
     """
-    from .. import data as data_mod
-
     order = effects_mod.FOURIER_ORDER if order is None else order
     tau = gait.time / float(gait.cycle_time)
     shift = float(gait.left_shift)
@@ -337,10 +335,6 @@ def book_gaps(root=None) -> pd.DataFrame:
     :func:`exact_left_leg`), RMS z of the EMG channels (muscle models), the number of
     significant channel × phase cells (non-EMG) and the largest such cell.
     """
-    from ..marks import failure_label
-    from . import msk
-    from . import predictive as pr
-
     items = [("Ch 5", m, "DT (Eq 5.33)" if m == "MSK" else "DT (Eq 5.55)", msk.solve(m, root=root)) for m in ("MSK", "NMSK")]
     r6 = pr.cost_function_study(("MSK", "NMSK"), pr.CH6_COSTS, progress=False, root=root)
     items += [("Ch 6", r6.specs[k].model, r6.specs[k].cost, s) for k, s in r6.solutions.items()]

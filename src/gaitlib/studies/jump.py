@@ -11,6 +11,7 @@ import pandas as pd
 from .. import conventions as cv
 from ..problems.jump import (FORMULATION, LABELS, SPECS, TABLE_3_5, THESIS, JumpProblem, JumpSolution,  # noqa: F401
                              JumpSpec, build, cache_location, initial_guess, joint_bounds, meshes, solve, spec)
+from .. import plots
 
 __all__ = ["solve_all", "results_table", "stats_table", "plot_channels", "animate", "THESIS", "SPECS",
            "JumpSpec", "JumpSolution", "joint_bounds", "spec", "solve", "build", "cache_location",
@@ -129,8 +130,6 @@ def plot_channels(sols: dict[str, JumpSolution], kind: str, figsize_per=(3.4, 2.
 def animate(s: JumpSolution, **kw):
     """Stick-figure animation of a solved jump (:func:`gaitlib.plots.animate_jump`), with
     the ground reaction force drawn from ``cop_x``."""
-    from .. import plots
-
     t, Q = s.poses()
     tr = s.trajectory[~pd.Index(s.trajectory.index).duplicated(keep="last")]
     grf = tr[["grf_x", "grf_y"]].to_numpy(float)

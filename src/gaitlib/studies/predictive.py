@@ -41,6 +41,9 @@ from .. import data as data_mod
 from .. import ocp
 from ..problems import gait as gait_ocp
 from . import gait as sg
+from . import msk
+from .. import marks
+from ..marks import failure_label
 
 __all__ = ["CH6_COSTS", "CH7_CLASSES", "THESIS_CLASS", "THESIS_HOURS_TABLE_6_3", "THESIS_HOURS_TABLE_7_2",
            "THESIS_COT_FIG_7_5", "THESIS_FP_GAIN_PCT", "THESIS_FP_EXCITATION_GAIN_PCT",
@@ -86,8 +89,6 @@ def baseline(model: str, *, n_intervals: int = 20, degree: int = 5, root=None, p
     the activation parameters identified, warm-started from the MSK one):
     :func:`gaitlib.studies.msk.solve`, solved or reloaded from the cache; ``kw`` override
     spec fields."""
-    from . import msk
-
     return msk.solve(model, root=root, progress=progress, **_mesh(n_intervals, degree), **kw)
 
 
@@ -95,8 +96,6 @@ def default_params() -> dict:
     """The parameter sets the thesis carries into Chs 6–7: those of the Ch 5 solves
     (:func:`gaitlib.studies.msk.parameter_sets`). The NMSK runs use the activation
     parameters of thesis Table 5.10 (``GaitSpec`` has no field for ours yet)."""
-    from . import msk
-
     return msk.parameter_sets()
 
 
@@ -233,8 +232,6 @@ def excitation_score(sol: gait_ocp.GaitSolution, gait: data_mod.GaitData) -> pd.
     """RMSE and NRMSE of the NMSK excitations e(t) against ``gait``'s EMG envelopes (both
     dimensionless, on normalised time) for the muscles that data set has (mapping
     :data:`gaitlib.studies.msk.EMG_MAP`: e.g. BF ↔ Schwartz's lateral hamstrings)."""
-    from . import msk
-
     if sol.excitations is None:
         raise ValueError("excitation_score needs an NMSK solution")
     col = 0 if gait.source == "schwartz2008" else 1
@@ -291,8 +288,6 @@ class StudyResult:
 
     def rerun_table(self, reruns: dict) -> pd.DataFrame:
         """The study's own status and objective of each rerun run beside the rerun's."""
-        from .. import marks
-
         rows = {}
         for k, s in reruns.items():
             own = self.solutions.get(k)
@@ -305,20 +300,14 @@ class StudyResult:
 
     def marks(self) -> dict:
         """Run name → failure label (:func:`gaitlib.marks.failure_label`; None when converged)."""
-        from .. import marks
-
         return {k: marks.failure_label(self.solutions.get(k, rec)) for k, rec in self.records.items()}
 
     def converged_scores(self) -> pd.DataFrame:
         """:attr:`scores` of the unmarked runs only (converged and passing the validity gates,
         :func:`gaitlib.marks.failure_label`) — what a headline may use."""
-        from .. import marks
-
         return marks.unmarked(self.scores)
 
     def stats(self) -> pd.DataFrame:
-        from .. import marks
-
         rows = []
         for name, rec in self.records.items():
             sol = self.solutions.get(name)
@@ -342,8 +331,6 @@ def _run(specs: dict, guesses: dict, *, root, scheduler, n_workers, serial, prog
 
 
 def _scores(sols: dict, gaits: dict, key_of) -> pd.DataFrame:
-    from .. import marks
-
     parts = []
     for name, sol in sols.items():
         model, label = name.split(" ", 1)
@@ -422,8 +409,6 @@ def cot_table(ch7: StudyResult, natural=None) -> pd.DataFrame:
     function and activation parameters as the Ch 7 runs) and, labelled apart, the Ch 5
     NMSK solution. Columns ``source`` (the run), ``mark``
     (:func:`gaitlib.marks.failure_label`) and ``converged`` say what each point is."""
-    from .. import marks
-
     thesis = {c: (v, cot) for c, v, cot in THESIS_COT_FIG_7_5}
     rows = []
     items = [(s.spec.speed_class, k, s) for k, s in ch7.solutions.items() if k.startswith("NMSK ")]
@@ -446,8 +431,6 @@ def times_table(result: StudyResult, thesis_hours: dict, label_of=lambda spec: s
     """Our times (build = symbolic graph + derivatives + nlpsol; solve = IPOPT), iterations
     and time per iteration per run beside the thesis's hours (Table 6.3 or 7.2; labelled)
     and the speed-up (thesis hours / our build + solve)."""
-    from ..marks import failure_label
-
     rows = []
     for name, spec in result.specs.items():
         sol = result.solutions.get(name)
@@ -626,8 +609,6 @@ def cot_figure(cot: pd.DataFrame, ch5_row: str | None = None):
     the converged points joined, the marked ones as labelled crosses, the ``ch5_row`` point
     (the Ch 5 solution) apart, and the thesis's points at their own speeds."""
     import matplotlib.pyplot as plt
-
-    from .. import marks
 
     curve = cot.drop(index=ch5_row, errors="ignore") if ch5_row else cot
     fig, ax = plt.subplots(figsize=(8.0, 3.6), layout="constrained")

@@ -16,6 +16,11 @@ from collections.abc import Iterable
 import pandas as pd
 
 from .. import validity
+from . import gait
+from . import jump
+from . import contact_id as ci
+from . import msk
+from . import predictive as pr
 
 __all__ = ["CHAPTERS", "book_solutions", "book_gates", "gates_matrix", "summary"]
 
@@ -32,31 +37,21 @@ def book_solutions(chapters: Iterable[str] = CHAPTERS) -> dict[str, object]:
     chapters = set(chapters)
     out: dict[str, object] = {}
     if "ch2" in chapters:
-        from . import gait
-
         out["ch2 SK Eq4.11"] = gait.natural_gait("SK")
         out["ch2 MSK Eq5.33"] = gait.natural_gait("MSK")
     if "ch3" in chapters:
-        from . import jump
-
         for n in ("toeless", "toe", "ellipsoid"):
             out[f"ch3 {n}"] = jump.solve(n, use_cache=True)
     if "ch4" in chapters:
-        from . import contact_id as ci
-
         a = ci.trajectory_optimization()
         b = ci.optimal_control()
         c = ci.optimal_control_body(warm=b)
         cw = ci.optimal_control_body(spec=ci.spec_c(contact_bounds="widened"), warm=b)
         out.update({"ch4 (a)": a, "ch4 (b)": b, "ch4 (c)": c, "ch4 (c) widened": cw})
     if "ch5" in chapters:
-        from . import msk
-
         out["ch5 MSK Eq5.33"] = msk.solve("MSK")
         out["ch5 NMSK Eq5.55"] = msk.solve("NMSK")
     if "ch6" in chapters or "ch7" in chapters:
-        from . import predictive as pr
-
         runs = []
         if "ch6" in chapters:
             runs += [("ch6", pr.cost_function_study(("MSK", "NMSK"), pr.CH6_COSTS, progress=False, serial=True), ""),
