@@ -31,8 +31,9 @@ import numpy as np
 import pandas as pd
 
 from gaitlib import gap, marks
-from gaitlib.gap import diagnose as D, figures as F, locate as L, twin
-from gaitlib.studies import gap as G
+from gaitlib.gap import diagnose, locate, twin
+from gaitlib.gap import figures as gap_figures
+from gaitlib.studies import gap as gap_study
 from IPython.display import Markdown, display
 
 pd.set_option("display.precision", 3)
@@ -70,15 +71,15 @@ T0 = time.perf_counter()
 # repeated on 20 × 5 at the middle magnitude.)
 
 # %%
-dS = G.sk_diagnosis("schwartz2008")
-sS = G.summary(dS)
+dS = gap_study.sk_diagnosis("schwartz2008")
+sS = gap_study.summary(dS)
 print(f"baseline fit: {dS.baseline.stats['status']}, {dS.baseline.stats['iterations']} iterations; "
       f"RSS = {sS['rss']:.1f} over {dS.located.n_points} points (n_eff = {sS['n_eff']:.0f} resels), "
       f"RMS z = {sS['rms_z']:.2f}; {sS['significant_cells']} of {sS['cells']} cells leave the band significantly")
-F.gap_heatmap(dS.located, title="SK baseline fit vs Schwartz 2008 Free: RMS z by channel and phase (* significant)",
+gap_figures.gap_heatmap(dS.located, title="SK baseline fit vs Schwartz 2008 Free: RMS z by channel and phase (* significant)",
               mark=marks.failure_label(dS.baseline));
 plt.show()
-G.top_cells(dS.located)
+gap_study.top_cells(dS.located)
 
 # %% [markdown]
 # ## 2. Attribute: the effect library and the criterion
@@ -91,7 +92,7 @@ G.top_cells(dS.located)
 # dynamics — so they are candidates only for muscle models, against the EMG (Sec. 5).
 
 # %%
-G.effect_table()
+gap_study.effect_table()
 
 # %% [markdown]
 # **Re-solving.** For a data set the baseline is fitted from five starts
@@ -131,8 +132,8 @@ G.effect_table()
 # re-identification's).
 
 # %%
-print(f"threshold: ΔBIC ≤ {D.BIC_THRESHOLD:g}; 'explained' from {D.EXPLAINED_PCT:g} % closed; "
-      f"profile grids {D.PROFILE_GRID}")
+print(f"threshold: ΔBIC ≤ {diagnose.BIC_THRESHOLD:g}; 'explained' from {diagnose.EXPLAINED_PCT:g} % closed; "
+      f"profile grids {diagnose.PROFILE_GRID}")
 
 # %% [markdown]
 # ## 3. Validation on twins whose effect is withheld
@@ -171,12 +172,12 @@ print(f"threshold: ΔBIC ≤ {D.BIC_THRESHOLD:g}; 'explained' from {D.EXPLAINED_
 # median are shown beside it.
 
 # %%
-tv = G.twin_validation()
+tv = gap_study.twin_validation()
 acc = tv.accuracy()
 acc
 
 # %%
-F.confusion_plot(tv.confusion, title="twins: injected effect (rows) vs effect named by the diagnosis");
+gap_figures.confusion_plot(tv.confusion, title="twins: injected effect (rows) vs effect named by the diagnosis");
 plt.show()
 rows = tv.rows.copy()
 rows[["twin", "injected", "magnitude", "top", "verdict", "correct", "identified_magnitude", "rss_base", "base_start", "rss_top",
@@ -204,7 +205,7 @@ wrong[["twin", "injected", "magnitude", "top", "dBIC_top", "dBIC_true", "identif
 # what was named (`dBIC_top`; empty when nothing passed the threshold):
 
 # %%
-thr = D.BIC_THRESHOLD
+thr = diagnose.BIC_THRESHOLD
 true_not_better = wrong[wrong["true_not_named"]]
 print(f"misnamed twins where even the true model, fitted the same way, would not have been named: "
       f"{len(true_not_better)} of {len(wrong)}")
@@ -228,12 +229,12 @@ for r in true_not_better.itertuples():
 # solves, `gaitlib.studies.gap.twin_validation_full_mesh`):
 
 # %%
-tvf = G.twin_validation_full_mesh()
+tvf = gap_study.twin_validation_full_mesh()
 rf = tvf.rows
 display(rf[["twin", "injected", "magnitude", "top", "verdict", "correct", "identified_magnitude", "rss_base",
             "base_start", "rss_top", "rss_true_fixed", "rss_gen", "shrink_injected_top", "shrink_vs_noise_top", "dBIC_top",
             "dBIC_true", "retried", "true_start"]])
-head, *misses = G.twin_full_mesh_lines(tvf)
+head, *misses = gap_study.twin_full_mesh_lines(tvf)
 print(head)
 for line in misses:
     print("  " + line)
@@ -251,7 +252,7 @@ for line in misses:
 # which the retry now catches. What the current method gives:
 
 # %%
-display(Markdown("\n\n".join(G.twin_full_mesh_verdict(tvf))))
+display(Markdown("\n\n".join(gap_study.twin_full_mesh_verdict(tvf))))
 
 # %% [markdown]
 # ## 4. Findings on the real data
@@ -262,14 +263,14 @@ display(Markdown("\n\n".join(G.twin_full_mesh_verdict(tvf))))
 # resampling interval for the top three) and penalised (ΔBIC; dashed line the threshold):
 
 # %%
-F.ranking_bars(dS.ranking, top=dS.top_effect, mark=marks.failure_label(dS.baseline));
+gap_figures.ranking_bars(dS.ranking, top=dS.top_effect, mark=marks.failure_label(dS.baseline));
 plt.show()
-G.ranking_table(dS)
+gap_study.ranking_table(dS)
 
 # %%
 best = sS["best"]
 if best is not None:
-    F.shrink_heatmaps(dS.located, dS.fits[best].located, best,
+    gap_figures.shrink_heatmaps(dS.located, dS.fits[best].located, best,
                       marks=(marks.failure_label(dS.baseline), marks.failure_label(dS.fits[best].status)),
                       title=f"Schwartz 2008 Free: gap of the SK baseline fit and with {best}");
     plt.show()
@@ -287,16 +288,16 @@ if best is not None:
 # the right one (as for Schwartz), so the left-leg time shift is a candidate for both.
 
 # %%
-dU = G.sk_diagnosis("gaitutils")
-sU = G.summary(dU)
+dU = gap_study.sk_diagnosis("gaitutils")
+sU = gap_study.summary(dU)
 print("excluded channels:", [(d["id"], d["reason"]) for d in dU.located.excluded])
 print(f"baseline fit: {dU.baseline.stats['status']}; RSS = {sU['rss']:.1f}, RMS z = {sU['rms_z']:.2f}; "
       f"{sU['significant_cells']} of {sU['cells']} cells significant (n = 1: the band test is conservative)")
-F.gap_heatmap(dU.located, title="SK baseline fit vs gaitutils normal data", mark=marks.failure_label(dU.baseline));
+gap_figures.gap_heatmap(dU.located, title="SK baseline fit vs gaitutils normal data", mark=marks.failure_label(dU.baseline));
 plt.show()
-F.ranking_bars(dU.ranking, top=dU.top_effect, mark=marks.failure_label(dU.baseline));
+gap_figures.ranking_bars(dU.ranking, top=dU.top_effect, mark=marks.failure_label(dU.baseline));
 plt.show()
-G.ranking_table(dU)
+gap_study.ranking_table(dU)
 
 # %% [markdown]
 # ### How much of the gap is the data's own left leg?
@@ -318,8 +319,8 @@ G.ranking_table(dU)
 # against the exact shift — the data pipeline's own gap, in the same SD units:
 
 # %%
-chkS = G.left_leg_check(dS)
-chkU = G.left_leg_check(dU)
+chkS = gap_study.left_leg_check(dS)
+chkU = gap_study.left_leg_check(dU)
 gen = pd.concat({"Schwartz 2008 Free": chkS["generation"].set_index("channel"),
                  "gaitutils": chkU["generation"].set_index("channel")}, axis=1)
 display(gen)
@@ -332,10 +333,10 @@ llc = pd.DataFrame({lab: {"baseline RSS, data as tracked": c["rss"]["data as tra
 llc
 
 # %%
-F.data_views(dS.located, chkS["located_exact"], ["grf:grf_x_l", "grf:grf_y_l", "torque:ankle_l", "torque:hip_l"],
+gap_figures.data_views(dS.located, chkS["located_exact"], ["grf:grf_x_l", "grf:grf_y_l", "torque:ankle_l", "torque:hip_l"],
              sim_label="SK baseline fit", mark=marks.failure_label(dS.baseline));
 plt.show()
-F.gap_heatmap(chkS["located_exact"], title="SK baseline fit vs Schwartz 2008 Free, left leg shifted exactly",
+gap_figures.gap_heatmap(chkS["located_exact"], title="SK baseline fit vs Schwartz 2008 Free, left leg shifted exactly",
               mark=marks.failure_label(dS.baseline));
 plt.show()
 
@@ -366,17 +367,17 @@ for lab, c in (("Schwartz 2008 Free", chkS), ("gaitutils", chkU)):
 # for every generator pair (hip, knee, ankle; both legs).
 
 # %%
-dN = G.nmsk_attribution()
-sN = G.summary(dN)
+dN = gap_study.nmsk_attribution()
+sN = gap_study.summary(dN)
 print(f"Ch 5 NMSK solution: {dN.baseline.stats['status']}, {dN.baseline.stats['iterations']} iterations; "
       f"RSS = {sN['rss']:.1f} (RMS z = {sN['rms_z']:.2f}) over {dN.located.n_points} points incl. EMG")
-F.gap_heatmap(dN.located, title="Ch 5 NMSK solution vs Schwartz 2008 Free (with EMG)",
+gap_figures.gap_heatmap(dN.located, title="Ch 5 NMSK solution vs Schwartz 2008 Free (with EMG)",
               mark=marks.failure_label(dN.baseline));
 plt.show()
 for n, f in dN.fits.items():
     if f.profile:
         print(n, "profile (magnitude, RSS, status):", [(m, round(r, 1), s) for m, r, s in f.profile])
-G.ranking_table(dN)
+gap_study.ranking_table(dN)
 
 # %% [markdown]
 # The EMG part of the gap, channel by channel, for the baseline and each candidate's best
@@ -384,9 +385,9 @@ G.ranking_table(dN)
 # profile point of co-contraction and joint stiffness — the whole gap and the EMG alone:
 
 # %%
-emg = G.emg_gap_table(dN)
+emg = gap_study.emg_gap_table(dN)
 display(emg)
-prof = {n: G.profile_table(dN, n) for n, f in dN.fits.items() if f.profile}
+prof = {n: gap_study.profile_table(dN, n) for n, f in dN.fits.items() if f.profile}
 for n, t in prof.items():
     print(n)
     display(t)
@@ -394,7 +395,7 @@ for n, t in prof.items():
 # %%
 cc = dN.fits.get("co_contraction")
 if cc is not None and cc.located is not None:
-    F.channel_curves(dN.located, cc.located, ["emg:TA_r", "emg:MG_r", "emg:TA_l", "emg:MG_l"],
+    gap_figures.channel_curves(dN.located, cc.located, ["emg:TA_r", "emg:MG_r", "emg:TA_l", "emg:MG_l"],
                      labels=("Ch 5 NMSK", f"co-contraction c = {cc.thetas['co_contraction']['c']:.2f}"),
                      marks=(marks.failure_label(dN.baseline), marks.failure_label(cc.status)));
     plt.show()
@@ -412,7 +413,7 @@ if cc is not None and cc.located is not None:
 # cost function; a run IPOPT did not finish keeps its status.
 
 # %%
-bg = G.book_gaps()
+bg = gap_study.book_gaps()
 with pd.option_context("display.max_rows", 40):
     display(bg)
 
@@ -436,5 +437,5 @@ if len(ch7):
 # ## Findings
 
 # %%
-display(Markdown("\n\n".join(G.findings(tv, tvf, dS, dU, dN, chkS, chkU, bg, emg))))
+display(Markdown("\n\n".join(gap_study.findings(tv, tvf, dS, dU, dN, chkS, chkU, bg, emg))))
 print(f"notebook time: {time.perf_counter() - T0:.0f} s")
