@@ -266,3 +266,23 @@ def test_planned_mtp_hits_table_4_6_postures():
     d = data.load_gait_data("Free")
     assert d.mean["mtp_r"].max() == pytest.approx(0.4 * np.ptp(d.mean["ankle_r"]), rel=0.02)
     assert (d.sd["mtp_r"] == 0).all()
+
+
+def test_load_gait_data_reads_once_and_again_after_a_file_changes(tmp_path):
+    """Same arguments on unchanged files: the same object (read and derived once); another
+    argument or a changed file: read again."""
+    import os
+    import shutil
+
+    from gaitlib import data as data_mod
+
+    for f in data_mod.DATA_DIR.glob("*.csv"):
+        shutil.copy(f, tmp_path / f.name)
+    a = data_mod.load_gait_data("Free", data_dir=tmp_path)
+    assert data_mod.load_gait_data("Free", data_dir=tmp_path) is a
+    assert data_mod.load_gait_data("Slow", data_dir=tmp_path) is not a
+    f = tmp_path / "schwartz2008_curves.csv"
+    st = f.stat()
+    os.utime(f, ns=(st.st_atime_ns, st.st_mtime_ns + 10**9))
+    b = data_mod.load_gait_data("Free", data_dir=tmp_path)
+    assert b is not a and b.mean.equals(a.mean)

@@ -700,6 +700,37 @@ def load_gait_data(speed_class: str = "Free", source: str = "schwartz2008",
                    include_emg: bool = True, allow_no_sd: bool | None = None) -> GaitData:
     """The model's view of one data set and speed class (see :class:`GaitData`).
 
+    Calls with the same arguments on unchanged files (same size and modification time of
+    every file of the data directory) return the same object, read and derived once: treat
+    its frames as read-only (copy before changing them). Arguments as
+    :func:`_read_gait_data`'s.
+    """
+    args = (speed_class, source, float(body_mass), float(body_height), n_points, fourier_order,
+            left_shift, include_emg, allow_no_sd)
+    directory = Path(data_dir) if data_dir is not None else DATA_DIR
+    files = tuple(sorted((f.name, f.stat().st_size, f.stat().st_mtime_ns)
+                         for f in directory.glob("*.csv"))) if directory.is_dir() else ()
+    key = (str(directory.resolve()), files, args)
+    if key not in _LOADED:
+        if len(_LOADED) >= _LOADED_MAX:
+            _LOADED.pop(next(iter(_LOADED)))
+        _LOADED[key] = _read_gait_data(speed_class, source, body_mass, body_height, data_dir, n_points,
+                                       fourier_order, left_shift, include_emg, allow_no_sd)
+    return _LOADED[key]
+
+
+#: Data sets already read by :func:`load_gait_data` (oldest first; at most _LOADED_MAX).
+_LOADED: dict = {}
+_LOADED_MAX = 64
+
+
+def _read_gait_data(speed_class: str = "Free", source: str = "schwartz2008",
+                    body_mass: float = cv.BODY_MASS, body_height: float = cv.BODY_HEIGHT,
+                    data_dir: str | Path | None = None, n_points: int | None = None,
+                    fourier_order: int = 5, left_shift: float | None = None,
+                    include_emg: bool = True, allow_no_sd: bool | None = None) -> GaitData:
+    """Read and derive one data set and speed class (:func:`load_gait_data`, uncached).
+
     Parameters
     ----------
     speed_class : one of :data:`gaitlib.conventions.SPEED_CLASSES` (``gaitutils`` has

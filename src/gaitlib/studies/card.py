@@ -34,7 +34,6 @@ why — the ``cause`` column does that where a page of the book has measured it.
 
 from __future__ import annotations
 
-import contextlib
 import json
 import re
 from dataclasses import dataclass
@@ -211,27 +210,6 @@ def gate(sol, name: str = "") -> str:
     """The validity text of a solution: ``"valid"``, or :meth:`gaitlib.validity.Gates.label`
     (``"not converged (…)"``, ``"invalid: …"``)."""
     return validity.label(sol, name=name)
-
-
-@contextlib.contextmanager
-def _memo_data():
-    """Within: :func:`gaitlib.data.load_gait_data` returns one object per distinct call (it
-    re-reads and re-fits the tidy CSV on every call; the card asks for the same classes
-    dozens of times). The callers here never modify the returned data."""
-    orig = data_mod.load_gait_data
-    memo: dict = {}
-
-    def load(*a, **k):
-        key = (a, tuple(sorted(k.items())))
-        if key not in memo:
-            memo[key] = orig(*a, **k)
-        return memo[key]
-
-    data_mod.load_gait_data = load
-    try:
-        yield
-    finally:
-        data_mod.load_gait_data = orig
 
 
 def _rms_sd(gait, col: str, scale: float = 1.0) -> float:
@@ -605,7 +583,7 @@ def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict) -> list[
 def build(chapters=(3, 4, 5, 6, 7)) -> pd.DataFrame:
     """The report card (module docstring) from the stored solutions; never solves
     (:func:`gaitlib.cache.only`: a missing solution is a "not comparable" row)."""
-    with _memo_data(), cache.only("the card reads stored solutions only"):
+    with cache.only("the card reads stored solutions only"):
         return _build(tuple(chapters))
 
 
