@@ -5,15 +5,20 @@ Inverse dynamics gives the joint torques and pelvis residual loads, the contact 
 GRFs, and the parameters minimise Eq 4.5 (weights Table 4.8: w1 = w2 = 1/4) within the
 Table 4.7 bounds and the friction-ratio constraint Eq 4.4 (0.55 ≤ μ_d/μ_s ≤ 0.99). Each local
 solve is IPOPT with exact first and second derivatives (CasADi AD) in scaled variables
-z ∈ [0, 1]³⁹ (k_v log-scaled: it spans three decades). The multistart around it and the
-approaches (b)/(c), which are the gait problem (:mod:`gaitlib.problems.gait`) with the
-parameters free, are :mod:`gaitlib.studies.contact_id`'s.
+z ∈ [0, 1]³⁹ (k_v log-scaled: it spans three decades). The multistart around it is
+:mod:`gaitlib.studies.contact_id`'s.
+
+Approaches (b)/(c) are the gait problem (:mod:`gaitlib.problems.gait`) with the parameters
+free (:func:`spec_b`, :func:`spec_c`), solved from a start parameter set through a
+continuation on the residual bounds (:data:`CONTINUATION`, :func:`solve_continued`), each
+stage cached (:func:`solve_stage`, version :data:`FORMULATION`).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import time
+import warnings
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -21,14 +26,18 @@ import casadi as ca
 import numpy as np
 import pandas as pd
 
+from .. import cache
 from .. import contact as contact_mod
 from .. import conventions as cv
 from .. import data as data_mod
+from .. import ocp
 from ..model import ChildModel
 from . import gait as gait_ocp
 from ..model import ELLIPSOID_LABELS
 
-__all__ = ["TRAJOPT_FORMULATION", "MU_RATIO", "TrajOptSpec", "InverseDynamicsID", "neutral_start"]
+__all__ = ["TRAJOPT_FORMULATION", "MU_RATIO", "TrajOptSpec", "InverseDynamicsID", "neutral_start",
+           "FORMULATION", "GUESS_METHOD", "CONTINUATION", "spec_b", "spec_c", "stage_spec", "solve_stage",
+           "solve_continued"]
 
 #: Version of approach (a)'s trajectory-optimisation problem (:class:`InverseDynamicsID`, its
 #: multistart and solver options): part of its cache keys.
@@ -36,6 +45,11 @@ TRAJOPT_FORMULATION = "contact-trajopt-1"
 
 #: Friction-ratio bounds of Eq 4.4 (μ_d / μ_s), thesis Sec 4.3.1.
 MU_RATIO = (0.55, 0.99)
+
+#: Version of approaches (b)/(c) on top of :data:`gaitlib.problems.gait.FORMULATION` (their
+#: starts, guesses and continuation): part of their cache keys. Bump either when a change
+#: alters what is solved (tests/test_formulation_versions.py).
+FORMULATION = "contact-id-1"
 
 
 # --------------------------------------------------------------------------------------
@@ -264,3 +278,85 @@ class InverseDynamicsID:
             ell[f"fx_{lab}"] = fx[i]
         return {"q": q, "torques": torques, "residuals": residuals, "grf": grf_f,
                 "ellipsoids": pd.DataFrame(ell, index=idx)}
+
+
+# --------------------------------------------------------------------------------------
+# Approaches (b)/(c): the gait problem with the parameters free
+# --------------------------------------------------------------------------------------
+
+
+def spec_b(n_intervals: int = 20, degree: int = 5, contact_bounds: str = "table4.7", **kw) -> gait_ocp.GaitSpec:
+    """Approach (b): SK, Eq 4.11 (Table 4.8 weights), 39 contact parameters free within
+    Table 4.7 verbatim and Eq 4.4; Eq 4.8 residual bounds; thesis mesh 20 × 5 LGR."""
+    return gait_ocp.GaitSpec(model="SK", cost="Eq4.11", free_contact=True, contact_bounds=contact_bounds,
+                       n_intervals=n_intervals, degree=degree, **kw)
+
+
+def spec_c(n_intervals: int = 20, degree: int = 5, contact_bounds: str = "table4.7", **kw) -> gait_ocp.GaitSpec:
+    """Approach (c): (b) + the 25 body/joint parameters free (Table 4.14), per-ellipsoid
+    normal force ≥ 0 (Sec 4.4.1), cost Eq 4.13 (Eq 4.11 + Imp Eq 4.12 + Rsd Eq 4.13,
+    w5 = w6 = 1/4). ``contact_bounds="widened"``: Table 4.7 widened to contain the thesis's
+    own (c) values (Table 4.17, five of which lie outside Table 4.7 — the bounds the thesis
+    must have used in Sec 4.4, unreported)."""
+    return gait_ocp.GaitSpec(model="SK", cost="Eq4.13", free_contact=True, free_body=True,
+                       normal_force_constraint=True, contact_bounds=contact_bounds,
+                       n_intervals=n_intervals, degree=degree, **kw)
+
+
+#: How a cold-started (b)/(c) guess is built; part of the cache key of those solves: change it
+#: with the method.
+GUESS_METHOD = "data-based guess of the spec (states, jerks, data torques, zero residuals) + start parameters (v1)"
+
+
+def solve_stage(spec: gait_ocp.GaitSpec, start: dict, warm: gait_ocp.GaitSolution | None, use_cache: bool, root,
+                       progress: bool = False) -> gait_ocp.GaitSolution:
+    """Solve ``spec`` from the data-based guess with the parameters ``start`` (name → value)
+    or warm-started from ``warm``; cached on spec + start + warm start's identity + code."""
+    desc = {"kind": "contact_id_gait", **spec.to_dict(), "guess": GUESS_METHOD,
+            "start": {k: float(np.format_float_positional(v, 12)) for k, v in sorted(start.items())}}
+    if warm is not None:
+        ws = warm.solution
+        desc["warm_start"] = {"spec": warm.spec.to_dict(), "status": ws.status,
+                              "objective": float(f"{ws.objective:.12g}"), "iterations": ws.iterations}
+    where = cache.lookup("contact_id", desc, root, formulation=(gait_ocp.FORMULATION, FORMULATION),
+                         identified=spec.identified_sets())
+
+    def solve():
+        gp = gait_ocp.build(spec)
+        if warm is not None:
+            g = gait_ocp.warm_start(gp, warm)
+            guess = ocp.Guess(phases=g.phases, parameters={**dict(g.parameters), **start})
+        else:
+            guess = ocp.Guess(phases=gp.guess.phases, parameters=dict(start))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ocp.SolveFailedWarning)
+            sol = gait_ocp.solve(gp, guess=guess, progress=progress)
+        sol.stats["from_cache"] = False
+        return sol
+
+    return cache.solve_or_load(where, solve, gait_ocp.GaitSolution.from_cache, marker="spec.json",
+                               use_cache=use_cache)
+
+
+#: Continuation towards approach (b) from a start far from dynamic consistency (our device):
+#: the pelvis residual bounds (R_x, R_y N; R_z N·m) of the stages before the final problem,
+#: each stage with the Rsd term (Eq 4.13, weight 1/4) added and warm-started from the last.
+CONTINUATION = ((1000.0, 1000.0, 100.0), (100.0, 100.0, 10.0), (10.0, 10.0, 1.0))
+
+
+def stage_spec(spec: gait_ocp.GaitSpec, bounds) -> gait_ocp.GaitSpec:
+    w = tuple(spec.weights) if "Rsd" in spec.term_weights else tuple(spec.weights) + (("Rsd", 0.25),)
+    return dataclasses.replace(spec, residual_bounds=tuple(float(b) for b in bounds), weights=w)
+
+
+def solve_continued(spec: gait_ocp.GaitSpec, start: dict, warm, stages, use_cache, root, progress):
+    """Solve the ``stages`` (residual bounds) then ``spec`` itself, each warm-started from the
+    previous solution (whatever its status: every stage's status is kept and reported)."""
+    sols = []
+    prev = warm
+    for b in stages:
+        sol = solve_stage(stage_spec(spec, b), start if prev is None else {}, prev, use_cache, root, progress)
+        sols.append(sol)
+        prev = sol
+    final = solve_stage(spec, start if prev is None else {}, prev, use_cache, root, progress)
+    return final, sols

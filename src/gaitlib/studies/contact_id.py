@@ -48,11 +48,9 @@ different data (Bovi et al. 2011, 0.98 s cycle).
 
 from __future__ import annotations
 
-import dataclasses
 import datetime as _dt
 import json
 import time
-import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -64,12 +62,12 @@ from .. import cache
 from .. import contact as contact_mod
 from .. import conventions as cv
 from .. import data as data_mod
-from .. import ocp
 from .. import params as params_mod
 from ..problems import gait as gait_ocp
 from ..model import P_BODY_NAMES, P_BODY_UNITS, ChildModel
-from ..problems.contact_id import (MU_RATIO, TRAJOPT_FORMULATION, InverseDynamicsID,  # noqa: F401  (API)
-                                   TrajOptSpec, neutral_start)
+from ..problems.contact_id import (CONTINUATION, FORMULATION, GUESS_METHOD, MU_RATIO,  # noqa: F401  (API)
+                                   TRAJOPT_FORMULATION, InverseDynamicsID, TrajOptSpec, solve_continued,
+                                   solve_stage, neutral_start, spec_b, spec_c)
 
 __all__ = [
     "APPROACHES", "THESIS_RMSE", "THESIS_GEOMETRY", "THESIS_CONTACT", "THESIS_TIME",
@@ -81,10 +79,6 @@ __all__ = [
     "save_identified", "identified_vs_result", "THESIS_RANKING", "ranking", "findings",
 ]
 
-#: Version of approaches (b)/(c) on top of :data:`gaitlib.problems.gait.FORMULATION` (their
-#: starts, guesses and continuation): part of their cache keys. Bump either when a change
-#: alters what is solved (tests/test_formulation_versions.py).
-FORMULATION = "contact-id-1"
 
 #: The three approaches: key → label used in tables and figures.
 APPROACHES = {"a": "(a) trajectory optimisation", "b": "(b) optimal control",
@@ -324,83 +318,6 @@ def _result_a(prob: InverseDynamicsID, rec: dict, from_cache: bool) -> ApproachR
                           fr["ellipsoids"], rmse, stats, starts=starts)
 
 
-def spec_b(n_intervals: int = 20, degree: int = 5, contact_bounds: str = "table4.7", **kw) -> gait_ocp.GaitSpec:
-    """Approach (b): SK, Eq 4.11 (Table 4.8 weights), 39 contact parameters free within
-    Table 4.7 verbatim and Eq 4.4; Eq 4.8 residual bounds; thesis mesh 20 × 5 LGR."""
-    return gait_ocp.GaitSpec(model="SK", cost="Eq4.11", free_contact=True, contact_bounds=contact_bounds,
-                       n_intervals=n_intervals, degree=degree, **kw)
-
-
-def spec_c(n_intervals: int = 20, degree: int = 5, contact_bounds: str = "table4.7", **kw) -> gait_ocp.GaitSpec:
-    """Approach (c): (b) + the 25 body/joint parameters free (Table 4.14), per-ellipsoid
-    normal force ≥ 0 (Sec 4.4.1), cost Eq 4.13 (Eq 4.11 + Imp Eq 4.12 + Rsd Eq 4.13,
-    w5 = w6 = 1/4). ``contact_bounds="widened"``: Table 4.7 widened to contain the thesis's
-    own (c) values (Table 4.17, five of which lie outside Table 4.7 — the bounds the thesis
-    must have used in Sec 4.4, unreported)."""
-    return gait_ocp.GaitSpec(model="SK", cost="Eq4.13", free_contact=True, free_body=True,
-                       normal_force_constraint=True, contact_bounds=contact_bounds,
-                       n_intervals=n_intervals, degree=degree, **kw)
-
-
-#: How a cold-started (b)/(c) guess is built; part of the cache key of those solves: change it
-#: with the method.
-GUESS_METHOD = "data-based guess of the spec (states, jerks, data torques, zero residuals) + start parameters (v1)"
-
-
-def _solve_gait_cached(spec: gait_ocp.GaitSpec, start: dict, warm: gait_ocp.GaitSolution | None, use_cache: bool, root,
-                       progress: bool = False) -> gait_ocp.GaitSolution:
-    """Solve ``spec`` from the data-based guess with the parameters ``start`` (name → value)
-    or warm-started from ``warm``; cached on spec + start + warm start's identity + code."""
-    desc = {"kind": "contact_id_gait", **spec.to_dict(), "guess": GUESS_METHOD,
-            "start": {k: float(np.format_float_positional(v, 12)) for k, v in sorted(start.items())}}
-    if warm is not None:
-        ws = warm.solution
-        desc["warm_start"] = {"spec": warm.spec.to_dict(), "status": ws.status,
-                              "objective": float(f"{ws.objective:.12g}"), "iterations": ws.iterations}
-    where = cache.lookup("contact_id", desc, root, formulation=(gait_ocp.FORMULATION, FORMULATION),
-                         identified=spec.identified_sets())
-
-    def solve():
-        gp = gait_ocp.build(spec)
-        if warm is not None:
-            g = gait_ocp.warm_start(gp, warm)
-            guess = ocp.Guess(phases=g.phases, parameters={**dict(g.parameters), **start})
-        else:
-            guess = ocp.Guess(phases=gp.guess.phases, parameters=dict(start))
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", ocp.SolveFailedWarning)
-            sol = gait_ocp.solve(gp, guess=guess, progress=progress)
-        sol.stats["from_cache"] = False
-        return sol
-
-    return cache.solve_or_load(where, solve, gait_ocp.GaitSolution.from_cache, marker="spec.json",
-                               use_cache=use_cache)
-
-
-#: Continuation towards approach (b) from a start far from dynamic consistency (our device):
-#: the pelvis residual bounds (R_x, R_y N; R_z N·m) of the stages before the final problem,
-#: each stage with the Rsd term (Eq 4.13, weight 1/4) added and warm-started from the last.
-CONTINUATION = ((1000.0, 1000.0, 100.0), (100.0, 100.0, 10.0), (10.0, 10.0, 1.0))
-
-
-def _stage_spec(spec: gait_ocp.GaitSpec, bounds) -> gait_ocp.GaitSpec:
-    w = tuple(spec.weights) if "Rsd" in spec.term_weights else tuple(spec.weights) + (("Rsd", 0.25),)
-    return dataclasses.replace(spec, residual_bounds=tuple(float(b) for b in bounds), weights=w)
-
-
-def _continuation(spec: gait_ocp.GaitSpec, start: dict, warm, stages, use_cache, root, progress):
-    """Solve the ``stages`` (residual bounds) then ``spec`` itself, each warm-started from the
-    previous solution (whatever its status: every stage's status is kept and reported)."""
-    sols = []
-    prev = warm
-    for b in stages:
-        sol = _solve_gait_cached(_stage_spec(spec, b), start if prev is None else {}, prev, use_cache, root, progress)
-        sols.append(sol)
-        prev = sol
-    final = _solve_gait_cached(spec, start if prev is None else {}, prev, use_cache, root, progress)
-    return final, sols
-
-
 def _stages_frame(stages: list, final: gait_ocp.GaitSolution) -> pd.DataFrame:
     rows = []
     for s in list(stages) + [final]:
@@ -437,7 +354,7 @@ def optimal_control(spec: gait_ocp.GaitSpec | None = None, start=None, stages=CO
     spec = spec or spec_b()
     p0 = neutral_start() if start is None else np.asarray(start, float)
     st = {f"c.{n}": float(v) for n, v in zip(contact_mod.param_names(), p0)}
-    final, sols = _continuation(spec, st, None, stages, use_cache, root, progress)
+    final, sols = solve_continued(spec, st, None, stages, use_cache, root, progress)
     return _with_stages(_result_from_gait("b", final), sols)
 
 
@@ -452,11 +369,11 @@ def optimal_control_body(spec: gait_ocp.GaitSpec | None = None, warm: ApproachRe
     if warm is not None:
         if warm.solution is None:
             raise ValueError("optimal_control_body: warm must be an optimal-control result ((b))")
-        sol = _solve_gait_cached(spec, {}, warm.solution, use_cache, root, progress)
+        sol = solve_stage(spec, {}, warm.solution, use_cache, root, progress)
     else:
         p0 = neutral_start() if start is None else np.asarray(start, float)
         st = {f"c.{n}": float(v) for n, v in zip(contact_mod.param_names(), p0)}
-        sol = _solve_gait_cached(spec, st, None, use_cache, root, progress)
+        sol = solve_stage(spec, st, None, use_cache, root, progress)
     key = "c" if spec.contact_bounds == "table4.7" else "c_wide"
     return _with_stages(_result_from_gait(key, sol), [])
 
