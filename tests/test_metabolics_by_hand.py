@@ -323,3 +323,52 @@ def test_reading_isometric_torque_is_max_isometric():
     want_S = (0.16 * TAU0_ANKLE_EXT + 0.18 * tau_ext) * 2.0 + 0.157 * tau_flex * (-2.0)
     assert out["shortening"] == pytest.approx(want_S, rel=REL, abs=1e-12)
     assert out["work"] == pytest.approx((-tau_ext + tau_flex) * (-2.0), rel=REL, abs=1e-12)
+
+
+# ---- whole model: Eq 5.38 summed over 16 muscles, 12 generators, 6 MTG joints -------------
+
+# Adult τ0 (N·m, RBDL Gymnast, model-facts Sec 2) and s^τ (thesis Table 5.2) per generator;
+# σ: model-convention joint torque = σ × generator torque, and ω_f = σ q̇ (model-facts Sec 2:
+# extensors σ = −s_θ, flexors +s_θ; s_θ = +1 hip, −1 knee, +1 ankle).
+GEN = {
+    #               τ0_adult  s^τ     σ
+    "hip_ext": (175.746, 0.9995, -1.0),
+    "hip_flex": (157.293, 1.0067, 1.0),
+    "knee_ext": (285.619, 1.0012, 1.0),
+    "knee_flex": (98.7579, 1.0026, -1.0),
+    "ankle_ext": (127.561, 0.9999, -1.0),
+    "ankle_flex": (44.3106, 1.0015, 1.0),
+}
+
+
+def test_whole_model_sum_eq_5_38():
+    """nmsk_metabolic_rate at one gait-like state against the hand sum. The generator torques
+    τ^M are the MTG model's (an input to the metabolic model, tested in test_mtg.py); every
+    metabolic term, the fibre-velocity signs, τ0 (Eq 5.21 × s^τ) and the sums are by hand."""
+    scale = (41.4 * 1.47) / (69.6 * 1.732)  # Eq 5.21
+    q = {"hip_r": 0.35, "knee_r": -0.6, "ankle_r": 0.1, "hip_l": -0.15, "knee_l": -0.1, "ankle_l": -0.2}
+    qd = {"hip_r": 1.5, "knee_r": 3.0, "ankle_r": -1.0, "hip_l": -0.8, "knee_l": -2.0, "ankle_l": -4.0}
+    e = dict(zip(TABLE, (0.30, 0.25, 0.40, 0.35, 0.50, 0.20, 0.45, 0.15), strict=True))
+    ex = {f"{mu}_{sd}": e[mu] * (1.0 if sd == "r" else 0.6) for mu in TABLE for sd in ("r", "l")}
+    ts = {k: 0.1 + 0.02 * i for i, k in enumerate(ex)}
+    out = met.nmsk_metabolic_rate(q, qd, ex, params=mtg.THESIS_PARAMS, t_stim=ts, forbid_negative=False)
+    gt = out["generator_torques"]
+
+    A = sum(A_hand(k[:-2], v, ts[k]) for k, v in ex.items())
+    M = sum(M_hand(k[:-2], v) for k, v in ex.items())
+    B = 2 * sum(B_hand(mu) for mu in TABLE)
+    S = W = 0.0
+    for sd in ("r", "l"):
+        for j in ("hip", "knee", "ankle"):
+            tau_joint = 0.0
+            for d in ("ext", "flex"):
+                tau0_adult, s_tau, sigma = GEN[f"{j}_{d}"]
+                tau_m = gt[f"{j}_{d}_{sd}"]
+                assert tau_m >= 0
+                S += S_hand(tau_m, sigma * qd[f"{j}_{sd}"], s_tau * scale * tau0_adult)
+                tau_joint += sigma * tau_m
+            W += tau_joint * qd[f"{j}_{sd}"]
+    for k, want in (("activation", A), ("maintenance", M), ("basal", B), ("shortening", S), ("work", W)):
+        assert out[k] == pytest.approx(want, rel=REL), k
+    assert out["total"] == pytest.approx(A + M + S + B + W, rel=REL)
+    assert out["per_kg"] == pytest.approx((A + M + S + B + W) / BM, rel=REL)
