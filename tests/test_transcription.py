@@ -89,3 +89,19 @@ def test_failed_gait_solve_is_reported_as_failed():
         gs = gait_ocp.solve(gait_ocp.GaitSpec(n_intervals=3, degree=3, max_iter=2))
     assert not gs.success and gs.stats["status"] == "Maximum_Iterations_Exceeded"
     assert gs.stats["iterations"] == 2
+
+
+def test_every_weighted_cost_term_has_a_goal_factory_for_its_model():
+    """Each term a cost function weights (COST_FUNCTIONS) is a named goal factory of
+    COST_TERMS that is defined for that model (Act not for SK; Mtb only for NMSK)."""
+    from collections import defaultdict
+
+    from gaitlib.problems import gait as gp_mod
+
+    ctx = {m: gp_mod.GoalContext(model=m, ranges=defaultdict(lambda: 1.0), node=None, tf_of=None, stride=1.0) for m in gp_mod.COST_FUNCTIONS}
+    for model, costs in gp_mod.COST_FUNCTIONS.items():
+        for cost, weights in costs.items():
+            for term in weights:
+                assert term in gp_mod.COST_TERMS, (model, cost, term)
+                assert gp_mod.COST_TERMS[term](ctx[model]) is not None, (model, cost, term)
+    assert gp_mod.goal_act(ctx["SK"]) is None and gp_mod.goal_mtb(ctx["MSK"]) is None

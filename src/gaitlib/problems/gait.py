@@ -639,6 +639,111 @@ def mtb_scale(t_f, stride: float, body_mass: float = cv.BODY_MASS):
     return t_f**6 / (body_mass**2 * stride**4) / d_edot**2
 
 
+# -- cost terms ---------------------------------------------------------------------------
+# Every thesis cost term is a named goal factory: GoalContext → integrand (x, u, p, t[, d]) or
+# None where the term is not defined for the model. build() adds, in COST_TERMS's order, the
+# terms the cost function weights (COST_FUNCTIONS), each divided by the duration.
+
+
+@dataclass(frozen=True)
+class GoalContext:
+    """What the cost terms read from a built problem: ``model``; ``ranges`` (the data's range
+    per channel, :attr:`Reference.ranges`, the normalisation of Eqs 4.9-4.11); ``node`` (the
+    per-node closure, :attr:`GaitProblem.node`); ``tf_of`` (p → final time, s); ``stride``
+    (m); NMSK: ``muscle_activations`` (x, p → the 16 activations) and ``basal`` (W)."""
+
+    model: str
+    ranges: Any
+    node: Any
+    tf_of: Any
+    stride: float
+    muscle_activations: Any = None
+    basal: float = 0.0
+
+
+def _sq(e, r):
+    return (e / r) ** 2
+
+
+def goal_jrk(c: GoalContext):
+    """Jrk (Eq 4.10): jerks of every coordinate, × t_f⁶ (Eq 5.55's time scaling)."""
+    return lambda x, u, p, t: c.tf_of(p)**6 * sum(_sq(u[f"jerk_{k}"], c.ranges[f"jerk_{k}"]) for k in cv.COORDS)
+
+
+def goal_rsd(c: GoalContext):
+    """Rsd (Eq 4.13): HAT residual loads, normalised by the thesis's residual range (Eq 4.8:
+    ±1 N, ±0.1 N·m) even when the bounds are relaxed (continuation), so relaxing never makes
+    residuals cheap."""
+    rn = dict(zip(cv.RESIDUALS, RESIDUAL_RANGE))
+    return lambda x, u, p, t: sum(_sq(u[r], rn[r]) for r in cv.RESIDUALS)
+
+
+def goal_imp(c: GoalContext):
+    """Imp (Eq 6.3): inverse-dynamics minus input torques over the 8 joints; the metatarsal
+    joints have no data, so their differences are normalised by the same side's ankle range."""
+    rg, node = c.ranges, c.node
+    imp_range = {j: rg[f"tau_{j}"] if f"tau_{j}" in rg else rg[f"tau_{j.replace('mtp', 'ankle')}"]
+                 for j in cv.JOINTS}
+    return lambda x, u, p, t: sum(_sq(node(x, u, p)["tau_id"][i] - node(x, u, p)["tau_in"][i], imp_range[j])
+                                  for i, j in enumerate(cv.JOINTS))
+
+
+def goal_hat(c: GoalContext):
+    """HAT: the pelvis (HAT) coordinates tracking their reference."""
+    rg = c.ranges
+    return lambda x, u, p, t, d: sum(_sq(x[k] - d[f"ref_{k}"], rg[k]) for k in cv.COORDS[:3])
+
+
+def goal_act(c: GoalContext):
+    """Act: MSK, the 12 MTG activations (Eq 5.33); NMSK, the 16 muscle activations (Eq 6.6,
+    range a_max − a_min = 1, Sec 5.3.4); not defined for SK."""
+    if c.model == "MSK":
+        return lambda x, u, p, t: sum(u[a] ** 2 for a in MTG_CONTROLS)
+    if c.model == "NMSK":
+        return lambda x, u, p, t: sum(a_**2 for a_ in c.muscle_activations(x, p).values())
+    return None
+
+
+def goal_mtb(c: GoalContext):
+    """Mtb (Eq 6.7 with Eq 5.56), NMSK only: Ė = B + smax(Ȧ + Ṁ + Ṡ + Ẇ) as
+    :func:`gaitlib.metabolics.metabolic_rate`, with Ȧ + Ṁ + Ṡ + Ẇ the lifted control
+    ``edot_rest``."""
+    if c.model != "NMSK":
+        return None
+    return lambda x, u, p, t: mtb_scale(c.tf_of(p), c.stride) * (c.basal + metabolics._smax0(u["edot_rest"], 0.1)) ** 2
+
+
+def goal_trq(c: GoalContext):
+    """Trq (Eq 4.11): net joint torques of the 6 leg joints tracking the data."""
+    rg, node = c.ranges, c.node
+    return lambda x, u, p, t, d: sum(_sq(node(x, u, p)["tau_net"][cv.JOINTS.index(j)] - d[f"ref_tau_{j}"],
+                                         rg[f"tau_{j}"]) for j in LEG_JOINTS)
+
+
+def goal_ang(c: GoalContext):
+    """Ang (Eq 4.9): the 6 leg joint angles tracking the data."""
+    rg = c.ranges
+    return lambda x, u, p, t, d: sum(_sq(x[j] - d[f"ref_{j}"], rg[j]) for j in LEG_JOINTS)
+
+
+def goal_grf(c: GoalContext):
+    """GRF (Eq 4.11): the foot forces tracking the data."""
+    rg, node = c.ranges, c.node
+    return lambda x, u, p, t, d: sum(_sq(node(x, u, p)["grf"][i] - d[f"ref_{g}"], rg[g])
+                                     for i, g in enumerate(GRF_CHANNELS))
+
+
+def goal_q(c: GoalContext):
+    """Q: every coordinate tracking its reference."""
+    rg = c.ranges
+    return lambda x, u, p, t, d: sum(_sq(x[k] - d[f"ref_{k}"], rg[k]) for k in cv.COORDS)
+
+
+#: Cost term name → goal factory, in the order build() adds them.
+COST_TERMS = {"Jrk": goal_jrk, "Rsd": goal_rsd, "Imp": goal_imp, "HAT": goal_hat, "Act": goal_act,
+              "Mtb": goal_mtb, "Trq": goal_trq, "Ang": goal_ang, "GRF": goal_grf, "Q": goal_q}
+
+
 def build(spec: GaitSpec) -> GaitProblem:
     """Turn a :class:`GaitSpec` into an :class:`ocp.Problem` with mesh, options, guess."""
     model = ChildModel()
@@ -829,44 +934,17 @@ def build(spec: GaitSpec) -> GaitProblem:
         path.append(PathConstraint("metabolic_rate", lambda x, u, p, t: u["edot_rest"] - edot_rest(x, u, p),
                                    0.0, 0.0))
 
-    def sq(e, r):
-        return (e / r) ** 2
-
     goals = []
-
-    def goal(name, f):
-        if name in w:
-            if fx is not None and ocp._accepts_data(f):  # effects may override references
-                f = (lambda f_: lambda x, u, p, t, d: f_(x, u, p, t, fx.wrap_data(d, p, t)))(f)
-            goals.append(Goal(name, weight=w[name], integrand=f, divide_by_duration=True))
-
-    goal("Jrk", lambda x, u, p, t: tf_of(p)**6 * sum(sq(u[f"jerk_{c}"], rg[f"jerk_{c}"]) for c in cv.COORDS))
+    ctx = GoalContext(model=spec.model, ranges=rg, node=node, tf_of=tf_of, stride=stride,
+                      muscle_activations=muscle_activations if nmsk else None, basal=basal if nmsk else 0.0)
+    for name, factory in COST_TERMS.items():
+        f = factory(ctx) if name in w else None
+        if f is None:
+            continue
+        if fx is not None and ocp._accepts_data(f):  # effects may override references
+            f = (lambda f_: lambda x, u, p, t, d: f_(x, u, p, t, fx.wrap_data(d, p, t)))(f)
+        goals.append(Goal(name, weight=w[name], integrand=f, divide_by_duration=True))
     rb = dict(zip(cv.RESIDUALS, spec.residual_bounds))
-    # Rsd is normalised by the thesis's residual range (Eq 4.8: ±1 N, ±0.1 N·m) even when
-    # the bounds are relaxed (continuation), so relaxing never makes residuals cheap.
-    rn = dict(zip(cv.RESIDUALS, RESIDUAL_RANGE))
-    goal("Rsd", lambda x, u, p, t: sum(sq(u[r], rn[r]) for r in cv.RESIDUALS))
-    # Imp (Eq 6.3) over the 8 leg joints; the metatarsal joints have no data, so their
-    # differences are normalised by the same side's ankle torque range.
-    imp_range = {j: rg[f"tau_{j}"] if f"tau_{j}" in rg else rg[f"tau_{j.replace('mtp', 'ankle')}"]
-                 for j in cv.JOINTS}
-    goal("Imp", lambda x, u, p, t: sum(sq(node(x, u, p)["tau_id"][i] - node(x, u, p)["tau_in"][i], imp_range[j])
-                                        for i, j in enumerate(cv.JOINTS)))
-    goal("HAT", lambda x, u, p, t, d: sum(sq(x[c] - d[f"ref_{c}"], rg[c]) for c in cv.COORDS[:3]))
-    if spec.model == "MSK":
-        goal("Act", lambda x, u, p, t: sum(u[a] ** 2 for a in MTG_CONTROLS))
-    elif nmsk:
-        # Act_NMSK (Eq 6.6): the 16 muscle activations, range a_max − a_min = 1 (Sec 5.3.4)
-        goal("Act", lambda x, u, p, t: sum(a_**2 for a_ in muscle_activations(x, p).values()))
-        # Mtb (Eq 6.7 with Eq 5.56); Ė = B + smax(Ȧ + Ṁ + Ṡ + Ẇ) as metabolics.metabolic_rate
-        goal("Mtb", lambda x, u, p, t: mtb_scale(tf_of(p), stride)
-             * (basal + metabolics._smax0(u["edot_rest"], 0.1)) ** 2)
-    goal("Trq", lambda x, u, p, t, d: sum(sq(node(x, u, p)["tau_net"][cv.JOINTS.index(j)] - d[f"ref_tau_{j}"], rg[f"tau_{j}"])
-                                          for j in LEG_JOINTS))
-    goal("Ang", lambda x, u, p, t, d: sum(sq(x[j] - d[f"ref_{j}"], rg[j]) for j in LEG_JOINTS))
-    goal("GRF", lambda x, u, p, t, d: sum(sq(node(x, u, p)["grf"][i] - d[f"ref_{g}"], rg[g])
-                                          for i, g in enumerate(GRF_CHANNELS)))
-    goal("Q", lambda x, u, p, t, d: sum(sq(x[c] - d[f"ref_{c}"], rg[c]) for c in cv.COORDS))
     unused = set(w) - {g.name for g in goals}
     if unused:
         raise ValueError(f"cost terms {sorted(unused)} are not defined for model {spec.model}")
