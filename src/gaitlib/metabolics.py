@@ -170,7 +170,8 @@ def basal_rate(muscle: str) -> float:
     return B_RATE * _muscle(muscle).mass
 
 
-def shortening_heat_rate(tau_m, omega_f, tau_max, omega_smooth: float = 0.01):
+def shortening_heat_rate(tau_m, omega_f, tau_max, omega_smooth: float = 0.01, *, sign: str = "bhargava",
+                         split: str = "fibre"):
     """Shortening heat rate Ṡ of one generator, W (Eq 5.47, sign as in the module doc).
 
     Parameters
@@ -180,11 +181,18 @@ def shortening_heat_rate(tau_m, omega_f, tau_max, omega_smooth: float = 0.01):
     tau_max : isometric torque term, N·m: s^τ τ0 in the thesis's Eq 5.47 (Bhargava's
         F_iso is the isometric force at the current activation and length instead).
     omega_smooth : ω_s of the tanh switch between the two cases, rad/s (0 → exact switch).
+    sign : {'bhargava', 'printed'}
+        'bhargava' (default, what the NLPs use): α ω_f, heat ≥ 0 when shortening.
+        'printed': Eq 5.47 as printed, −α θ̇ with θ̇ ≡ ω_f, i.e. the negative of the default.
+    split : {'fibre', 'printed'}
+        'fibre' (default): concentric case where ω_f ≥ 0 (tanh-smoothed). 'printed': Eq 5.47's
+        τ^M θ̇ ≥ 0, which differs only where τ^M = 0: there the concentric case applies
+        even when lengthening (0.16 τ_max ω_f instead of 0.157 × 0 × ω_f = 0).
 
     Returns
     -------
     α ω_f, α = 0.16 τ_max + 0.18 τ^M (ω_f ≥ 0) or 0.157 τ^M (ω_f < 0): ≥ 0 concentric,
-    ≤ 0 eccentric.
+    ≤ 0 eccentric (defaults; the opposite signs with ``sign='printed'``).
     """
     alpha_c = 0.16 * tau_max + 0.18 * tau_m
     alpha_e = 0.157 * tau_m
@@ -192,7 +200,16 @@ def shortening_heat_rate(tau_m, omega_f, tau_max, omega_smooth: float = 0.01):
         s = 0.5 * (1.0 + _fn("tanh", omega_f)(omega_f / omega_smooth))
     else:
         s = (omega_f >= 0) * 1.0 if _is_ca(omega_f) else np.where(np.asarray(omega_f) >= 0, 1.0, 0.0)
-    return (s * alpha_c + (1.0 - s) * alpha_e) * omega_f
+    if split == "printed":  # τ^M θ̇ ≥ 0 with τ^M ≥ 0: concentric wherever τ^M = 0
+        s = ca.if_else(tau_m <= 0, 1.0, s) if _is_ca(tau_m, s) else np.where(np.asarray(tau_m) <= 0, 1.0, s)
+    elif split != "fibre":
+        raise ValueError("split must be 'fibre' or 'printed'")
+    out = (s * alpha_c + (1.0 - s) * alpha_e) * omega_f
+    if sign == "printed":
+        return -out
+    if sign != "bhargava":
+        raise ValueError("sign must be 'bhargava' or 'printed'")
+    return out
 
 
 def work_rate(tau, qd):
@@ -219,6 +236,9 @@ def metabolic_rate(
     forbid_negative: bool = True,
     eps: float = 0.1,
     body_mass: float = BODY_MASS,
+    shortening_sign: str = "bhargava",
+    shortening_split: str = "fibre",
+    basal_whole_body: float | None = None,
 ) -> dict[str, Any]:
     """Total metabolic rate Ė (thesis Eq 5.38) from per-muscle, per-generator and per-joint
     quantities at one instant (or elementwise over time samples).
@@ -233,8 +253,14 @@ def metabolic_rate(
     joint_torques, joint_speeds : mappings joint name → net torque (N·m, model
         convention) and velocity (rad/s); include torque-driven mtp joints here.
     t_stim : float or mapping muscle → t_stim (s), see :func:`activation_heat_rate`.
-    forbid_negative, eps : smooth clipping of the non-basal part (module docstring).
-    body_mass : kg, for the per-kg rate.
+    forbid_negative, eps : smooth clipping of the non-basal part (module docstring);
+        ``forbid_negative=False`` is Eq 5.38's plain sum.
+    body_mass : kg, for the per-kg rate (and the whole-body basal rate).
+    shortening_sign, shortening_split : ``sign`` and ``split`` of
+        :func:`shortening_heat_rate` (defaults: Bhargava's sign, split on ω_f).
+    basal_whole_body : None (default) → Eq 5.48, 0.0225 W/kg × the given muscles' mass;
+        a number c (W/kg) → c × ``body_mass`` for the whole body (OpenSim's Bhargava probe:
+        ``basal_coefficient`` 1.2 W/kg).
 
     Returns
     -------
@@ -248,8 +274,11 @@ def metabolic_rate(
         A = A + activation_heat_rate(m, e, ts)
         M = M + maintenance_heat_rate(m, e)
         B = B + basal_rate(m)
+    if basal_whole_body is not None:
+        B = basal_whole_body * body_mass
     for g, tq in generator_torques.items():
-        S = S + shortening_heat_rate(tq, generator_speeds[g], generator_tau_max[g], omega_smooth)
+        S = S + shortening_heat_rate(tq, generator_speeds[g], generator_tau_max[g], omega_smooth,
+                                     sign=shortening_sign, split=shortening_split)
     for j, tq in joint_torques.items():
         W = W + work_rate(tq, joint_speeds[j])
     rest = A + M + S + W
@@ -304,7 +333,8 @@ def nmsk_metabolic_rate(
         s^τ τ0, the maximum isometric torque, so a relaxed generator that shortens still
         produces 0.16 s^τ τ0 ω_f of heat. 'bhargava' (Bhargava 2004 / OpenSim): the
         isometric torque at the current activation and angle, a s^τ τ0 t^A(θ).
-    **kw : passed to :func:`metabolic_rate` (``omega_smooth``, ``forbid_negative``, ``eps``).
+    **kw : passed to :func:`metabolic_rate` (``omega_smooth``, ``forbid_negative``, ``eps``,
+        ``shortening_sign``, ``shortening_split``, ``basal_whole_body``).
 
     Returns
     -------
