@@ -15,6 +15,8 @@ Functions
 :func:`activation_table`    τ_act, c3, s1, s2: ours beside thesis Table 5.10.
 :func:`cot_breakdown`       the cost of transport (Eq 5.57) by term of Eq 5.38, and with the
                             two readings of the shortening heat.
+:func:`cot_readings`        the COT under each open reading of Eqs 5.38, 5.47, 5.48 and 5.57,
+                            one change at a time (same trajectory, not re-optimised).
 :func:`mtb_scale_table`     the size of the Mtb term under its normalisation (Eq 5.56).
 :func:`excitation_figure`   thesis Fig 5.11.
 :func:`angle_errors`        the largest angle error per joint and where in the cycle.
@@ -47,6 +49,7 @@ from . import gait as sg
 
 __all__ = ["EMG_MAP", "THESIS_TABLE_5_10", "THESIS_COT", "THESIS_HOURS", "parameter_sets", "ch5_spec", "solve",
            "emg_table", "emg_reference", "excitation_scores", "activation_table", "cot_breakdown",
+           "cot_readings", "pelvis_travel", "min_generator_torque", "THESIS_DISTANCE_M", "OPENSIM_BASAL_W_PER_KG",
            "mtb_scale_table", "excitation_figure", "saturation", "synergy_cost_table", "MOVED_TOL",
            "verdict_text", "range_text", "thesis_rmse_range", "moved_parameters", "short_generators",
            "angle_errors", "findings"]
@@ -307,9 +310,8 @@ def saturation(sol: gait_ocp.GaitSolution, level: float = 0.99) -> pd.Series:
     return (sol.activations >= level).mean()
 
 
-def _recompute_edot(sol: gait_ocp.GaitSolution, **kw) -> dict:
-    """Ė (W) of an NMSK solution's trajectory with :func:`gaitlib.metabolics.nmsk_metabolic_rate`
-    options ``kw`` (e.g. ``isometric_torque="bhargava"``), at the control nodes."""
+def _nmsk_rate(sol: gait_ocp.GaitSolution, **kw) -> dict:
+    """:func:`gaitlib.metabolics.nmsk_metabolic_rate` on an NMSK solution's control nodes."""
     U = sol.solution.phase("cycle").controls
     q = {j: sol.q[j].to_numpy() for j in cv.JOINTS}
     qd = {j: sol.qd[j].to_numpy() for j in cv.JOINTS}
@@ -318,20 +320,31 @@ def _recompute_edot(sol: gait_ocp.GaitSolution, **kw) -> dict:
     ap = sol.stats["activation_parameters"]
     ts = dict(zip(gait_ocp.NMSK_MUSCLES, sol.stats["t_stim_s"]))
     mtp = {f"mtp_{s}": U[f"tau_mtp_{s}"].to_numpy() for s in cv.SIDES}
-    r = metabolics.nmsk_metabolic_rate(q, qd, ed, am, gait_ocp.mtg_params_of(sol.spec), s1=ap["s1"], s2=ap["s2"],
-                                       mtp_torques=mtp, t_stim=ts, **kw)
+    return metabolics.nmsk_metabolic_rate(q, qd, ed, am, gait_ocp.mtg_params_of(sol.spec), s1=ap["s1"], s2=ap["s2"],
+                                          mtp_torques=mtp, t_stim=ts, **kw)
+
+
+def _recompute_edot(sol: gait_ocp.GaitSolution, **kw) -> dict:
+    """Ė (W) of an NMSK solution's trajectory with :func:`gaitlib.metabolics.nmsk_metabolic_rate`
+    options ``kw`` (e.g. ``isometric_torque="bhargava"``), at the control nodes."""
+    r = _nmsk_rate(sol, **kw)
     return {k: np.asarray(r[k], float) * np.ones(len(sol.q)) for k in
             ("total", "activation", "maintenance", "shortening", "basal", "work")}
 
 
-def _cot_of(sol, edot) -> float:
+def _stride(sol) -> float:
+    """The data's stride D = speed × cycle time, m (the distance of Eq 5.57 the NLP uses)."""
+    g = data_mod.load_gait_data(sol.spec.speed_class, sol.spec.source)
+    return g.speed * g.cycle_time
+
+
+def _cot_of(sol, edot, distance: float | None = None) -> float:
     t = sol.q.index.to_numpy()
     tf = float(sol.stats["tf_s"])
     per = t < tf - 1e-12
     tt = np.append(t[per], tf)
     ee = np.append(np.asarray(edot)[per], np.asarray(edot)[per][0])
-    g = data_mod.load_gait_data(sol.spec.speed_class, sol.spec.source)
-    return metabolics.cost_of_transport(tt, ee, distance=g.speed * g.cycle_time)
+    return metabolics.cost_of_transport(tt, ee, distance=_stride(sol) if distance is None else distance)
 
 
 def cot_breakdown(sol: gait_ocp.GaitSolution) -> pd.DataFrame:
@@ -347,6 +360,83 @@ def cot_breakdown(sol: gait_ocp.GaitSolution) -> pd.DataFrame:
         out[lab] = {k: _cot_of(sol, v) for k, v in e.items()}
     df = pd.DataFrame(out)
     df.index.name = "term of Eq 5.38"
+    return df
+
+
+#: Thesis Sec 5.3.4 (text after Eq 5.56): "D is 1.24 (m) that is the distance the child subject
+#: travelled" — the thesis's own subjects' distance, m.
+THESIS_DISTANCE_M = 1.24
+#: OpenSim's Bhargava2004MuscleMetabolicsProbe default ``basal_coefficient``, W/kg body mass.
+OPENSIM_BASAL_W_PER_KG = 1.2
+_TERMS = ("activation", "maintenance", "shortening", "basal", "work")
+
+
+def pelvis_travel(sol: gait_ocp.GaitSolution) -> float:
+    """pelvis_tx(t_f) − pelvis_tx(t_0) of a gait solution's states, m (the distance the model
+    itself travels over the cycle)."""
+    x = sol.solution.phase("cycle").states["pelvis_tx"]
+    return float(x.iloc[-1] - x.iloc[0])
+
+
+def min_generator_torque(sol: gait_ocp.GaitSolution) -> float:
+    """Smallest generator torque τ^M (N·m, ≥ 0) over the 12 MTGs and the control nodes of an
+    NMSK solution: Eq 5.47's printed case split differs from the split on ω_f only where
+    τ^M = 0."""
+    return float(min(np.min(np.asarray(v, float)) for v in _nmsk_rate(sol)["generator_torques"].values()))
+
+
+def cot_readings(sol: gait_ocp.GaitSolution) -> pd.DataFrame:
+    """Cost of transport (Eq 5.57, J kg⁻¹ m⁻¹) of an NMSK solution under each reading of the
+    metabolic model the thesis leaves open, one change at a time from the NLP's own reading.
+
+    Same stored trajectory (states, controls, activation parameters, t_stim of the NLP),
+    Ė recomputed with :func:`gaitlib.metabolics.nmsk_metabolic_rate`; **not re-optimised**:
+    the motion would change if the NLP minimised another reading.
+
+    Rows (``reading``): the NLP's reading first (Bhargava's sign with ω_f, split on ω_f,
+    F0 = s^τ τ0, basal Eq 5.48, non-basal part smoothly clipped at 0, D = the data's stride
+    speed × cycle time), then Eq 5.47's sign as printed; its case split τ^M θ̇ ≥ 0 as printed;
+    Bhargava's F_iso = a s^τ τ0 t^A; Eq 5.38's plain sum (no clipping); OpenSim's whole-body
+    basal rate 1.2 W/kg × BM; D = the solution's pelvis_tx travel over the cycle; D = the
+    thesis's 1.24 m. Last, the thesis's value (Sec 5.3.5, reference only; the thesis prints
+    no breakdown).
+
+    Columns: ``what changes`` (one line, with its equation), ``COT`` (total), ``change vs
+    NLP reading (%)``, and each term of Eq 5.38 integrated alone (``activation``,
+    ``maintenance``, ``shortening``, ``basal``, ``work``; the total includes the clipping,
+    so the terms need not add up to it).
+    """
+    D = _stride(sol)
+    rec = [
+        ("NLP's reading (default)", "Ṡ = α ω_f (> 0 shortening), split on ω_f, F0 = s^τ τ0; Ḃ = 0.0225 m; "
+         "Ė = ΣḂ + smax(rest) (Eq 5.38 clipped); D = speed × T", {}, D),
+        ("Eq 5.47 sign as printed", "Ṡ = −(0.16 s^τ τ0 + 0.18 τ^M) θ̇ concentric, −0.157 τ^M θ̇ eccentric, θ̇ ≡ ω_f "
+         "(Eq 5.47 literal: negative heat when shortening)", {"shortening_sign": "printed"}, D),
+        ("Eq 5.47 case split as printed", "concentric case where τ^M θ̇ ≥ 0 (Eq 5.47), i.e. also where τ^M = 0 "
+         "and lengthening", {"shortening_split": "printed"}, D),
+        ("F0 Bhargava", "Eq 5.47's 0.16 s^τ τ0 → 0.16 a s^τ τ0 t^A(θ) (Bhargava 2004 / OpenSim F_iso)",
+         {"isometric_torque": "bhargava"}, D),
+        ("negative totals: plain sum", "Ė = Σ(Ȧ + Ṁ + Ḃ) + ΣṠ + ΣẆ without clipping (Eq 5.38 as printed)",
+         {"forbid_negative": False}, D),
+        ("basal whole-body (OpenSim)", f"Ḃ = {OPENSIM_BASAL_W_PER_KG:g} W/kg × BM instead of Eq 5.48's "
+         "0.0225 W/kg × muscle mass", {"basal_whole_body": OPENSIM_BASAL_W_PER_KG}, D),
+        ("D = pelvis travel", "Eq 5.57's D = pelvis_tx(t_f) − pelvis_tx(t_0) of the solution", {}, pelvis_travel(sol)),
+        ("D = thesis 1.24 m", "Eq 5.57's D = 1.24 m (thesis Sec 5.3.4: its subjects' distance)", {}, THESIS_DISTANCE_M),
+    ]
+    cache: dict = {}
+    rows = []
+    for lab, what, kw, dist in rec:
+        key = tuple(sorted(kw.items()))
+        if key not in cache:
+            cache[key] = _recompute_edot(sol, **kw)
+        e = cache[key]
+        row = {"reading": lab, "what changes": what, "COT": _cot_of(sol, e["total"], dist)}
+        row.update({k: _cot_of(sol, e[k], dist) for k in _TERMS})
+        rows.append(row)
+    df = pd.DataFrame(rows).set_index("reading")
+    df.insert(2, "change vs NLP reading (%)", 100.0 * (df["COT"] / df["COT"].iloc[0] - 1.0))
+    df.loc["thesis, Sec 5.3.5 (reference)"] = {"what changes": "printed value; no breakdown printed",
+                                                "COT": THESIS_COT}
     return df
 
 
