@@ -1,0 +1,172 @@
+"""The readings of the metabolic model behind :func:`gaitlib.studies.msk.cot_readings`: each
+alternative changes exactly the term it names (hand-checked), and the table integrates and
+divides as Eq 5.57 says. No solve: a hand-built state set and a stand-in solution."""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import casadi as ca
+import numpy as np
+import pandas as pd
+import pytest
+
+from gaitlib import metabolics as met
+from gaitlib import mtg
+from gaitlib.studies import msk
+
+BM = 41.4  # kg, the child (thesis Sec 4.1)
+EPS = 0.1  # W, the smooth max's width (metabolics module docstring)
+TERMS = ("activation", "maintenance", "shortening", "basal", "work")
+
+# five gait-like states of the six MTG joints (rad, rad/s; model convention)
+Q = {"hip_r": [0.35, 0.1, -0.2, 0.0, 0.3], "knee_r": [-0.6, -0.1, -1.0, -0.3, -0.05],
+     "ankle_r": [0.1, -0.2, 0.05, 0.2, -0.3], "hip_l": [-0.15, 0.2, 0.4, -0.3, 0.0],
+     "knee_l": [-0.1, -0.9, -0.4, 0.0, -1.1], "ankle_l": [-0.2, 0.1, 0.0, -0.35, 0.15]}
+QD = {"hip_r": [1.5, -0.5, 0.2, -2.0, 0.7], "knee_r": [3.0, -4.0, 1.0, 0.5, -1.5],
+      "ankle_r": [-1.0, 2.0, -3.5, 0.3, 1.2], "hip_l": [-0.8, 1.1, -0.3, 2.2, -1.7],
+      "knee_l": [-2.0, 3.5, 0.1, -1.0, 2.5], "ankle_l": [-4.0, 0.5, 1.5, -2.5, 0.0]}
+E = [0.30, 0.05, 0.40, 0.35, 0.02, 0.20, 0.45, 0.15, 0.25, 0.6, 0.1, 0.3, 0.5, 0.05, 0.2, 0.4]
+
+
+def _rate(**kw):
+    q = {k: np.array(v) for k, v in Q.items()}
+    qd = {k: np.array(v) for k, v in QD.items()}
+    ex = [np.full(5, e) for e in E]
+    return met.nmsk_metabolic_rate(q, qd, ex, params=mtg.THESIS_PARAMS, t_stim=0.3, **kw)
+
+
+def _changed(a, b):
+    return [k for k in ("total",) + TERMS if not np.allclose(a[k], b[k], rtol=1e-12, atol=1e-12)]
+
+
+def test_sign_as_printed_flips_only_the_shortening_heat():
+    d, p = _rate(), _rate(shortening_sign="printed")
+    assert set(_changed(d, p)) <= {"shortening", "total"}
+    np.testing.assert_allclose(p["shortening"], -d["shortening"], rtol=1e-12)
+    # one generator by hand: concentric (ω_f = 2 rad/s, τ^M = 30, τ_max = 50):
+    # printed −(0.16·50 + 0.18·30)·2 = −26.8 W; eccentric (ω_f = −2): −0.157·30·(−2) = +9.42 W
+    assert met.shortening_heat_rate(30.0, 2.0, 50.0, 0.0, sign="printed") == pytest.approx(-26.8)
+    assert met.shortening_heat_rate(30.0, -2.0, 50.0, 0.0, sign="printed") == pytest.approx(9.42)
+
+
+def test_case_split_as_printed_differs_only_at_zero_torque():
+    # τ^M = 0 lengthening: printed split → concentric 0.16·50·(−1.5) = −12 W; default 0.157·0 = 0
+    assert met.shortening_heat_rate(0.0, -1.5, 50.0, split="printed") == pytest.approx(-12.0, rel=1e-12)
+    assert met.shortening_heat_rate(0.0, -1.5, 50.0) == pytest.approx(0.0, abs=1e-15)
+    # τ^M > 0: identical (numeric and CasADi)
+    tau = np.array([0.5, 10.0, 30.0, 60.0])
+    om = np.array([-2.0, -0.003, 0.004, 1.5])
+    np.testing.assert_array_equal(met.shortening_heat_rate(tau, om, 50.0, split="printed"),
+                                  met.shortening_heat_rate(tau, om, 50.0))
+    t, w = ca.SX.sym("t"), ca.SX.sym("w")
+    f = ca.Function("f", [t, w], [met.shortening_heat_rate(t, w, 50.0, split="printed")])
+    assert float(f(0.0, -1.5)) == pytest.approx(-12.0, rel=1e-12)
+    assert float(f(30.0, -2.0)) == pytest.approx(-0.157 * 30 * 2.0, rel=1e-9)
+    # on the gait states every τ^M > 0, so nothing changes
+    assert _changed(_rate(), _rate(shortening_split="printed")) == []
+
+
+def test_bhargava_isometric_torque_changes_only_the_shortening_heat():
+    d, b = _rate(), _rate(isometric_torque="bhargava")
+    assert set(_changed(d, b)) == {"shortening", "total"}
+
+
+def test_whole_body_basal_changes_only_the_basal_rate():
+    d, w = _rate(), _rate(basal_whole_body=1.2)
+    assert set(_changed(d, w)) == {"basal", "total"}
+    assert w["basal"] == pytest.approx(1.2 * BM)  # 49.68 W
+    np.testing.assert_allclose(w["total"] - d["total"], 1.2 * BM - d["basal"], rtol=1e-12)
+    # Eq 5.48 for comparison: 0.0225 W/kg × 16 muscles' mass ≈ 0.06 W
+    assert 0.03 < d["basal"] < 0.1
+
+
+def test_plain_sum_against_the_smooth_clip():
+    d, p = _rate(), _rate(forbid_negative=False)
+    assert set(_changed(d, p)) <= {"total"}
+    rest = p["total"] - p["basal"]
+    np.testing.assert_allclose(p["total"], sum(p[k] for k in TERMS), rtol=1e-12)
+    smax = 0.5 * (rest + np.sqrt(rest**2 + EPS**2)) - 0.5 * EPS
+    np.testing.assert_allclose(d["total"], d["basal"] + smax, rtol=1e-12)
+    # smax(x) ≥ x − ε/2 and smax(x) ≥ −ε/2: plain ≤ clipped + ε/2; strictly below when rest < 0
+    assert np.all(p["total"] <= d["total"] + EPS / 2 + 1e-12)
+    x = np.array([-30.0, -1.0, 0.0, 2.0, 300.0])
+    r = met.metabolic_rate({}, {}, {}, {}, {"j": x}, {"j": np.ones(5)})
+    r0 = met.metabolic_rate({}, {}, {}, {}, {"j": x}, {"j": np.ones(5)}, forbid_negative=False)
+    np.testing.assert_array_equal(r0["total"], x)
+    assert np.all(r["total"][:2] > x[:2]) and r["total"][2] == 0.0
+    assert np.all(x[3:] - r["total"][3:] <= EPS / 2)
+
+
+def test_readings_keyword_errors():
+    with pytest.raises(ValueError):
+        met.shortening_heat_rate(1.0, 1.0, 1.0, sign="literal")
+    with pytest.raises(ValueError):
+        met.shortening_heat_rate(1.0, 1.0, 1.0, split="tau")
+
+
+# ---- the table: a stand-in solution (uniform grid, constant rates) -----------------------
+
+T_F, STRIDE, TRAVEL = 1.0, 1.2, 1.25  # s, m, m
+
+
+def _fake_sol():
+    t = np.linspace(0.0, T_F, 11)[:-1]  # control nodes, t_f excluded
+    states = pd.DataFrame({"pelvis_tx": [0.0, TRAVEL]}, index=[0.0, T_F])
+    ph = SimpleNamespace(states=states)
+    return SimpleNamespace(q=pd.DataFrame(index=pd.Index(t, name="time")), stats={"tf_s": T_F},
+                           solution=SimpleNamespace(phase=lambda name: ph))
+
+
+# constant rates, W, per reading (what the fake metabolic model returns)
+BASE = {"activation": 5.0, "maintenance": 40.0, "shortening": 100.0, "basal": 0.06, "work": 60.0}
+
+
+def _fake_edot(calls):
+    def f(sol, **kw):
+        calls.append(kw)
+        r = dict(BASE)
+        if kw.get("shortening_sign") == "printed":
+            r["shortening"] = -r["shortening"]
+        if kw.get("isometric_torque") == "bhargava":
+            r["shortening"] = 35.0
+        if kw.get("basal_whole_body"):
+            r["basal"] = kw["basal_whole_body"] * BM
+        r["total"] = sum(r.values())
+        n = len(sol.q)
+        return {k: np.full(n, v) for k, v in r.items()}
+
+    return f
+
+
+def test_cot_readings_table(monkeypatch):
+    calls = []
+    monkeypatch.setattr(msk, "_recompute_edot", _fake_edot(calls))
+    monkeypatch.setattr(msk, "_stride", lambda sol: STRIDE)
+    df = msk.cot_readings(_fake_sol())
+    first = df.iloc[0]
+    # Eq 5.57 by hand: constant Ė over t_f: COT = Ė t_f / (BM D)
+    tot = sum(BASE.values())
+    assert first["COT"] == pytest.approx(tot * T_F / (BM * STRIDE), rel=1e-12)
+    for k in TERMS:
+        assert first[k] == pytest.approx(BASE[k] * T_F / (BM * STRIDE), rel=1e-12)
+    assert first["change vs NLP reading (%)"] == 0.0
+    # each alternative: the options it passes, one at a time
+    assert {tuple(sorted(c.items())) for c in calls} == {
+        (), (("shortening_sign", "printed"),), (("shortening_split", "printed"),),
+        (("isometric_torque", "bhargava"),), (("forbid_negative", False),), (("basal_whole_body", 1.2),)}
+    sp = df.loc["Eq 5.47 sign as printed"]
+    assert sp["shortening"] == pytest.approx(-first["shortening"])
+    assert sp["COT"] == pytest.approx((tot - 200.0) * T_F / (BM * STRIDE))
+    bb = df.loc["basal whole-body (OpenSim)"]
+    assert bb["basal"] == pytest.approx(1.2 * T_F / STRIDE)  # 1.2 W/kg × BM × t_f / (BM D)
+    # distance readings scale the whole row by D_stride / D_alt
+    for lab, d in (("D = pelvis travel", TRAVEL), ("D = thesis 1.24 m", msk.THESIS_DISTANCE_M)):
+        row = df.loc[lab]
+        for k in ("COT",) + TERMS:
+            assert row[k] == pytest.approx(first[k] * STRIDE / d, rel=1e-12)
+        assert row["change vs NLP reading (%)"] == pytest.approx(100 * (STRIDE / d - 1), rel=1e-12)
+    th = df.iloc[-1]
+    assert "thesis" in df.index[-1] and th["COT"] == msk.THESIS_COT
+    assert th[list(TERMS)].isna().all() and math.isnan(th["change vs NLP reading (%)"])
