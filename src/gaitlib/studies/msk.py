@@ -408,18 +408,18 @@ def cot_readings(sol: gait_ocp.GaitSolution) -> pd.DataFrame:
     """
     D = _stride(sol)
     rec = [
-        ("NLP's reading (default)", "Ṡ = α ω_f (> 0 shortening), split on ω_f, F0 = s^τ τ0; Ḃ = 0.0225 m; "
-         "Ė = ΣḂ + smax(rest) (Eq 5.38 clipped); D = speed × T", {}, D),
-        ("Eq 5.47 sign as printed", "Ṡ = −(0.16 s^τ τ0 + 0.18 τ^M) θ̇ concentric, −0.157 τ^M θ̇ eccentric, θ̇ ≡ ω_f "
-         "(Eq 5.47 literal: negative heat when shortening)", {"shortening_sign": "printed"}, D),
-        ("Eq 5.47 case split as printed", "concentric case where τ^M θ̇ ≥ 0 (Eq 5.47), i.e. also where τ^M = 0 "
-         "and lengthening", {"shortening_split": "printed"}, D),
+        ("NLP's reading (default)", ("Ṡ = α ω_f (> 0 shortening), split on ω_f, F0 = s^τ τ0; Ḃ = 0.0225 m; "
+                                     "Ė = ΣḂ + smax(rest) (Eq 5.38 clipped); D = speed × T"), {}, D),
+        ("Eq 5.47 sign as printed", ("Ṡ = −(0.16 s^τ τ0 + 0.18 τ^M) θ̇ concentric, −0.157 τ^M θ̇ eccentric, "
+                                     "θ̇ ≡ ω_f (Eq 5.47 literal: negative heat when shortening)"), {"shortening_sign": "printed"}, D),
+        ("Eq 5.47 case split as printed", ("concentric case where τ^M θ̇ ≥ 0 (Eq 5.47), i.e. also where "
+                                           "τ^M = 0 and lengthening"), {"shortening_split": "printed"}, D),
         ("F0 Bhargava", "Eq 5.47's 0.16 s^τ τ0 → 0.16 a s^τ τ0 t^A(θ) (Bhargava 2004 / OpenSim F_iso)",
          {"isometric_torque": "bhargava"}, D),
         ("negative totals: plain sum", "Ė = Σ(Ȧ + Ṁ + Ḃ) + ΣṠ + ΣẆ without clipping (Eq 5.38 as printed)",
          {"forbid_negative": False}, D),
-        ("basal whole-body (OpenSim)", f"Ḃ = {OPENSIM_BASAL_W_PER_KG:g} W/kg × BM instead of Eq 5.48's "
-         "0.0225 W/kg × muscle mass", {"basal_whole_body": OPENSIM_BASAL_W_PER_KG}, D),
+        ("basal whole-body (OpenSim)", (f"Ḃ = {OPENSIM_BASAL_W_PER_KG:g} W/kg × BM instead of Eq 5.48's "
+                                        "0.0225 W/kg × muscle mass"), {"basal_whole_body": OPENSIM_BASAL_W_PER_KG}, D),
         ("D = pelvis travel", "Eq 5.57's D = pelvis_tx(t_f) − pelvis_tx(t_0) of the solution", {}, pelvis_travel(sol)),
         ("D = thesis 1.24 m", "Eq 5.57's D = 1.24 m (thesis Sec 5.3.4: its subjects' distance)", {}, THESIS_DISTANCE_M),
     ]
