@@ -378,6 +378,44 @@ cot = msk.cot_breakdown(nmsk_sol)
 marks.mark_rows(cot, marks.failure_label(nmsk_sol))
 
 # %% [markdown]
+# #### Readings of the metabolic model, one at a time
+#
+# The thesis leaves four things open: the sign of Eq 5.47 (as printed, shortening gives
+# *negative* heat), its case split at $\tau^M\dot\theta \ge 0$ (which puts a relaxed
+# generator in the concentric case), the "isometric force" of the shortening heat, and
+# negative totals of Eq 5.38 (summed plainly, or clipped as OpenSim does); the basal rate
+# (Eq 5.48, per muscle mass) differs from OpenSim's whole-body default, and Eq 5.57's
+# distance $D$ can be read as the data's stride, the model's own pelvis travel, or the
+# thesis's 1.24 m. Each row below changes **one** of these from the reading the NLP
+# minimised (first row), on the same stored trajectory, recomputed — not re-optimised:
+# had the NLP minimised another reading, the motion would differ too. The thesis prints
+# only the total, no breakdown; its value is the last row, for reference.
+
+# %%
+readings = msk.cot_readings(nmsk_sol)
+marks.mark_rows(readings, marks.failure_label(nmsk_sol))
+
+# %%
+alts = readings.iloc[1:-1]
+change = alts["change vs NLP reading (%)"]
+big = change.abs().idxmax()
+nlp_cot = readings["COT"].iloc[0]
+print(f"• Largest effect: '{big}', COT {alts.loc[big, 'COT']:.2f} J/(kg·m), {change[big]:+.0f} % against the "
+      f"NLP's reading ({nlp_cot:.2f}).")
+for lab in change.drop(big).abs().sort_values(ascending=False).index:
+    print(f"• '{lab}': {alts.loc[lab, 'COT']:.2f} J/(kg·m) ({change[lab]:+.2f} %).")
+tau_min = msk.min_generator_torque(nmsk_sol)
+print(f"• Smallest generator torque on the trajectory: {tau_min:.1e} N·m — "
+      + ("> 0, so the printed case split (which differs only at τ^M = 0) never applies here."
+         if tau_min > 0 else "the printed case split applies where it is 0."))
+print(f"• The pelvis travels {msk.pelvis_travel(nmsk_sol):.4f} m over the cycle; the data's stride "
+      f"(speed × cycle time, the periodic pelvis offset) is {free.speed * free.cycle_time:.4f} m.")
+near = (readings["COT"].iloc[:-1] - msk.THESIS_COT).abs().idxmin()
+print(f"• Closest to the thesis's {msk.THESIS_COT:g} J/(kg·m): '{near}' ({readings.loc[near, 'COT']:.2f})"
+      + (f" — with a negative shortening heat ({readings.loc[near, 'shortening']:.2f} J/(kg·m)): heat absorbed "
+         "while shortening, not a physical reading." if readings.loc[near, "shortening"] < 0 else "."))
+
+# %% [markdown]
 # How much the Mtb term weighs in the objective (Eq 5.56 normalisation). The thesis scales
 # the squared rate by $t_f^6/(BM^2 d^4)$ without defining $d$; we read $d$ as the distance
 # D (the only reading that shrinks the term, as the thesis says it should).
