@@ -367,7 +367,7 @@ scores
 #
 # $COT = \int \dot E\, dt / (BM \cdot D)$ with BM = 41.4 kg and D our stride. The thesis
 # reports 1.53 J kg⁻¹ m⁻¹ (Sec 5.3.5). Below: the COT of our solution by term of Eq 5.38
-# (each term integrated on its own), computed as the NLP computed it (Eq 5.47 as printed:
+# (each term integrated on its own), computed as the NLP computed it (Eq 5.47's F0 as printed, s^τ τ0:
 # concentric shortening heat $0.16\, s^\tau\tau_0\, \omega$ even when the generator is
 # relaxed) and with Bhargava's isometric force (the isometric torque at the current
 # activation and angle) — the same trajectory, not re-optimised. Caveat: MTGs have no
@@ -455,7 +455,7 @@ print(f"• This page's solves and identifications took {time.perf_counter() - T
 #   identified by data: the effort terms decide, and push s1, s2 to a corner of their
 #   bounds (exactly: the Act argument above). The thesis's interior s1 = s2 = 0.25 is not a
 #   stationary point of Eq 5.55's Act term.
-# * *Cost of transport.* The shortening heat of Eq 5.47 as printed charges 0.16 s^τ τ0 ω
+# * *Cost of transport.* The shortening heat with Eq 5.47's F0 as printed charges 0.16 s^τ τ0 ω
 #   for every shortening generator, active or not; it dominates our COT. Bhargava's
 #   isometric force (a τ0 t^A) removes most of it; maintenance heat and positive work
 #   remain. With the Mtb normalisation read as the thesis motivates it, the energy term is a

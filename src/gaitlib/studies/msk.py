@@ -351,11 +351,11 @@ def cot_breakdown(sol: gait_ocp.GaitSolution) -> pd.DataFrame:
     """Cost of transport (Eq 5.57, J kg⁻¹ m⁻¹) of an NMSK solution by term of Eq 5.38
     (each term integrated alone; 'total' includes the clipping of negative non-basal
     power, so the terms need not add up to it), for two readings of the shortening heat:
-    the thesis's Eq 5.47 as printed (isometric term 0.16 s^τ τ0 ω_f even for a relaxed
-    generator — what the NLP minimised) and Bhargava's (0.16 a s^τ τ0 t^A(θ) ω_f). Same
+    the thesis's F0 in Eq 5.47 (isometric term 0.16 s^τ τ0 ω_f even for a relaxed
+    generator — what the NLP minimised; the heat's sign is Bhargava's, :func:`cot_readings`) and Bhargava's (0.16 a s^τ τ0 t^A(θ) ω_f). Same
     trajectory, recomputed; not re-optimised."""
     out = {}
-    for lab, kw in (("Eq 5.47 as printed (NLP)", {}), ("Bhargava F_iso = a τ0 t^A", {"isometric_torque": "bhargava"})):
+    for lab, kw in (("NLP: F0 = s^τ τ0 (thesis)", {}), ("Bhargava F_iso = a τ0 t^A", {"isometric_torque": "bhargava"})):
         e = _recompute_edot(sol, **kw)
         out[lab] = {k: _cot_of(sol, v) for k, v in e.items()}
     df = pd.DataFrame(out)
@@ -556,7 +556,7 @@ def findings(ident, ident_thesis_tol, params_table: pd.DataFrame, margins: pd.Da
     out.append("Activation parameters (ours): " + ", ".join(
         f"{k} = {v:.4g}" + (f" (at its {b} bound)" if b else "") for k, v, b in
         zip(act.index, act["ours"], act["ours at bound"])) + f" — thesis Table 5.10: {THESIS_ACTIVATION_TEXT}.")
-    c, cb = cot["Eq 5.47 as printed (NLP)"], cot["Bhargava F_iso = a τ0 t^A"]
+    c, cb = cot["NLP: F0 = s^τ τ0 (thesis)"], cot["Bhargava F_iso = a τ0 t^A"]
     out.append(f"COT {c['total']:.2f} J/(kg·m) (thesis {THESIS_COT:g}): shortening heat {c['shortening']:.2f}, "
                f"activation {c['activation']:.2f}, maintenance {c['maintenance']:.2f}, work {c['work']:.2f}, "
                f"basal {c['basal']:.3f}; with Bhargava's isometric force the same motion costs {cb['total']:.2f}.")
