@@ -218,7 +218,9 @@ def work_rate(tau, qd):
     return tau * qd
 
 
-def _smax0(x, eps):
+def smooth_max0(x, eps):
+    """max(x, 0) smoothed: ½(x + √(x² + ε²)) − ε/2 (0 at x = 0; x − ε/2 for x ≫ ε), numpy or
+    CasADi; the clipping of negative totals (Eq 5.38) and of the Mtb term's rate."""
     sq = _fn("sqrt", x)
     return 0.5 * (x + sq(x * x + eps * eps)) - 0.5 * eps
 
@@ -282,7 +284,7 @@ def metabolic_rate(
     for j, tq in joint_torques.items():
         W = W + work_rate(tq, joint_speeds[j])
     rest = A + M + S + W
-    total = B + (_smax0(rest, eps) if forbid_negative else rest)
+    total = B + (smooth_max0(rest, eps) if forbid_negative else rest)
     return {
         "total": total,
         "per_kg": total / body_mass,

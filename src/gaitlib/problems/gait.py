@@ -710,7 +710,7 @@ def goal_mtb(c: GoalContext):
     ``edot_rest``."""
     if c.model != "NMSK":
         return None
-    return lambda x, u, p, t: mtb_scale(c.tf_of(p), c.stride) * (c.basal + metabolics._smax0(u["edot_rest"], 0.1)) ** 2
+    return lambda x, u, p, t: mtb_scale(c.tf_of(p), c.stride) * (c.basal + metabolics.smooth_max0(u["edot_rest"], 0.1)) ** 2
 
 
 def goal_trq(c: GoalContext):
