@@ -177,3 +177,20 @@ def test_existing_cluster_gives_bitwise_the_serial_results(serial, dask_cluster,
     assert "math domain error" in gen[1].error
     gen2 = sw.sweep(math.sqrt, {"x": 25.0}, scheduler=address, progress=False)
     assert gen2[0].value == 5.0
+
+
+def _needs_a_solve(x):
+    from gaitlib import cache
+
+    raise cache.NotCached(f"entry {x}: not cached or stored (test)")
+
+
+def test_a_missing_solution_is_not_a_failed_run():
+    """Inside cache.only a run that would have to solve raises NotCached in the caller (a
+    missing stored solution must not be reported as a failed run); other errors stay records."""
+    from gaitlib import cache
+
+    with pytest.raises(cache.NotCached, match="1 of 2 runs need a solve"):
+        sw.sweep(lambda x: _needs_a_solve(x) if x == 1 else x, {"a": 1, "b": 2}, serial=True, progress=False)
+    recs = sw.sweep(math.sqrt, {"ok": 4.0, "bad": -1.0}, serial=True, progress=False)
+    assert [r.ok for r in recs] == [True, False]

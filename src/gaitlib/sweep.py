@@ -43,6 +43,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from . import blas
+from .cache import NotCached
 
 __all__ = ["RunRecord", "sweep", "ACCEPTED_STATUSES", "BLAS_ENV"]
 
@@ -183,6 +184,16 @@ def _worker_env() -> dict[str, str]:
     return {v: os.environ.get(v, default) for v, default in blas.SETTINGS.items()}
 
 
+def _refuse_missing(records: list[RunRecord]) -> list[RunRecord]:
+    """Raise :class:`gaitlib.cache.NotCached` if a run hit a missing solution inside
+    :func:`gaitlib.cache.only` (its worker's error says so); else the records."""
+    missing = [r for r in records if r.error and f"{NotCached.__name__}:" in r.error]
+    if missing:
+        last = missing[0].error.strip().splitlines()[-1]
+        raise NotCached(f"{len(missing)} of {len(records)} runs need a solve (first: {missing[0].name}: {last})")
+    return records
+
+
 def sweep(func: Callable[[Any], Any], items, *, scheduler: str | None = None, n_workers: int | None = None,
           serial: bool = False, progress: bool = True) -> list[RunRecord]:
     """Run ``func(arg)`` for every ``(name, arg)`` of ``items``, in parallel on dask.distributed.
@@ -206,6 +217,12 @@ def sweep(func: Callable[[Any], Any], items, *, scheduler: str | None = None, n_
     -------
     list of :class:`RunRecord`, in the order of ``items``; a failed run (exception, lost
     worker, non-success IPOPT status) is a record with ``ok=False``, never dropped.
+
+    Raises
+    ------
+    gaitlib.cache.NotCached
+        inside :func:`gaitlib.cache.only`, when a run needed a solve: a solution that is not
+        stored is missing, not a failed run, and must not be reported as one.
     """
     pairs = _normalise_items(items)
     prog = _Progress(len(pairs), progress)
@@ -217,7 +234,7 @@ def sweep(func: Callable[[Any], Any], items, *, scheduler: str | None = None, n_
             prog(rec)
             records.append(rec)
         prog.finish(records)
-        return records
+        return _refuse_missing(records)
     if not pairs:
         return []
 
@@ -260,7 +277,7 @@ def sweep(func: Callable[[Any], Any], items, *, scheduler: str | None = None, n_
             prog(rec)
             fut.release()
         prog.finish(records)
-        return records  # type: ignore[return-value]
+        return _refuse_missing(records)  # type: ignore[arg-type]
     finally:
         client.close()
         if cluster is not None:
