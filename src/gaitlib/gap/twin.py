@@ -29,6 +29,7 @@ import numpy as np
 import pandas as pd
 
 from .. import conventions as cv
+from .method import DEFAULT_BASE  # the twins' baseline is the diagnosis's
 from .noise import NOISE_LENGTH, smooth_noise
 from ..problems import gait as gait_ocp
 from . import io as gio
@@ -44,9 +45,6 @@ from ..effects import TWIN_EFFECTS
 from .diagnose import BIC_THRESHOLD
 
 __all__ = ["NOISE_LENGTH", "smooth_noise", "twin_spec", "twin_frame", "make_twin", "write_twin", "DEFAULT_BASE"]
-
-#: Default baseline of twins: SK data tracking on a coarse mesh (10 × 3 LGR).
-DEFAULT_BASE = dict(model="SK", cost="DT", n_intervals=10, degree=3)
 
 
 def twin_spec(effects: tuple, base: dict | None = None) -> gait_ocp.GaitSpec:
