@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import shutil
+from pathlib import Path
 
 import pytest
 
@@ -143,6 +144,40 @@ def test_two_writers_of_one_key_never_mix(tmp_path, monkeypatch):
             cache.verify(where)
             tags = {line.split(",")[0] for p in where.glob("part*.csv") for line in p.read_text().splitlines()}
             assert len(tags) == 1
+    assert [p.name for p in (tmp_path / "gait").iterdir()] == ["same"]
+
+
+def test_a_writer_that_loses_the_race_keeps_the_other_writers_entry(tmp_path, monkeypatch):
+    """The interleaving CI once hit: our first rename fails (an entry is there), the other
+    writer moves that entry aside, then puts its own in place just before our second rename.
+    The save must neither fail nor mix: the other writer's complete entry stays."""
+    import os
+
+    monkeypatch.setenv("GAITLIB_STORE", "")
+    where = tmp_path / "gait" / "same"
+    cache.save(where, _write({"a.csv": "first"}))
+    theirs = cache.save(tmp_path / "other" / "same", _write({"a.csv": "theirs"}))
+    real = os.rename
+    seen = []
+
+    def racing(src, dst):
+        src, dst = Path(src), Path(dst)
+        if src.name.startswith(".tmp-") and dst == where:
+            seen.append(src)
+            if len(seen) == 2:  # the other writer's entry lands just before our retry
+                real(theirs, where)
+        try:
+            return real(src, dst)
+        finally:
+            if len(seen) == 1 and src.name.startswith(".tmp-") and where.exists():
+                real(where, tmp_path / "aside")  # the other writer moves the old entry aside
+
+    monkeypatch.setattr(cache.os, "rename", racing)
+    cache.save(where, _write({"a.csv": "ours"}))
+    monkeypatch.setattr(cache.os, "rename", real)
+    assert len(seen) == 2
+    cache.verify(where)
+    assert (where / "a.csv").read_text() == "theirs"
     assert [p.name for p in (tmp_path / "gait").iterdir()] == ["same"]
 
 

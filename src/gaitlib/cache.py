@@ -282,20 +282,22 @@ def save(where, write) -> Path:
         try:
             os.rename(tmp, where)  # atomic when ``where`` does not exist
         except OSError:
-            if where.exists():
-                old = where.parent / f".old-{where.name}-{os.getpid()}-{uuid.uuid4().hex[:8]}"
-                try:
-                    os.rename(where, old)
-                except OSError:  # another writer moved it first
-                    old = None
-                try:
-                    os.rename(tmp, where)
-                except OSError:  # another writer's entry is already in place: keep it
-                    pass
+            # ``where`` exists: move it aside and put ours in its place. Another writer of
+            # the same key may move it first, or put its own entry there between the two
+            # renames; then its (complete, verified-on-read) entry is kept and ours dropped.
+            old = where.parent / f".old-{where.name}-{os.getpid()}-{uuid.uuid4().hex[:8]}"
+            try:
+                os.rename(where, old)
+            except OSError:  # another writer moved it first
+                old = None
+            try:
+                os.rename(tmp, where)
+            except OSError:
+                if not where.exists():  # not a race: a real failure
+                    raise
+            finally:
                 if old is not None:
                     shutil.rmtree(old, ignore_errors=True)
-            else:
-                os.rename(tmp, where)
     finally:
         if tmp.exists():
             shutil.rmtree(tmp, ignore_errors=True)
