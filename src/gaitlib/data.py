@@ -617,6 +617,35 @@ class GaitData:
                             index=pd.Index(t, name="time"))
 
 
+#: Margin at each end of the data's swing window, fraction of the cycle (the events' SD,
+#: Schwartz et al. 2008: foot off 0.59 ± 0.02 at Free speed).
+SWING_MARGIN = 0.02
+
+
+def swing_windows(events: dict, left_shift: float | None = None,
+                  margin: float = SWING_MARGIN) -> dict[str, tuple[float, float]]:
+    """Where the data say each foot swings, as fractions of the cycle ``(lo, hi)`` with
+    ``0 ≤ lo < 1`` and ``hi > lo`` (``hi`` may exceed 1: the window wraps past the cycle's
+    end). Right foot: from foot off + ``margin`` to the next foot contact (1) − ``margin``;
+    left foot: the same shifted by ``left_shift`` (default the data's opposite foot
+    contact). ``events``: :attr:`GaitData.events` (needs ``foot_off``)."""
+    fo = float(events["foot_off"])
+    shift = float(left_shift if left_shift is not None else events.get("opposite_foot_contact", 0.5))
+    out = {}
+    for side, off in (("r", 0.0), ("l", shift)):
+        lo = fo + off + margin
+        hi = 1.0 + off - margin
+        k = math.floor(lo)
+        out[side] = (lo - k, hi - k)
+    return out
+
+
+def in_window(tau, window: tuple[float, float]):
+    """Whether cycle fractions ``tau`` lie in a :func:`swing_windows` window (numpy)."""
+    lo, hi = window
+    return np.mod(np.asarray(tau, dtype=float) - lo, 1.0) <= (hi - lo)
+
+
 def time_scaled(gait: GaitData, target: GaitData) -> GaitData:
     """``gait``'s curves stretched or shrunk in time to ``target``'s cycle time (thesis Ch 7).
 

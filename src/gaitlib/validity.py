@@ -120,9 +120,9 @@ __all__ = ["CONVERGED_STATUSES", "SWING_LOAD_BW", "SWING_MARGIN", "DOUBLE_SUPPOR
 CONVERGED_STATUSES = ACCEPTED_STATUSES
 #: Vertical load a swinging foot may carry, fraction of body weight.
 SWING_LOAD_BW = 0.02
-#: Margin at each end of the data's swing window, fraction of the cycle (the events' SD,
-#: Schwartz et al. 2008: foot off 0.59 ± 0.02 at Free speed).
-SWING_MARGIN = 0.02
+#: Margin at each end of the data's swing window, fraction of the cycle
+#: (:data:`gaitlib.data.SWING_MARGIN`, the events' SD).
+SWING_MARGIN = data_mod.SWING_MARGIN
 #: Largest fraction of the cycle with both feet loaded (> SWING_LOAD_BW) that is still walking.
 DOUBLE_SUPPORT_MAX = 0.40
 #: Double support of walking, fraction of the cycle (total of both phases): ≈ 20–25 %
@@ -305,12 +305,11 @@ def check_frames(*, status: str, q: pd.DataFrame | None = None, torques: pd.Data
         tau = (t - t[0]) / (T - t[0])
         fo = float(events["foot_off"])
         shift = float(left_shift if left_shift is not None else events.get("opposite_foot_contact", 0.5))
+        windows = data_mod.swing_windows(events, shift, SWING_MARGIN)
         worst, parts = -np.inf, []
         for s in feet:
-            off = 0.0 if s == "r" else shift
-            lo, hi = fo + off + SWING_MARGIN, 1.0 + off - SWING_MARGIN  # swing window, cycle fractions
-            ph = np.mod(tau - lo, 1.0)
-            sel = ph <= (hi - lo)
+            lo, hi = windows[s]  # swing window, cycle fractions
+            sel = data_mod.in_window(tau, (lo, hi))
             fy = grf[f"grf_y_{s}"].to_numpy(float)[sel]
             peak = float(fy.max()) if fy.size else 0.0
             at = float(np.mod(tau[sel][np.argmax(fy)], 1.0)) if fy.size else float("nan")

@@ -226,6 +226,11 @@ for _name, _w in _T62_NMSK.items():
         k: v for k, v in zip(("Jrk", "Rsd", "Imp", "HAT", "Act", "Mtb", "Trq", "Ang", "GRF"), _w) if v}
 
 
+#: Spec options that are left out of :meth:`GaitSpec.to_dict` (hence of every cache key)
+#: while unset: added after the store was written, they must not change existing keys.
+KEY_STABLE_OPTIONS = ("swing_load_max",)
+
+
 @dataclass(frozen=True)
 class GaitSpec:
     """What to solve: a natural-gait (or speed-class) optimal control problem.
@@ -288,6 +293,11 @@ class GaitSpec:
         first parameter), ``None`` makes its parameters NLP variables ``fx.<name>.<param>``
         (identified with the motion). Magnitude 0 is the baseline model. See
         :mod:`gaitlib.effects`.
+    swing_load_max : ``None`` (the thesis: no such constraint) or a bound, N, on each foot's
+        vertical GRF while the *data* say that foot swings (the validity gate's window:
+        foot off + margin to the next foot contact − margin, :func:`swing_windows`). An
+        ablation of the Fidelity II study (:mod:`gaitlib.studies.fidelity`): it measures what
+        an unloaded swing foot costs in tracking. Tracking runs with fixed final time only.
     """
 
     model: str = "SK"
@@ -317,6 +327,7 @@ class GaitSpec:
     track_class: str = ""
     hat_reference: tuple = ()
     effects: tuple = ()
+    swing_load_max: float | None = None
 
     def __post_init__(self):
         if self.model not in MODELS:
@@ -351,6 +362,11 @@ class GaitSpec:
                 raise ValueError("hat_reference must be () or four equal-length tuples (tau, dx, y, tilt)")
         if self.effects:
             object.__setattr__(self, "effects", effects_mod.validate(self.effects, self.model))
+        if self.swing_load_max is not None:
+            if not float(self.swing_load_max) >= 0.0:
+                raise ValueError(f"swing_load_max must be None or >= 0 N, got {self.swing_load_max!r}")
+            if self.tf_bounds or self.cost == "FP":
+                raise ValueError("swing_load_max needs the data's swing (a tracking run with fixed final time)")
 
     @property
     def term_weights(self) -> dict[str, float]:
@@ -375,7 +391,13 @@ class GaitSpec:
         return cache.key({"kind": "gait", **self.to_dict()}, FORMULATION, identified=self.identified_sets())
 
     def to_dict(self) -> dict:
-        return json.loads(json.dumps(asdict(self)))
+        """The spec as plain JSON values; options added after the store was written are
+        left out while unset (:data:`KEY_STABLE_OPTIONS`), so every existing key stays."""
+        d = json.loads(json.dumps(asdict(self)))
+        for k in KEY_STABLE_OPTIONS:
+            if d.get(k) is None:
+                d.pop(k, None)
+        return d
 
     @classmethod
     def from_dict(cls, d: dict) -> "GaitSpec":
@@ -872,6 +894,21 @@ def build(spec: GaitSpec) -> GaitProblem:
                            0.0, 0.0)]
     if spec.normal_force_constraint:
         path.append(PathConstraint("normal_force", lambda x, u, p, t: node(x, u, p)["fn_raw"], 0.0, np.inf))
+    if spec.swing_load_max is not None:  # ablation: no vertical load on a foot the data say swings
+        windows = data_mod.swing_windows(gait.events, gait.left_shift)
+
+        def swinging(t, window):
+            """1 at times in the window (cycle fraction t / T, wrapped), else 0 (t is SX)."""
+            lo, hi = window
+            tau = t / T
+            return ca.logic_or(ca.logic_and(tau >= lo, tau <= hi),
+                               ca.logic_and(tau + 1.0 >= lo, tau + 1.0 <= hi))
+
+        path.append(PathConstraint(
+            "swing_load",
+            lambda x, u, p, t: ca.vertcat(swinging(t, windows["r"]) * node(x, u, p)["grf"][1],
+                                          swinging(t, windows["l"]) * node(x, u, p)["grf"][3]),
+            -np.inf, float(spec.swing_load_max)))
     if fx is not None:  # effects' path constraints, each expr ≥ 0 (co-contraction)
         def fx_path(e_, m_):
             return lambda x, u, p, t: e_.path(node(x, u, p), fx.theta(e_, m_, p), fx.ctx)

@@ -1,0 +1,85 @@
+"""The swing-load ablation (gaitlib.studies.fidelity): the data's swing windows by hand, the
+key stability of the new spec option, the constraint's rows against the node's own forces,
+and the clearance probe's invariants."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from gaitlib import data as data_mod
+from gaitlib.ocp import Named
+from gaitlib.problems import gait as gait_ocp
+from gaitlib.studies import fidelity
+
+
+def test_swing_windows_by_hand():
+    # Schwartz 2008 Free: foot off 59 %, left leg shifted by half a cycle, 2 % margin
+    w = data_mod.swing_windows({"foot_off": 0.59, "opposite_foot_contact": 0.5}, 0.5, 0.02)
+    assert w["r"] == pytest.approx((0.61, 0.98))
+    assert w["l"] == pytest.approx((0.11, 0.48))
+    tau = np.array([0.05, 0.2, 0.6, 0.7, 0.97, 0.99])
+    assert data_mod.in_window(tau, w["r"]).tolist() == [False, False, False, True, True, False]
+    assert data_mod.in_window(tau, w["l"]).tolist() == [False, True, False, False, False, False]
+    # a window that wraps past the cycle's end (left shift 0.6: 1.21 … 1.58 → 0.21 … 0.58)
+    w = data_mod.swing_windows({"foot_off": 0.59}, 0.6, 0.02)
+    assert w["l"] == pytest.approx((0.21, 0.58))
+    w = data_mod.swing_windows({"foot_off": 0.70}, 0.5, 0.02)  # right: 0.72 … 0.98; left 0.22 … 0.48
+    assert data_mod.in_window([0.1, 0.3], w["l"]).tolist() == [False, True]
+
+
+def test_the_new_option_keeps_every_existing_key():
+    spec = gait_ocp.GaitSpec(model="MSK", cost="Eq5.33")
+    assert "swing_load_max" not in spec.to_dict()
+    bounded = replace(spec, swing_load_max=4.06)
+    assert bounded.to_dict()["swing_load_max"] == 4.06
+    assert bounded.key() != spec.key()
+    assert gait_ocp.GaitSpec.from_dict(bounded.to_dict()) == bounded
+    assert gait_ocp.GaitSpec.from_dict(spec.to_dict()) == spec
+    with pytest.raises(ValueError, match="swing_load_max"):
+        gait_ocp.GaitSpec(model="MSK", cost="Eq5.33", swing_load_max=-1.0)
+    with pytest.raises(ValueError, match="fixed final time"):
+        gait_ocp.GaitSpec(model="MSK", cost="Eq5.33", swing_load_max=4.0, tf_bounds=(0.8, 1.2))
+
+
+def test_the_constraint_is_each_swinging_foots_vertical_force_and_nothing_else():
+    """The 'swing_load' path constraint equals the node's right (left) vertical GRF where
+    the data say the right (left) foot swings, and 0 elsewhere."""
+    spec = gait_ocp.GaitSpec(model="MSK", cost="Eq5.33", n_intervals=3, degree=2, swing_load_max=4.0)
+    gp = gait_ocp.build(spec)
+    ph = gp.problem.phases[0]
+    pc = {c.name: c for c in ph.path_constraints}["swing_load"]
+    assert pc.upper == 4.0 and pc.lower == -np.inf
+    x = ca.SX.sym("x", len(ph.states))
+    u = ca.SX.sym("u", len(ph.controls))
+    p = ca.SX.sym("p", len(gp.problem.parameter_names))
+    t = ca.SX.sym("t")
+    xn, un, pn = Named(x, ph.states), Named(u, ph.controls), Named(p, gp.problem.parameter_names)
+    f = ca.Function("f", [x, u, p, t], [pc.fun(xn, un, pn, t), gp.node(xn, un, pn)["grf"]])
+    gd = data_mod.load_gait_data("Free")
+    T = gd.cycle_time
+    pose = gp.ref.q  # the reference pose: both feet near the ground at times
+    for tau, right, left in ((0.05, False, False), (0.3, False, True), (0.55, False, False), (0.8, True, False)):
+        q = pose.iloc[int(np.argmin(np.abs(pose.index.to_numpy() / T - tau)))]
+        xv = np.zeros(len(ph.states))
+        for i, name in enumerate(ph.states):
+            if name in q.index:
+                xv[i] = q[name]
+        xv[ph.states.index("pelvis_ty")] -= 0.01  # press both feet a little into the ground
+        c, grf = (np.asarray(v).ravel() for v in f(xv, np.zeros(len(ph.controls)), np.zeros(p.numel()), tau * T))
+        assert grf[1] > 1.0 or grf[3] > 1.0
+        assert c[0] == pytest.approx(grf[1] if right else 0.0)
+        assert c[1] == pytest.approx(grf[3] if left else 0.0)
+
+
+def test_clearance_is_relative_to_the_lower_foot():
+    c = fidelity.data_clearance(n=40)
+    assert np.allclose(np.minimum(c["clear_r"], c["clear_l"]), 0.0)
+    assert (c[["clear_r", "clear_l"]] >= 0).all().all()
+    # the data's windows: right swings 61–98 %, left 11–48 % (Free)
+    assert c["swing_r"].mean() == pytest.approx(0.375, abs=0.03)
+    s = fidelity.clearance_summary(c)
+    assert set(s.index) == {"r", "l"}
