@@ -83,3 +83,17 @@ def test_clearance_is_relative_to_the_lower_foot():
     assert c["swing_r"].mean() == pytest.approx(0.375, abs=0.03)
     s = fidelity.clearance_summary(c)
     assert set(s.index) == {"r", "l"}
+
+
+def test_each_ablation_change_is_one_change_on_the_swing_unloaded_spec():
+    base, bounded = fidelity.ablation_specs("MSK").values()
+    assert base.swing_load_max is None
+    # half the gate's limit: 1 % of 41.4 kg × 9.81 m/s²
+    assert bounded.swing_load_max == pytest.approx(0.01 * 41.4 * 9.81, abs=1e-3)
+    assert replace(bounded, swing_load_max=None) == base
+    for name, change in fidelity.tracking_changes("MSK").items():
+        spec = replace(bounded, **change)  # a valid spec (GaitSpec checks its fields)
+        differs = {k for k, v in spec.to_dict().items() if bounded.to_dict().get(k) != v}
+        assert differs == set(change), name
+    # Table 5.3's tracking weights are 1/4: "×4" restores 1
+    assert "GRF weight ×4" in fidelity.tracking_changes("MSK")
