@@ -57,6 +57,7 @@ from . import msk
 from . import mtg_id
 from .. import activation
 from . import predictive as pr
+from . import fidelity
 
 __all__ = ["COLUMNS", "VERDICTS", "REL_TOL", "ABS_TOL", "RULE", "verdict", "Row", "StoredGait", "stored_gait",
            "gate", "build", "counts", "write", "PHYSIOLOGICAL_JUMP_RISE_M"]
@@ -355,6 +356,7 @@ def _ch5(bases: dict) -> list[Row]:
                                 float(params[g][k]), "1", "unknown", name, v))
     gait = sg.tracking_data(data_mod.load_gait_data("Free"))
     # Tables 5.4 and 5.11: tracking RMSEs
+    ablation = {"MSK": _ablation_causes("MSK")}
     for model, table in (("MSK", "Table 5.4"), ("NMSK", "Table 5.11")):
         s = bases.get(model)
         valid = gate(s, model) if s is not None else ""
@@ -366,7 +368,8 @@ def _ch5(bases: dict) -> list[Row]:
             sd = _rms_sd(gait, col, 1 / cv.DEG if kind == "angle" else 1.0)
             ours = float(r.get((kind, ch), np.nan)) if r is not None else np.nan
             rows.append(Row(5, f"{model} RMSE {kind} {part} {side.upper()} ({table})", tv, ours, unit,
-                            "unknown", s.name if s is not None else "", valid, sd=sd))
+                            ablation.get(model, {}).get((kind, part, side), "unknown"),
+                            s.name if s is not None else "", valid, sd=sd))
     # Table 5.10 and COT: the NMSK solution
     s = bases.get("NMSK")
     valid = gate(s, "NMSK") if s is not None else ""
@@ -390,6 +393,23 @@ def _ch5(bases: dict) -> list[Row]:
     rows.append(Row(5, "NMSK cost of transport, natural speed (Sec 5.3.5, Eq 5.57)", msk.THESIS_COT, cot, "J/kg/m",
                     cause, s.name if s is not None else "", valid))
     return rows
+
+
+def _ablation_causes(model: str = "MSK") -> dict:
+    """(kind, part, side) → the tracking ablation's measured answer for that channel (Ch 2:
+    the lowest RMSE any single change reaches, and whether any meets the Fidelity II target);
+    empty when the ablation is not stored."""
+    try:
+        swing = fidelity.swing_ablation(model)
+        _, picked = fidelity.tracking_ablation(model, swing=swing)
+    except cache.NotCached:
+        return {}
+    where = _anchor("ch02_gait", "The tracking ablation: one change at a time")
+    out = {}
+    for (kind, part, side, unit), r in fidelity.channel_table(picked, model).iterrows():
+        out[(kind, part, side)] = (f"tracking ablation: lowest {r[r['best change']]:.1f} {unit} "
+                                   f"({r['best change']}), target {r['target']:.1f} {unit} met by: {r['met by']} [{where}]")
+    return out
 
 
 def _ch5_bases() -> dict:

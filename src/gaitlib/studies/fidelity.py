@@ -30,6 +30,7 @@ from .. import validity
 from ..model import ChildModel
 from ..problems import gait as gait_ocp
 from . import gait as gait_study
+from . import msk
 
 #: The ablation's bound on a swinging foot's vertical force: half the validity gate's limit
 #: (:data:`gaitlib.validity.SWING_LOAD_BW` × body weight), so a solution meeting it passes
@@ -93,11 +94,24 @@ def clearance_summary(clear: pd.DataFrame, touch: float = TOUCH, speed_class: st
     return pd.DataFrame(rows).set_index("foot")
 
 
+def swing_bound(bound_bw: float = SWING_BOUND_BW) -> float:
+    """The ablation's bound on a swinging foot's vertical force, N (rounded to 1 mN: it is
+    part of the spec, hence of the cache key)."""
+    return round(bound_bw * cv.BODY_MASS * cv.G, 3)
+
+
+def ch5_unloaded(model: str = "NMSK", bound_bw: float = SWING_BOUND_BW) -> gait_ocp.GaitSolution:
+    """The Ch 5 solve of ``model`` (:func:`gaitlib.studies.msk.solve`: its parameter sets,
+    cost and start; NMSK warm-started from the MSK solve of the same bound) with a swinging
+    foot's vertical force bounded by :func:`swing_bound`."""
+    return msk.solve(model, swing_load_max=swing_bound(bound_bw))
+
+
 def ablation_specs(model: str = "MSK", bound_bw: float = SWING_BOUND_BW) -> dict[str, gait_ocp.GaitSpec]:
     """The swing-load ablation: the chapter's tracking spec, and the same with each foot's
     vertical force bounded by ``bound_bw`` × body weight while the data say it swings."""
     base = gait_study.natural_gait_spec(model)
-    bound = round(bound_bw * cv.BODY_MASS * cv.G, 3)
+    bound = swing_bound(bound_bw)
     return {f"{model} {base.cost}": base,
             f"{model} {base.cost}, swing load ≤ {bound:.2f} N": replace(base, swing_load_max=bound)}
 
@@ -282,4 +296,67 @@ def channel_table(picked: dict, model: str = "MSK") -> pd.DataFrame:
     cols = list(picked)
     out["best change"] = out[cols].idxmin(axis=1)
     out["met by"] = out[cols].le(out["target"], axis=0).apply(lambda r: ", ".join(c for c in cols if r[c]) or "none", axis=1)
+    return out
+
+
+def tracking_findings(tracking: pd.DataFrame, per_channel: pd.DataFrame) -> list[str]:
+    """The chapter's sentences on the tracking ablation, computed from
+    :func:`tracking_ablation`'s table and :func:`channel_table`."""
+    rows = list(tracking.index)
+    ref = tracking.loc[rows[0]]
+    kinds = {"worst angle RMSE (deg)": ("angles", "°"), "worst torque RMSE (N·m)": ("torques", " N·m"),
+             "worst GRF RMSE (N)": ("GRFs", " N")}
+    out = []
+    usable = []
+    for k in rows[1:]:
+        r = tracking.loc[k]
+        if r["status"] not in validity.CONVERGED_STATUSES:
+            out.append(f"**{k}:** neither start converged ({r['status']}); not read.")
+            continue
+        usable.append(k)
+        moves = ", ".join(f"{n} {ref[c]:.1f} → {r[c]:.1f}{u}" for c, (n, u) in kinds.items())
+        out.append(f"**{k}** ({r['starts converged']} starts converged; {r['gates']}): worst RMSE {moves}.")
+    cols = [c for c in [rows[0]] + usable if c in per_channel.columns]
+    met_any = per_channel[cols].le(per_channel["target"], axis=0).any(axis=1)
+    n = len(per_channel)
+    best_counts = per_channel.loc[:, cols].idxmin(axis=1).value_counts()
+    out.append(f"**Against the target** (1.5 × the thesis's worst row of each kind): {int(met_any.sum())} of {n} "
+               "channels meet it in at least one row"
+               + (f" ({', '.join(f'{c[0]} {c[1]} {c[2]}' for c in per_channel.index[met_any])})" if met_any.any() else "")
+               + f". The change with the lowest RMSE in most channels: {best_counts.index[0]} "
+                 f"({best_counts.iloc[0]} of {n}).")
+    return out
+
+
+def cot_findings(readings: pd.DataFrame, readings_unloaded: pd.DataFrame, sol, sol_unloaded) -> list[str]:
+    """Ch 5's sentences on the COT of the swing-unloaded NMSK solve beside the book's, the
+    thesis's (reference) and the measured gross COT of children (:data:`msk.CHILD_COT_GROSS`).
+    ``readings``: :func:`msk.cot_readings` of ``sol``; the same for ``sol_unloaded``."""
+    g0, g1 = validity.check(sol), validity.check(sol_unloaded)
+    c0, c1 = readings["COT"].iloc[0], readings_unloaded["COT"].iloc[0]
+    out = []
+    if not g1.converged:
+        out.append(f"**The swing-unloaded NMSK solve did not converge** ({sol_unloaded.stats['status']}): its COT "
+                   f"({c1:.2f} J kg⁻¹ m⁻¹) carries no conclusion.")
+        return out
+    state = "passes every validity gate" if g1.passed else g1.label()
+    out.append(f"**The swing-unloaded NMSK solve** ({sol_unloaded.stats['iterations']} iterations) {state}. "
+               f"Its COT under the NLP's reading is {c1:.2f} J kg⁻¹ m⁻¹, against {c0:.2f} for the book's Ch 5 "
+               f"solve ({g0.label()}), the thesis's {msk.THESIS_COT:g} (reference, its model and data) and the "
+               f"gross COT measured in 6–12-year-olds at free speed, {msk.CHILD_COT_GROSS:.1f} J kg⁻¹ m⁻¹ "
+               f"(Waters et al. 1983: {msk.CHILD_COT_GROSS_ML_O2} mL O₂ kg⁻¹ m⁻¹ × {msk.J_PER_ML_O2} J/mL).")
+    if g1.passed:
+        ratio = c1 / msk.CHILD_COT_GROSS
+        out.append(f"On this valid gait the model's COT is {ratio:.2f}× the children's gross COT"
+                   + (" — above it, although the gross value also contains the whole body's resting rate, "
+                      "which the model's muscle-only basal term (Eq 5.48) does not: the MTG metabolic model "
+                      "overestimates walking's cost on this motion." if ratio > 1 else
+                      "; the gross value also contains the whole body's resting rate, which the model's "
+                      "muscle-only basal term (Eq 5.48) does not.")
+                   + f" The thesis's {msk.THESIS_COT:g} is {msk.THESIS_COT / msk.CHILD_COT_GROSS:.2f}× the children's gross COT.")
+    alts = readings_unloaded.iloc[1:-1]
+    ch = alts["change vs NLP reading (%)"]
+    big = ch.abs().idxmax()
+    out.append(f"Of the open readings, '{big}' moves it most on this motion too ({ch[big]:+.0f} %, "
+               f"{alts.loc[big, 'COT']:.2f}).")
     return out

@@ -47,7 +47,7 @@ from .. import params as params_mod
 from ..problems import gait as gait_ocp
 from . import gait as sg
 
-__all__ = ["EMG_MAP", "THESIS_TABLE_5_10", "THESIS_COT", "THESIS_HOURS", "parameter_sets", "ch5_spec", "solve",
+__all__ = ["EMG_MAP", "THESIS_TABLE_5_10", "THESIS_COT", "CHILD_COT_GROSS", "THESIS_HOURS", "parameter_sets", "ch5_spec", "solve",
            "emg_table", "emg_reference", "excitation_scores", "activation_table", "cot_breakdown",
            "cot_readings", "pelvis_travel", "min_generator_torque", "THESIS_DISTANCE_M", "OPENSIM_BASAL_W_PER_KG",
            "mtb_scale_table", "excitation_figure", "saturation", "synergy_cost_table", "MOVED_TOL",
@@ -70,6 +70,16 @@ EMG_MAP = {
 THESIS_TABLE_5_10 = {"initial": dict(activation.ACTIVATION_INITIAL), "identified": dict(activation.ACTIVATION_IDENTIFIED)}
 #: Thesis Sec 5.3.5: COT of the NMSK natural-speed solve, J kg⁻¹ m⁻¹ (Eq 5.57).
 THESIS_COT = 1.53
+#: Measured gross cost of transport of children walking at their free speed, J kg⁻¹ m⁻¹:
+#: Waters RL, Hislop HJ, Thomas L, Campbell J (1983) "Energy cost of walking in normal
+#: children and teenagers", Dev Med Child Neurol 25:184–188 — 6–12 years, oxygen cost
+#: 0.22 mL O₂ kg⁻¹ m⁻¹ (15.3 mL kg⁻¹ min⁻¹ at ≈ 70 m/min), times :data:`J_PER_ML_O2`.
+#: Gross: it includes the whole body's resting rate (the model's Eq 5.48 basal term covers
+#: its muscles only).
+CHILD_COT_GROSS_ML_O2 = 0.22
+#: Energy equivalent of oxygen, J per mL O₂ (≈ 20.1 at a respiratory exchange ratio ≈ 0.85).
+J_PER_ML_O2 = 20.1
+CHILD_COT_GROSS = CHILD_COT_GROSS_ML_O2 * J_PER_ML_O2
 #: Thesis computation times (GPOPS-II, i7-6700): MSK Sec 5.2.2, NMSK Sec 5.3.5, hours.
 THESIS_HOURS = {"MSK": 2.0, "NMSK": 2.0}
 
