@@ -354,6 +354,12 @@ def cot_findings(readings: pd.DataFrame, readings_unloaded: pd.DataFrame, sol, s
                       "; the gross value also contains the whole body's resting rate, which the model's "
                       "muscle-only basal term (Eq 5.48) does not.")
                    + f" The thesis's {msk.THESIS_COT:g} is {msk.THESIS_COT / msk.CHILD_COT_GROSS:.2f}× the children's gross COT.")
+        whole = [k for k in readings_unloaded.index if k.startswith("basal whole-body")]
+        if whole:
+            cw = readings_unloaded.loc[whole[0], "COT"]
+            out.append(f"Like for like with a gross value — the whole body's resting rate in place of the "
+                       f"muscle-only basal term (reading '{whole[0]}') — the model's COT is {cw:.2f} J kg⁻¹ m⁻¹, "
+                       f"{cw / msk.CHILD_COT_GROSS:.2f}× the children's.")
     alts = readings_unloaded.iloc[1:-1]
     ch = alts["change vs NLP reading (%)"]
     big = ch.abs().idxmax()
