@@ -392,7 +392,25 @@ def _ch5(bases: dict) -> list[Row]:
                  f"[{_anchor('ch05_msk', 'Cost of transport (Eq 5.57)')}]")
     rows.append(Row(5, "NMSK cost of transport, natural speed (Sec 5.3.5, Eq 5.57)", msk.THESIS_COT, cot, "J/kg/m",
                     cause, s.name if s is not None else "", valid))
+    rows += _ch5_unloaded()
     return rows
+
+
+def _ch5_unloaded() -> list[Row]:
+    """The Ch 5 NMSK solve with the swing foot unloaded (Ch 5, "the same on valid gaits"):
+    its COT beside the thesis's, with the children's measured gross COT as the cause."""
+    b = fidelity.swing_bound()
+    m = stored_gait(gait_ocp.cache_dir(msk.ch5_spec("MSK", swing_load_max=b)))
+    n = stored_gait(gait_ocp.cache_dir(msk.ch5_spec("NMSK", swing_load_max=b), guess=m.solution)) if m else None
+    item = "NMSK cost of transport, natural speed, swing foot unloaded (Sec 5.3.5, Eq 5.57)"
+    if n is None:
+        return [Row(5, item, msk.THESIS_COT, np.nan, "J/kg/m", "unknown", "", "")]
+    cot = float(n.stats.get("COT", np.nan))
+    gross = msk.CHILD_COT_GROSS
+    cause = (f"children aged 6–12 measured {gross:.1f} J/kg/m gross at free speed (Waters et al. 1983): ours "
+             f"{cot / gross:.2f}×, the thesis's {msk.THESIS_COT / gross:.2f}× "
+             f"[{_anchor('ch05_msk', 'The same on valid gaits: the swing foot unloaded')}]")
+    return [Row(5, item, msk.THESIS_COT, cot, "J/kg/m", cause, n.name, gate(n, "NMSK"))]
 
 
 def _ablation_causes(model: str = "MSK") -> dict:
