@@ -245,7 +245,7 @@ marks.mark_table(tracking.drop(columns=["gates"]), {k: marks.failure_label(v) fo
 
 # %%
 per_channel = fidelity.channel_table(tracking_sols, "MSK")
-per_channel
+per_channel.drop(columns=["met by"])
 
 # %%
 display(Markdown("\n\n".join(fidelity.tracking_findings(tracking, per_channel))))

@@ -267,8 +267,9 @@ def tracking_ablation(model: str = "MSK", *, bound_bw: float = SWING_BOUND_BW, u
         row = ablation_row(k, pair[pick])
         picked[k] = pair[pick]
         row["starts converged"] = f"{len(ok)}/2"
-        row["objective (data start)"] = pair["data"].stats["objective"]
-        row["objective (warm start)"] = pair["warm"].stats["objective"]
+        for st, s in pair.items():  # a start that did not converge says so beside its number
+            obj = s.stats["objective"]
+            row[f"objective ({st} start)"] = obj if st in ok else f"{obj:.3f}, not converged ({s.stats['status']})"
         rows.append(row)
     return pd.DataFrame(rows).set_index("run"), picked
 
@@ -316,6 +317,15 @@ def tracking_findings(tracking: pd.DataFrame, per_channel: pd.DataFrame) -> list
         usable.append(k)
         moves = ", ".join(f"{n} {ref[c]:.1f} → {r[c]:.1f}{u}" for c, (n, u) in kinds.items())
         out.append(f"**{k}** ({r['starts converged']} starts converged; {r['gates']}): worst RMSE {moves}.")
+    weight_rows = [k for k in usable if k.startswith("coordinate weight")]
+    if weight_rows:
+        k = weight_rows[0]
+        a0, a1 = ref["worst angle RMSE (deg)"], tracking.loc[k, "worst angle RMSE (deg)"]
+        if a1 >= a0:
+            out.append(f"**Raising the coordinate term's weight does not lower the angle error** ({k}: worst "
+                       f"{a0:.1f} → {a1:.1f}°): the angles are not held off the data by the weighting but by "
+                       "something the weight cannot move. A hypothesis, not yet measured: the data's angles leave the "
+                       "swing foot no clearance on this model (above), so a valid motion cannot follow them.")
     cols = [c for c in [rows[0]] + usable if c in per_channel.columns]
     met_any = per_channel[cols].le(per_channel["target"], axis=0).any(axis=1)
     n = len(per_channel)
