@@ -97,3 +97,48 @@ def test_each_ablation_change_is_one_change_on_the_swing_unloaded_spec():
         assert differs == set(change), name
     # Table 5.3's tracking weights are 1/4: "×4" restores 1
     assert "GRF weight ×4" in fidelity.tracking_changes("MSK")
+
+
+def _row(status="Solve_Succeeded", obj=0.3, gates="valid", angle=10.0, torque=12.0, grf=60.0, swing=4.0, ds=27.0):
+    return {"status": status, "iterations": 300, "objective": obj, "swing load (N)": swing,
+            "double support (%)": ds, "worst angle RMSE (deg)": angle, "worst torque RMSE (N·m)": torque,
+            "worst GRF RMSE (N)": grf, "gates": gates}
+
+
+def _summary(clear_mm=0.0):
+    import pandas as pd
+    return pd.DataFrame({"min mid-swing clearance (mm)": [clear_mm, clear_mm], "at (% cycle)": [78.0, 28.0],
+                         "mean clearance in swing (mm)": [9.0, 9.0],
+                         "swing within 2 mm of the ground (%)": [35.0, 29.0]}, index=pd.Index(["r", "l"], name="foot"))
+
+
+def test_swing_findings_read_the_better_converged_start_and_the_spread():
+    import pandas as pd
+    tab = pd.DataFrame({"MSK Eq5.33": _row(obj=0.227, gates="invalid: swing load 180 N", swing=180.0, ds=52.9),
+                        "MSK Eq5.33, swing load ≤ 4.06 N": _row(obj=0.332, angle=11.1),
+                        "MSK Eq5.33, swing load ≤ 4.06 N, from the baseline": _row(obj=0.270, angle=10.3)}).T
+    text = " ".join(fidelity.swing_findings(_summary(), tab))
+    assert "no clearance" in text
+    assert "objective 0.227 → 0.270" in text  # the better (lower-objective) start is the one read
+    assert "23 % apart" in text  # (0.332 − 0.270) / 0.270
+    assert "2 of 2 starts" in text
+    # a start that did not converge is never read
+    tab.iloc[2, tab.columns.get_loc("status")] = "Maximum_Iterations_Exceeded"
+    text = " ".join(fidelity.swing_findings(_summary(5.0), tab))
+    assert "objective 0.227 → 0.332" in text and "did not converge" in text
+    assert "no clearance" not in text  # 5 mm > the 2 mm touch threshold
+
+
+def test_tracking_findings_count_channels_against_the_target():
+    import pandas as pd
+    tab = pd.DataFrame({"swing unloaded (no other change)": dict(_row(), **{"starts converged": "2/2"}),
+                        "coordinate weight ×4": dict(_row(angle=11.9), **{"starts converged": "2/2"}),
+                        "mesh 40 × 5": dict(_row(status="Maximum_Iterations_Exceeded"), **{"starts converged": "0/2"})}).T
+    idx = pd.MultiIndex.from_tuples([("angle", "hip", "r", "deg"), ("grf", "y", "l", "N")],
+                                    names=["kind", "channel", "side", "unit"])
+    pc = pd.DataFrame({"swing unloaded (no other change)": [5.9, 47.0], "coordinate weight ×4": [4.5, 30.0],
+                       "target": [1.8, 36.3]}, index=idx)
+    text = " ".join(fidelity.tracking_findings(tab, pc))
+    assert "1 of 2 channels" in text and "grf y l" in text
+    assert "mesh 40 × 5:** neither start converged" in text
+    assert "does not lower the angle error" in text and "hypothesis" in text
