@@ -300,3 +300,20 @@ def test_ch7_findings_verdicts():
                            "3.00 J/(kg·m); minimum at Free (the natural speed — a U-curve as the thesis reports). "
                            "Thesis (Fig 7.5): 2.18, 1.99, 1.53, 1.96, 1.99 at XS, S, N, M, L.")
     assert f[3].endswith("The Ch 5 NMSK solution (Eq 5.55, its own activation parameters) has 1.60; it is not on the curve.")
+
+
+def test_mesh_verdict_says_whether_the_real_data_verdict_depends_on_the_mesh():
+    import pandas as pd
+    from gaitlib.studies import gap as gs
+
+    def table(top2, verdict2="partial"):
+        return pd.DataFrame({"verdict": ["partial", verdict2], "top effect": ["left_shift", top2],
+                             "best candidate": ["left_shift", top2], "its ΔBIC": [-21.7, -14.0]},
+                            index=pd.Index(["10 × 3", "20 × 5"], name="mesh"))
+
+    same = gs.mesh_verdict(table("left_shift"), -10)
+    assert same.startswith("**The real-data verdict does not depend on the mesh**")
+    other = gs.mesh_verdict(table("arm_swing"), -10)
+    assert other.startswith("**The real-data verdict depends on the mesh**")
+    assert "top arm_swing" in other and "ΔBIC -14.0" in other and "not measured" in other
+    assert gs.mesh_verdict(table("left_shift", "explained"), -10).startswith("**The real-data verdict depends")

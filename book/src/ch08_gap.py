@@ -254,6 +254,9 @@ for line in misses:
 # %%
 display(Markdown("\n\n".join(gap_study.twin_full_mesh_verdict(tvf))))
 
+# %%
+display(Markdown(gap_study.circularity(tvf, dS)))
+
 # %% [markdown]
 # ## 4. Findings on the real data
 #
@@ -277,6 +280,19 @@ if best is not None:
     sh = dS.shrink[best]
     display(sh.sort_values("rms_before", ascending=False).head(8)[
         ["channel", "phase", "rms_before", "rms_after", "pct_closed", "significant_before", "significant_after"]])
+
+# %% [markdown]
+# #### The same data on the coarse mesh
+#
+# `gaitlib gap` diagnoses a new data set on a 10 × 3 mesh by default (its baseline
+# `DEFAULT_BASE`, for speed); this chapter's real-data diagnoses run on the thesis's 20 × 5.
+# The Schwartz *Free* data diagnosed both ways, everything else equal:
+
+# %%
+dS_coarse = gap_study.sk_diagnosis(mesh=(10, 3))
+mesh_tab = gap_study.mesh_table({"10 × 3 (gaitlib gap's default)": dS_coarse, "20 × 5 (the thesis's, this chapter)": dS})
+display(mesh_tab)
+display(Markdown(gap_study.mesh_verdict(mesh_tab, diagnose.BIC_THRESHOLD)))
 
 # %% [markdown]
 # ### The second lab: gaitutils normative data
