@@ -142,3 +142,22 @@ def test_tracking_findings_count_channels_against_the_target():
     assert "1 of 2 channels" in text and "grf y l" in text
     assert "mesh 40 × 5:** neither start converged" in text
     assert "does not lower the angle error" in text and "hypothesis" in text
+
+
+def test_cot_curve_findings_locate_the_minimum_and_the_term_that_moves_it():
+    import pandas as pd
+    cot = pd.DataFrame({"mark": ["", "", "", "NOT CONVERGED: Maximum_Iterations_Exceeded"],
+                        "speed (m/s)": [0.9, 1.2, 1.5, 1.7]}, index=["Slow", "Free", "Fast", "VeryFast"])
+    # total = the sum; without 'work' the lowest would be Free (3.0 - 0.5), with it Slow
+    terms = pd.DataFrame({"speed (m/s)": [0.9, 1.2, 1.5], "activation": [0.1, 0.1, 0.1],
+                          "maintenance": [0.5, 0.5, 0.5], "shortening": [2.0, 1.4, 1.6], "basal": [0.0, 0.0, 0.0],
+                          "work": [0.3, 1.0, 1.2]}, index=["Slow", "Free", "Fast"])
+    terms["total"] = terms[["activation", "maintenance", "shortening", "basal", "work"]].sum(axis=1)
+    text = " ".join(fidelity.cot_curve_findings(cot, terms))
+    assert "minimum at **Slow**" in text and "not at the natural speed" in text
+    assert "Without the work term the minimum would be at Free" in text
+    assert "VeryFast: NOT CONVERGED" in text
+    assert "too few" in " ".join(fidelity.cot_curve_findings(cot, terms.iloc[:2]))
+    terms.loc["Free", "shortening"] = 0.5  # now Free is lowest
+    terms["total"] = terms[["activation", "maintenance", "shortening", "basal", "work"]].sum(axis=1)
+    assert "the natural speed, as the thesis" in " ".join(fidelity.cot_curve_findings(cot, terms))

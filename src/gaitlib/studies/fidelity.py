@@ -31,6 +31,7 @@ from ..model import ChildModel
 from ..problems import gait as gait_ocp
 from . import gait as gait_study
 from . import msk
+from . import predictive as pr
 
 #: The ablation's bound on a swinging foot's vertical force: half the validity gate's limit
 #: (:data:`gaitlib.validity.SWING_LOAD_BW` × body weight), so a solution meeting it passes
@@ -375,4 +376,59 @@ def cot_findings(readings: pd.DataFrame, readings_unloaded: pd.DataFrame, sol, s
     big = ch.abs().idxmax()
     out.append(f"Of the open readings, '{big}' moves it most on this motion too ({ch[big]:+.0f} %, "
                f"{alts.loc[big, 'COT']:.2f}).")
+    return out
+
+
+# ======================================================================================
+# Ch 7: the COT–speed curve of one consistent problem on valid gaits
+# ======================================================================================
+
+def consistent_speed_study(**kw):
+    """Thesis Ch 7's NMSK DT problem at **every** speed class, *Free* included (same cost,
+    activation parameters and parameter sets at each speed; Free data scaled in time), with
+    the swing foot unloaded (:func:`swing_bound`), warm-started from the swing-unloaded
+    Ch 5 NMSK solution (:func:`gaitlib.studies.predictive.speed_study`)."""
+    params = {**pr.default_params(), "swing_load_max": swing_bound()}
+    return pr.speed_study(models=("NMSK",), classes=cv.SPEED_CLASSES, params=params, **kw)
+
+
+def cot_terms(cot: pd.DataFrame, solutions: dict) -> pd.DataFrame:
+    """COT by term of Eq 5.38 (:func:`gaitlib.studies.msk.cot_breakdown`, the NLP's reading)
+    of every unmarked (converged, valid) point of a :func:`gaitlib.studies.predictive.cot_table`,
+    by class in speed order; ``solutions``: the study's solutions by run name (``source``)."""
+    rows = {}
+    for cls, r in cot.iterrows():
+        if r["mark"]:
+            continue
+        br = msk.cot_breakdown(solutions[r["source"]]).iloc[:, 0]
+        rows[cls] = {"speed (m/s)": r["speed (m/s)"], **br.to_dict()}
+    return pd.DataFrame(rows).T
+
+
+def cot_curve_findings(cot: pd.DataFrame, terms: pd.DataFrame, min_points: int = 3) -> list[str]:
+    """Where the consistent curve has its minimum, and — if not at *Free* — which term of
+    Eq 5.38 moves it there: the class where (total − that term) is lowest, per term."""
+    marked = cot[cot["mark"] != ""]
+    out = []
+    if len(marked):
+        out.append("Left out of the curve (marked): " + "; ".join(f"{c}: {r['mark']}" for c, r in marked.iterrows()) + ".")
+    if len(terms) < min_points:
+        out.insert(0, f"**Only {len(terms)} of {len(cot)} speeds converged to a valid gait**: too few for a curve.")
+        return out
+    at = terms["total"].astype(float).idxmin()
+    pts = ", ".join(f"{c} {r['total']:.2f} at {r['speed (m/s)']:.2f} m/s" for c, r in terms.iterrows())
+    head = (f"**The consistent curve** ({len(terms)} of {len(cot)} speeds valid; COT in J kg⁻¹ m⁻¹: {pts}) has its "
+            f"minimum at **{at}**" + (" — the natural speed, as the thesis and walking physiology say." if at == "Free"
+                                       else ", not at the natural speed."))
+    out.insert(0, head)
+    if at != "Free" and "Free" in terms.index:
+        moves = [t for t in ("activation", "maintenance", "shortening", "basal", "work")
+                 if t in terms.columns and (terms["total"] - terms[t]).astype(float).idxmin() == "Free"]
+        trend = ", ".join(f"{t} {terms[t].iloc[0]:.2f} → {terms[t].iloc[-1]:.2f}" for t in
+                          ("activation", "maintenance", "shortening", "basal", "work") if t in terms.columns)
+        out.append(f"By term, slowest → fastest valid speed: {trend}. "
+                   + (f"Without the {' or the '.join(moves)} term the minimum would be at Free: "
+                      f"{'that term moves' if len(moves) == 1 else 'these terms move'} the minimum (measured on "
+                      "these motions, not re-optimised)." if moves else
+                      "No single term's removal puts the minimum at Free."))
     return out

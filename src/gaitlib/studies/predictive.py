@@ -604,7 +604,8 @@ def ch7_findings(res: StudyResult, classes, control: pd.DataFrame, cot: pd.DataF
     return lines
 
 
-def cot_figure(cot: pd.DataFrame, ch5_row: str | None = None):
+def cot_figure(cot: pd.DataFrame, ch5_row: str | None = None,
+               label: str = "ours (NMSK DT, converged; Free = Ch 6 DT)"):
     """Thesis Fig 7.5: COT (J kg⁻¹ m⁻¹) against walking speed (m/s) from :func:`cot_table` —
     the converged points joined, the marked ones as labelled crosses, the ``ch5_row`` point
     (the Ch 5 solution) apart, and the thesis's points at their own speeds."""
@@ -613,11 +614,11 @@ def cot_figure(cot: pd.DataFrame, ch5_row: str | None = None):
     curve = cot.drop(index=ch5_row, errors="ignore") if ch5_row else cot
     fig, ax = plt.subplots(figsize=(8.0, 3.6), layout="constrained")
     okc = curve[curve["mark"] == ""]
-    ax.plot(okc["speed (m/s)"], okc["COT (J/kg/m)"], "o-", color="C1", label="ours (NMSK DT, converged; Free = Ch 6 DT)")
+    ax.plot(okc["speed (m/s)"], okc["COT (J/kg/m)"], "o-", color="C1", label=label)
     bad = curve[curve["mark"] != ""]
     if len(bad):
         ax.plot(bad["speed (m/s)"], bad["COT (J/kg/m)"], "x", color=marks.MARK_COLOR, ms=9, mew=2,
-                label=f"{marks.DAGGER} ours, NOT converged")
+                label=f"{marks.DAGGER} ours, marked (not converged or invalid)")
         for name, r in bad.iterrows():
             ax.annotate(f"{marks.DAGGER} {r['mark']}", (r["speed (m/s)"], r["COT (J/kg/m)"]), fontsize=6,
                         color=marks.MARK_COLOR, textcoords="offset points", xytext=(-4, -12), ha="right")
