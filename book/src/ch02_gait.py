@@ -197,7 +197,7 @@ HTML(plots.animation_html(anim))
 clear = fidelity.data_clearance()
 clear_summary = fidelity.clearance_summary(clear)
 ablation, ablation_sols = fidelity.swing_ablation("MSK")
-fig, axes = plt.subplots(1, 2, figsize=(12, 3.2), constrained_layout=True)
+fig, axes = plt.subplots(1, 2, figsize=(12, 4.2), constrained_layout=True)
 for s, colour in (("r", "C0"), ("l", "C1")):
     pct = 100 * clear.index.to_numpy()
     axes[0].plot(pct, 1e3 * clear[f"clear_{s}"], color=colour, label=f"{s} foot")
@@ -212,7 +212,7 @@ for lab, ls in zip(ablation.index, ("-", "--", ":")):
 axes[1].plot(100 * free.time / free.cycle_time, free.mean["grf_y_r"], color="grey", label="data mean")
 axes[1].axvspan(100 * (free.events["foot_off"] + 0.02), 98, color="C0", alpha=0.12)
 axes[1].set_title("right foot vertical GRF (N); shaded: the data's right swing")
-axes[1].legend(fontsize=6)
+axes[1].legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.2))
 for ax in axes:
     ax.set_xlabel("% gait cycle")
 plt.show()
