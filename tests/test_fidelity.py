@@ -131,12 +131,12 @@ def test_swing_findings_read_the_better_converged_start_and_the_spread():
 
 def test_tracking_findings_count_channels_against_the_target():
     import pandas as pd
-    tab = pd.DataFrame({"swing unloaded (no other change)": dict(_row(), **{"starts converged": "2/2"}),
+    tab = pd.DataFrame({"swing unloaded only": dict(_row(), **{"starts converged": "2/2"}),
                         "coordinate weight ×4": dict(_row(angle=11.9), **{"starts converged": "2/2"}),
                         "mesh 40 × 5": dict(_row(status="Maximum_Iterations_Exceeded"), **{"starts converged": "0/2"})}).T
     idx = pd.MultiIndex.from_tuples([("angle", "hip", "r", "deg"), ("grf", "y", "l", "N")],
                                     names=["kind", "channel", "side", "unit"])
-    pc = pd.DataFrame({"swing unloaded (no other change)": [5.9, 47.0], "coordinate weight ×4": [4.5, 30.0],
+    pc = pd.DataFrame({"swing unloaded only": [5.9, 47.0], "coordinate weight ×4": [4.5, 30.0],
                        "target": [1.8, 36.3]}, index=idx)
     text = " ".join(fidelity.tracking_findings(tab, pc))
     assert "1 of 2 channels" in text and "grf y l" in text

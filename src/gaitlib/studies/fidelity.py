@@ -227,9 +227,9 @@ def tracking_changes(model: str = "MSK") -> dict[str, dict]:
     term), and the mesh (40 × 5 instead of 20 × 5)."""
     w = dict(gait_ocp.COST_FUNCTIONS[model][gait_study.natural_gait_spec(model).cost])
     return {
-        "contact & body identified on our data (Ch 4)": {"contact_params": "ch4", "body_params": "ch4"},
-        "MTGs identified on our data (Ch 5)": {"mtg_params": "ch5"},
-        "Ch 5's parameter sets (both of the above)": {"contact_params": "ch4", "body_params": "ch4",
+        "Ch 4 contact & body (ours)": {"contact_params": "ch4", "body_params": "ch4"},
+        "Ch 5 MTGs (ours)": {"mtg_params": "ch5"},
+        "Ch 4 + Ch 5 sets (ours)": {"contact_params": "ch4", "body_params": "ch4",
                                                       "mtg_params": "ch5"},
         f"GRF weight ×{1 / w['GRF']:g}": {"weights": (("GRF", 1.0),)},
         f"coordinate weight ×{1 / w['Q']:g}": {"weights": (("Q", 1.0),)},
@@ -257,7 +257,7 @@ def tracking_ablation(model: str = "MSK", *, bound_bw: float = SWING_BOUND_BW, u
                                 guesses={f"{k} | warm": swing_sols[best_label] for k in specs}, use_cache=use_cache)
     for recs in (first, warm):
         sols.update({k: r.value for k, r in recs.items()})
-    first_row = "swing unloaded (no other change)"
+    first_row = "swing unloaded only"
     rows = [dict(ablation_row(first_row, swing_sols[best_label]),
                  **{"starts converged": f"{len(conv)}/{len(swing_tab) - 1}"})]
     picked = {first_row: swing_sols[best_label]}
