@@ -422,13 +422,14 @@ def cot_curve_findings(cot: pd.DataFrame, terms: pd.DataFrame, min_points: int =
                                        else ", not at the natural speed."))
     out.insert(0, head)
     if at != "Free" and "Free" in terms.index:
-        moves = [t for t in ("activation", "maintenance", "shortening", "basal", "work")
-                 if t in terms.columns and (terms["total"] - terms[t]).astype(float).idxmin() == "Free"]
-        trend = ", ".join(f"{t} {terms[t].iloc[0]:.2f} → {terms[t].iloc[-1]:.2f}" for t in
-                          ("activation", "maintenance", "shortening", "basal", "work") if t in terms.columns)
-        out.append(f"By term, slowest → fastest valid speed: {trend}. "
+        names = [t for t in ("activation", "maintenance", "shortening", "basal", "work") if t in terms.columns]
+        moves = [t for t in names if (terms["total"] - terms[t]).astype(float).idxmin() == "Free"]
+        diff = (terms.loc["Free", names] - terms.loc[at, names]).astype(float).sort_values(ascending=False)
+        out.append(f"By term, Free minus {at}: " + ", ".join(f"{t} {v:+.2f}" for t, v in diff.items())
+                   + f" J kg⁻¹ m⁻¹ (largest: {diff.index[0]}). "
                    + (f"Without the {' or the '.join(moves)} term the minimum would be at Free: "
                       f"{'that term moves' if len(moves) == 1 else 'these terms move'} the minimum (measured on "
                       "these motions, not re-optimised)." if moves else
-                      "No single term's removal puts the minimum at Free."))
+                      "No single term's removal puts the minimum at Free: the Free motion costs more per metre "
+                      "in several terms at once."))
     return out
