@@ -612,7 +612,31 @@ def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict) -> list[
     rows.append(Row(7, "COT against speed is U-shaped with its minimum at the natural speed (Sec 7.2, Fig 7.5)",
                     "U, minimum at natural speed", ours, "", "unknown",
                     "Ch 6 NMSK DT, Ch 7 NMSK", _joint(vals), holds=holds))
+    rows += _ch7_consistent()
     return rows
+
+
+def _ch7_consistent() -> list[Row]:
+    """Fig 7.5's claim on the consistent curve of valid gaits (Ch 7, "one consistent
+    problem on valid gaits"): the minimum's class and, if not Free, the by-term difference."""
+    item = ("COT against speed is U-shaped with its minimum at the natural speed — one consistent problem, "
+            "swing foot unloaded (Sec 7.2, Fig 7.5)")
+    try:
+        res = fidelity.consistent_speed_study(progress=False)
+    except cache.NotCached:
+        return [Row(7, item, "U, minimum at natural speed", np.nan, "", "unknown", "", "")]
+    cot = pr.cot_table(res)
+    terms = fidelity.cot_terms(cot, res.solutions)
+    valid = {k: gate(s, k) for k, s in res.solutions.items()}
+    if len(terms) < len(cot):
+        return [Row(7, item, "U, minimum at natural speed", np.nan, "", "not every speed valid", "",
+                    _joint(valid), holds=None)]
+    at = terms["total"].astype(float).idxmin()
+    ours = ", ".join(f"{c} {v:.2f}" for c, v in terms["total"].items()) + f" (minimum at {at})"
+    cause = fidelity.cot_curve_findings(cot, terms)[-1] if at != "Free" else ""
+    where = _anchor("ch07_speed", "One consistent problem on valid gaits")
+    return [Row(7, item, "U, minimum at natural speed", ours, "", f"{cause} [{where}]" if cause else "unknown",
+                "Ch 7 NMSK DT, swing unloaded", _joint(valid), holds=at == "Free")]
 
 
 # ======================================================================================
