@@ -310,3 +310,25 @@ def test_every_book_figure_of_a_solve_passes_its_mark():
             if not {kw.arg for kw in node.keywords} & {"marks", "mark"}:
                 missing.append(f"{f.name} (code line {node.lineno}) {name}")
     assert not missing, "figures of a solve without its failure label: " + ", ".join(missing)
+
+
+def test_a_long_mark_never_widens_a_saved_figure(tmp_path):
+    """Many marked runs give a label of hundreds of characters: the saved figure (tight
+    bounding box, as the book's notebooks save them) stays within its own width."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from PIL import Image
+
+    label = "; ".join(f"NMSK run {i} (INVALID: swing load {100 + i} N > 8.12 N (2 % BW); double support 52.9% > 40%)"
+                      for i in range(8))
+    fig, axes = plt.subplots(1, 4, figsize=(10, 3), dpi=50)
+    for ax in axes:
+        ax.plot([0, 1], [0, 1])
+        marks.mark_axes(ax, label)
+    marks.mark_figure(fig, label)
+    fig.savefig(tmp_path / "f.png", bbox_inches="tight")
+    plt.close(fig)
+    width_px = Image.open(tmp_path / "f.png").size[0]
+    assert width_px <= 1.1 * 10 * 50

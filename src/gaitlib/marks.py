@@ -19,6 +19,7 @@ Headline numbers are computed from unmarked runs only (:func:`unmarked`).
 from __future__ import annotations
 
 import math
+import textwrap
 from collections.abc import Mapping
 from . import validity
 
@@ -167,6 +168,9 @@ def mark_axes(ax, label: str | None, *, fontsize: float | None = None):
     diag = math.hypot(w, h) if w > 0 and h > 0 else 200.0
     if fontsize is None:  # the label spans about 85 % of the diagonal (≈ 0.6 em per character)
         fontsize = max(5.0, min(16.0, 0.85 * diag / (0.6 * max(len(label), 1))))
+    fit = int(0.85 * diag / (0.6 * fontsize))  # characters that fit along the diagonal
+    if len(label) > fit:  # never wider than the axes (it would widen a saved figure); the
+        label = label[:max(fit - 1, 1)].rstrip() + "…"  # figure's title carries the whole text
     txt = ax.text(0.5, 0.5, label, transform=ax.transAxes, rotation=angle, rotation_mode="anchor",
                   ha="center", va="center", color=MARK_COLOR, alpha=0.55, fontsize=fontsize,
                   fontweight="bold", zorder=100, clip_on=False, gid=MARK_GID)
@@ -184,6 +188,10 @@ def mark_figure(fig, label: str | None):
     old = fig._suptitle.get_text() if getattr(fig, "_suptitle", None) is not None else ""
     size = fig._suptitle.get_fontsize() if old else 10
     sep = "\n" if len(label) + len(old) > 70 else " — "
+    # wrapped to the figure's width (≈ 0.55 em per character): a long label (many marked
+    # runs) must not widen the saved figure beyond its axes
+    width = max(40, int(fig.get_size_inches()[0] * 72.0 / (0.55 * size)))
+    label = textwrap.fill(label, width=width)
     t = fig.suptitle(f"{label}{sep}{old}" if old else label, color=MARK_COLOR, fontsize=size,
                      fontweight="bold")
     t.set_gid(MARK_GID)
