@@ -30,8 +30,11 @@ $(STAMP): requirements.txt pyproject.toml
 	$(BIN)/python -m ipykernel install --sys-prefix --name python3 $(foreach v,$(BLAS_VARS),--env $(v) $($(v))) >/dev/null
 	touch $(STAMP)
 
+# --all: every page is executed again, also when only gaitlib's code changed (without it
+# Sphinx rebuilds only the notebooks whose files changed, and figures drawn by changed library
+# code stay stale).
 book: $(STAMP)
-	$(BIN)/jupyter-book build book -W -n --keep-going
+	$(BIN)/jupyter-book build book --all -W -n --keep-going
 
 # Every built page in headless Chromium with the network blocked: math typeset, figures
 # loaded, nothing wide cut off; screenshots in book/_build/screenshots/. Installs Debian's
