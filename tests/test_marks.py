@@ -332,3 +332,22 @@ def test_a_long_mark_never_widens_a_saved_figure(tmp_path):
     plt.close(fig)
     width_px = Image.open(tmp_path / "f.png").size[0]
     assert width_px <= 1.1 * 10 * 50
+
+
+def test_a_legend_of_long_marked_run_labels_never_widens_a_tracking_figure(tmp_path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from PIL import Image
+
+    from gaitlib import plots
+
+    fig, axes = plt.subplots(1, 2, figsize=(8, 3), dpi=50, squeeze=False)
+    for i in range(3):
+        axes[0, 0].plot([0, 1], [0, i], label=f"run {i} † INVALID: swing load {100 + i} N > 8.12 N (2 % BW); "
+                                              "double support 96.1% > 40% (of the cycle); residual force 331 N")
+    plots._finish_panels(fig, axes, 1, title="t")
+    fig.savefig(tmp_path / "f.png", bbox_inches="tight")
+    plt.close(fig)
+    assert Image.open(tmp_path / "f.png").size[0] <= 1.1 * 8 * 50

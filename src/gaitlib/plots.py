@@ -7,6 +7,7 @@ edge; every input is SI (see :mod:`gaitlib.conventions`).
 from __future__ import annotations
 
 import re
+import textwrap
 
 import numpy as np
 
@@ -64,6 +65,21 @@ def _label_panel(ax, channel: str, unit: str, name: str):
     ax.tick_params(labelsize=7)
 
 
+def _legend_layout(fig, labels, fontsize: float = 8.0, max_cols: int = 5):
+    """Labels wrapped to the figure's width and the number of legend columns that fits in
+    it (≈ 0.55 em per character, 30 pt per handle): a legend never widens a saved figure."""
+    width_pt = fig.get_size_inches()[0] * 72.0
+    chars = max(20, int((width_pt - 40.0) / (0.55 * fontsize)))
+    wrapped = [textwrap.fill(str(lab), width=chars) for lab in labels]
+    widths = [30.0 + 0.55 * fontsize * max(len(line) for line in lab.splitlines() or [""]) for lab in wrapped]
+    ncols = 1
+    for k in range(min(len(wrapped), max_cols), 0, -1):
+        if sum(sorted(widths, reverse=True)[:k]) <= width_pt:
+            ncols = k
+            break
+    return wrapped, ncols
+
+
 def _finish_panels(fig, axes, n: int, title=None):
     """Hide unused panels, label the x axes (% gait cycle), one legend, a title."""
     for ax in axes.flat[n:]:
@@ -72,7 +88,8 @@ def _finish_panels(fig, axes, n: int, title=None):
         ax.set_xlabel("% gait cycle", fontsize=8)
     handles, labs = axes.flat[0].get_legend_handles_labels()
     if handles:
-        fig.legend(handles, labs, loc="outside lower center", ncols=min(len(labs), 5), fontsize=8)
+        labs, ncols = _legend_layout(fig, labs)
+        fig.legend(handles, labs, loc="outside lower center", ncols=ncols, fontsize=8)
     if title:
         fig.suptitle(title, fontsize=10)
     return fig
@@ -638,8 +655,9 @@ def score_bars(scores, kind: str, value: str = "rmse", cases=None, models=None, 
     if shown:
         h, lab = h + [mk.bar_legend_handle()], lab + [mk.bar_legend_handle().get_label()]
     if h:
+        lab, ncols = _legend_layout(fig, lab, max_cols=len(h))
         fig.legend(h, lab, loc="outside lower center" if shown else "outside upper right", fontsize=8,
-                   ncols=len(h))
+                   ncols=ncols)
     if title:
         fig.suptitle(title, fontsize=10)
     if shown:
