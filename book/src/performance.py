@@ -81,6 +81,30 @@ print(perf.measured_on(gait_bench))
 display(perf.gait_table(gait_bench))
 
 # %% [markdown]
+# ## Building the NLP: whole-graph vs per-node derivatives
+#
+# Before the first iteration, IPOPT needs the exact gradient, constraint Jacobian and
+# Lagrangian Hessian. Letting CasADi differentiate the NLP's whole SX graph (the old default,
+# `derivatives="graph"`) builds a Hessian of about 12 million instructions for the MSK
+# problem, and that symbolic work *was* the build. Every non-linear term of the NLP sits in
+# one collocation node's function `node(x, u, p, t, d)`; the default `derivatives="nodes"`
+# differentiates that one small function, evaluates its Jacobian and Hessian at all nodes in
+# one mapped call and assembles IPOPT's matrices by the chain rule with the (small, mostly
+# linear) rest of the NLP, through constant sparse maps computed once. The functions agree
+# with CasADi's own derivatives to round-off and with finite differences
+# (`tests/test_node_derivatives.py`, on every stored formulation). IPOPT may still take
+# another path from round-off differences, which on these non-convex problems can mean another
+# local optimum: both paths' iterations and objectives are shown. `bench_build.py`, both
+# paths in one process:
+
+# %%
+build = perf.load_optional("build")
+if build is not None:
+    print(perf.measured_on(build))
+    display(perf.build_table(build))
+    print("\n".join(perf.build_findings(build)))
+
+# %% [markdown]
 # ## Where the MSK solve's time goes
 #
 # The target for the MSK data-tracking solve at the full mesh is ≤ 20 s. `bench_msk_profile.py`

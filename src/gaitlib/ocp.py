@@ -23,7 +23,10 @@ Dynamics, path constraints and integrands are called **once per phase** on symbo
 CasADi SX arguments, giving one per-node ``casadi.Function`` ``node(x, u, p, t, d) →
 (ẋ, g, L)``; it is then evaluated at all collocation nodes with ``Function.map``. With the
 default ``SolverOptions(graph="sx")`` the NLP is one SX graph (mapped calls are inlined),
-which is what was measured fastest here (performance-notes.md). With ``graph="mx"`` the NLP
+which is what was measured fastest to evaluate here (performance-notes.md). Its derivatives
+are either CasADi's of the whole graph (``derivatives="graph"``) or assembled from per-node
+derivative functions (``derivatives="nodes"``, :meth:`Transcription._node_derivatives`: the
+same derivatives to round-off, built in a fraction of the time). With ``graph="mx"`` the NLP
 is an MX graph with a single mapped call per phase, expanded to SX by ``nlpsol``
 (``expand=True``, the default: same speed as SX). ``graph="mx", expand=False`` keeps the
 mapped MX graph: building is much faster but each iteration's function evaluations are
@@ -52,6 +55,7 @@ from typing import Any, Union
 import casadi as ca
 import numpy as np
 import pandas as pd
+import scipy.sparse as sp
 
 from gaitlib.collocation import Mesh
 
@@ -380,6 +384,13 @@ class Problem:
 # ======================================================================================
 # Solver options
 # ======================================================================================
+#: The default of :attr:`SolverOptions.derivatives`. "graph" while the solution store holds
+#: solutions made with it: per-node derivatives are the same functions to round-off, but
+#: IPOPT's path from them can end in another local optimum, so switching the default means
+#: re-solving the store (tools/store_solutions.py) for a from-scratch run to reproduce it.
+DEFAULT_DERIVATIVES = "graph"
+
+
 @dataclass(frozen=True)
 class SolverOptions:
     """How to solve: IPOPT settings and NLP graph type (separate from the problem).
@@ -402,6 +413,20 @@ class SolverOptions:
     expand : bool
         With ``graph="mx"``: expand to SX inside nlpsol (recommended: unexpanded MX
         evaluates far slower per iteration on the gait problem).
+    derivatives : {"graph", "nodes"}
+        How the NLP's exact derivatives are built (with ``graph="sx"``; an MX graph is
+        always differentiated by CasADi); default :data:`DEFAULT_DERIVATIVES`.
+        ``"graph"``: CasADi differentiates the
+        whole NLP graph (one SX graph of every node; the Hessian of the Lagrangian of the
+        MSK gait problem is ≈ 12 million instructions, built symbolically before the first
+        iteration). ``"nodes"``: each phase's per-node function is differentiated once (its
+        Jacobian and the Hessian of a weighted sum of its outputs), evaluated at every
+        collocation node in one mapped call, and assembled by the chain rule with the
+        derivatives of the rest of the NLP (collocation defects, quadrature, endpoints: a
+        small graph with the node outputs as symbols). The same exact derivatives, to
+        round-off (tests/test_node_derivatives.py), built in a fraction of the time
+        (benchmarks/bench_build.py). IPOPT's path can still differ at round-off level, and
+        on the non-convex gait problems that can mean another local optimum.
     ipopt : mapping
         Further IPOPT options, applied last (e.g. ``{"nlp_scaling_method": "none"}``).
 
@@ -418,6 +443,7 @@ class SolverOptions:
     print_level: int = 0
     graph: str = "sx"
     expand: bool = True
+    derivatives: str = field(default_factory=lambda: DEFAULT_DERIVATIVES)
     ipopt: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self):
@@ -426,6 +452,8 @@ class SolverOptions:
             raise ValueError("hessian must be 'exact' or 'limited-memory'")
         if self.graph not in ("sx", "mx"):
             raise ValueError("graph must be 'sx' or 'mx'")
+        if self.derivatives not in ("graph", "nodes"):
+            raise ValueError("derivatives must be 'graph' or 'nodes'")
 
     def nlpsol_options(self) -> dict:
         ipopt = {
@@ -758,6 +786,42 @@ def _column(expr, what: str):
     return expr
 
 
+def _csr(m) -> "sp.csr_matrix":
+    """A constant CasADi matrix (DM or SX without symbols) as a SciPy CSR matrix."""
+    m = ca.DM(ca.evalf(m)) if isinstance(m, ca.SX) else ca.DM(m)
+    r, c = m.sparsity().get_triplet()
+    return sp.csr_matrix((np.asarray(m.nonzeros(), float), (r, c)), shape=m.shape)
+
+
+def _bilinear_map(A, ra, B, rb, shape, triu=False):
+    """The constant linear map from values v_k to the non-zeros of Σ_k v_k·A[ra_k]ᵀ·B[rb_k]
+    (A, B SciPy CSR; ra, rb row indices; ``triu``: the upper triangle only, for a symmetric
+    sum). Returns (M as a sparse DM, the result's sparsity): the result's non-zeros are
+    M @ v. Used to assemble per-node derivative blocks into the NLP's matrices by one
+    constant sparse product instead of sparse-by-sparse products at every evaluation."""
+    ra, rb = np.asarray(ra, int), np.asarray(rb, int)
+    la, lb = np.diff(A.indptr)[ra], np.diff(B.indptr)[rb]
+    k_a = np.repeat(np.arange(ra.size), la)  # one entry per non-zero of A[ra_k]
+    ea = np.repeat(A.indptr[ra], la) + (np.arange(la.sum()) - np.repeat(np.cumsum(la) - la, la))
+    n_pairs = lb[k_a]
+    ia = np.repeat(ea, n_pairs)
+    kk = np.repeat(k_a, n_pairs)
+    first = np.repeat(np.cumsum(n_pairs) - n_pairs, n_pairs)
+    eb = B.indptr[rb[kk]] + (np.arange(n_pairs.sum()) - first)
+    i, j, coef = A.indices[ia], B.indices[eb], A.data[ia] * B.data[eb]
+    if triu:
+        keep = i <= j
+        i, j, coef, kk = i[keep], j[keep], coef[keep], kk[keep]
+    key = j.astype(np.int64) * shape[0] + i  # column-major: CasADi's order of non-zeros
+    uniq, out = np.unique(key, return_inverse=True)
+    M = sp.csc_matrix((coef, (out, kk)), shape=(uniq.size, ra.size))
+    M.sum_duplicates()
+    M.sort_indices()
+    spM = ca.Sparsity(uniq.size, ra.size, M.indptr.tolist(), M.indices.tolist())
+    pattern = ca.Sparsity.triplet(shape[0], shape[1], (uniq % shape[0]).tolist(), (uniq // shape[0]).tolist())
+    return ca.DM(spM, M.data), pattern
+
+
 class _Block:
     """Book-keeping for one named constraint block (for violation reports)."""
 
@@ -779,6 +843,25 @@ class _PhaseLayout:
         self.t0_fixed = np.isscalar(phase.t0) or t0[0] == t0[1]
         self.tf_fixed = np.isscalar(phase.tf) or tf[0] == tf[1]
         self.t0_bounds, self.tf_bounds = t0, tf
+
+
+@dataclass
+class _NodePhase:
+    """One phase's per-node functions for :meth:`Transcription._node_derivatives`: the
+    mapped node values and Jacobians by part ("all", "fg": ẋ and path rows, "l": integrand
+    rows), the mapped node Hessian, the node inputs as a function of (w, p), sizes (n_c
+    nodes, n_z differentiated inputs, n_y outputs per node) and offsets into Y and Z."""
+
+    nc: int
+    nz: int
+    ny: int
+    y_off: int
+    z_off: int
+    inputs: ca.Function
+    hess: ca.Function
+    rows: dict = field(default_factory=dict)
+    values: dict = field(default_factory=dict)
+    jacobians: dict = field(default_factory=dict)
 
 
 class Transcription:
@@ -805,10 +888,13 @@ class Transcription:
             self.meshes = {ph.name: mesh[ph.name] for ph in problem.phases}
         self._sym = ca.SX if options.graph == "sx" else ca.MX
         self._path_sizes: dict[str, list[int]] = {}
+        self._by_nodes = options.derivatives == "nodes" and options.graph == "sx"
+        self._node_outputs: dict[str, tuple] = {}  # by_nodes: phase → (node inputs, output symbols)
         self._build()
+        functions = self._node_derivatives() if self._by_nodes else {}
         self.symbolic_time = time.perf_counter() - t_start
         self.solver = ca.nlpsol(
-            f"{problem.name}_nlp", "ipopt", self.nlp, options.nlpsol_options()
+            f"{problem.name}_nlp", "ipopt", self.nlp, {**options.nlpsol_options(), **functions}
         )
         self.build_time = time.perf_counter() - t_start
 
@@ -911,7 +997,13 @@ class Transcription:
             self._node_functions[ph.name] = node
             Xc = X[:, list(mesh.colloc_state_nodes)] if mesh.n_colloc_nodes < lay.ns else X
             Tc = t0 + dur * ca.DM(mesh.tau_colloc).T
-            F, G, L = node.map(lay.nc)(Xc, U, P, Tc, D)
+            if self._by_nodes:  # node outputs as symbols; the nodes are evaluated in _node_derivatives
+                sizes = [node.size1_out(i) for i in range(3)]
+                Y = S.sym(f"{ph.name}_node_outputs", sum(sizes), lay.nc)
+                F, G, L = Y[:sizes[0], :], Y[sizes[0]:sizes[0] + sizes[1], :], Y[sizes[0] + sizes[1]:, :]
+                self._node_outputs[ph.name] = ((Xc, U, P, S(Tc), D), Y)
+            else:
+                F, G, L = node.map(lay.nc)(Xc, U, P, Tc, D)
             # Dynamics defects and path constraints, interval by interval.
             Def = mesh.defects(X, F, dur)
             nd = mesh.interval.n_defects
@@ -1003,11 +1095,196 @@ class Transcription:
         if not isinstance(f, (ca.SX, ca.MX)):
             f = S(f)
         self.nlp = {"x": self.w, "f": f, "g": self.g, "p": ca.vertcat(Pdata, weights)}
-        self._goal_fun = ca.Function(
-            "goals", [self.w, self.nlp["p"]], [ca.vertcat(*goal_exprs) if goal_exprs else S(0, 1)]
-        )
+        self._goal_exprs = ca.vertcat(*goal_exprs) if goal_exprs else S(0, 1)
+        if not self._by_nodes:  # by nodes: made in _node_derivatives
+            self._goal_fun = ca.Function("goals", [self.w, self.nlp["p"]], [self._goal_exprs])
         self._n_pdata = n_d
         self.n_variables, self.n_constraints = n_w, n_g
+
+    def _node_derivatives(self) -> dict:
+        """``derivatives="nodes"``: the NLP as an MX graph of one mapped node call per phase,
+        with IPOPT's gradient, constraint Jacobian and Lagrangian Hessian assembled from
+        per-node derivative functions (the nlpsol options ``grad_f``, ``jac_g``, ``hess_lag``).
+
+        Notation: w the NLP variables, p the NLP parameters (data, goal weights), Y the node
+        outputs of all phases (one column of (ẋ, path, integrand) per collocation node), z_c
+        = (x_c, u_c, p_static, t_c) node c's differentiated inputs — affine in w (t_c = t0 +
+        (tf − t0)·τ_c), so ∂z/∂w = Z is a constant matrix. The outer functions f(w, p, Y),
+        g(w, p, Y) (defects, quadrature, endpoints) are small SX graphs. With J = ∂Y/∂w =
+        blockdiag(∂Y_c/∂z_c)·Z and Φ = σ·f + λᵀg, μ = ∂Φ/∂Y:
+
+            ∇f = f_w + Jᵀ f_Y,    ∂g/∂w = g_w + g_Y·J,
+            ∇²L = Φ_ww + Jᵀ Φ_Yw + Φ_wY J + Jᵀ Φ_YY J + Zᵀ blockdiag(∇²_z (μ_cᵀ Y_c)) Z.
+
+        Terms whose pattern is empty are left out (for fixed phase times every term but the
+        last and g_Y·J is zero)."""
+        S = ca.SX
+        w_sx, p_sx = self.w, self.nlp["p"]
+        W, Pm = ca.MX.sym("x", self._n_w), ca.MX.sym("p", p_sx.shape[0])
+        sig, lam = ca.MX.sym("lam_f"), ca.MX.sym("lam_g", self.n_constraints)
+        nodes, Y_sx, Z_parts = [], [], []
+        y_off = z_off = 0
+        for ph in self.problem.phases:
+            (Xc, U, P, Tc, D), Y = self._node_outputs[ph.name]
+            node, nc = self._node_functions[ph.name], self.layouts[ph.name].nc
+            x, u, p, t, d = (S.sym(n, node.size1_in(i)) for i, n in enumerate(("x", "u", "p", "t", "d")))
+            z = ca.vertcat(x, u, p, t)
+            y = ca.vertcat(*node(x, u, p, t, d))
+            m = S.sym("m", y.numel())
+            n_fg = node.size1_out(0) + node.size1_out(1)
+            nd = _NodePhase(nc=nc, nz=z.numel(), ny=y.numel(), y_off=y_off, z_off=z_off,
+                            inputs=ca.Function(f"{ph.name}_node_inputs", [w_sx, p_sx], [Xc, U, P, Tc, D]),
+                            hess=ca.Function(f"{ph.name}_node_hess", [x, u, p, t, d, m],
+                                             [ca.hessian(ca.dot(m, y), z)[0]]).map(nc))
+            # the constraints' rows (ẋ, path) and the objective's (integrands) separately, so
+            # that IPOPT's f and g (and their derivatives) evaluate only what each uses
+            for part, rows_ in (("all", slice(0, nd.ny)), ("fg", slice(0, n_fg)), ("l", slice(n_fg, nd.ny))):
+                nd.rows[part] = rows_
+                nd.values[part] = ca.Function(f"{ph.name}_node_{part}", [x, u, p, t, d], [y[rows_]]).map(nc)
+                nd.jacobians[part] = ca.Function(f"{ph.name}_node_jac_{part}", [x, u, p, t, d],
+                                                 [y[rows_], ca.jacobian(y[rows_], z)]).map(nc)
+            Zw = ca.jacobian(ca.vec(ca.vertcat(Xc, U, ca.repmat(P, 1, nc), Tc)), w_sx)
+            if ca.depends_on(Zw, ca.vertcat(w_sx, p_sx)):
+                raise AssertionError(f"phase {ph.name!r}: node inputs are not affine in the variables")
+            Z_parts.append(ca.DM(ca.evalf(Zw)))
+            Y_sx.append(ca.vec(Y))
+            nodes.append(nd)
+            y_off += nd.ny * nc
+            z_off += nd.nz * nc
+        n_y = y_off
+        Yv = ca.vertcat(*Y_sx)
+        Z = ca.vertcat(*Z_parts)  # node inputs of all phases stacked: (Σ n_z·n_c) × n_w
+
+        def place(nd, part, yv):
+            """A part's rows of one phase's node outputs, as that phase's slice of Y (MX)."""
+            if part == "all":
+                return ca.vec(yv)
+            v = ca.MX(nd.ny, nd.nc)
+            v[nd.rows[part], :] = yv
+            return ca.vec(v)
+
+        def values(Wx, Px, part="all"):
+            """Node outputs Y at all nodes of all phases (MX); only the rows of ``part``
+            ("all"; "fg": ẋ and path; "l": integrands) are computed, the others are zero."""
+            return ca.vertcat(*[place(nd, part, nd.values[part](*nd.inputs(Wx, Px))) for nd in nodes])
+
+        def values_and_jacobian(Wx, Px, part="all"):
+            """Y (the rows of ``part`` computed, the others zero) and the block-diagonal ∂Y/∂z
+            of ``part``'s rows at all nodes of all phases (MX)."""
+            ys, js = [], []
+            for nd in nodes:
+                yv, jv = nd.jacobians[part](*nd.inputs(Wx, Px))
+                ys.append(place(nd, part, yv))
+                js.extend(ca.horzsplit(jv, nd.nz))
+            return ca.vertcat(*ys), ca.diagcat(*js)
+
+        def rows(part):
+            """The elements of the symbols Yv that ``part`` computes."""
+            idx = []
+            for nd in nodes:
+                r = np.arange(nd.ny)[nd.rows[part]]
+                idx.extend(int(i) for c in range(nd.nc) for i in nd.y_off + c * nd.ny + r)
+            return Yv[idx]
+
+        f_sx, g_sx, goals_sx = self.nlp["f"], self.g, self._goal_exprs
+        outer = ca.Function("outer", [w_sx, p_sx, Yv], [f_sx, g_sx, goals_sx])
+        Ym = values(W, Pm)
+        f_mx = outer(W, Pm, Ym if ca.depends_on(f_sx, rows("fg")) else values(W, Pm, "l"))[0]
+        g_mx = outer(W, Pm, Ym if ca.depends_on(g_sx, rows("l")) else values(W, Pm, "fg"))[1]
+        goals_mx = outer(W, Pm, Ym)[2]
+        self.w, self.g = W, g_mx
+        self.nlp = {"x": W, "f": f_mx, "g": g_mx, "p": Pm}
+        self._goal_fun = ca.Function("goals", [W, Pm], [goals_mx])
+
+        def nz(e):
+            return e.nnz() > 0
+
+        # Where each per-node derivative's non-zeros sit: node c of a phase differentiates
+        # with respect to the rows z_off + c·n_z + (0 … n_z−1) of Z, and its outputs are the
+        # rows y_off + c·n_y + (0 … n_y−1) of Y (restricted to a part's rows for f and g).
+        Zs = ca.sparsify(Z)
+        Zcsr = _csr(Z)
+
+        def nonzeros(mx):
+            return ca.sparsity_cast(mx, ca.Sparsity.dense(mx.nnz(), 1))
+
+        def first_order(expr, part, fun_name, out_names):
+            """(expr, ∂expr/∂w) as an MX Function of (x, p), with ``part``'s rows of Y:
+            ∂expr/∂w = e_w + e_Y·blockdiag(∂Y_c/∂z_c)·Z."""
+            Yp = rows(part)
+            e_w, e_Y = ca.jacobian(expr, w_sx), ca.jacobian(expr, Yp)
+            d_outer = ca.Function("outer_" + fun_name, [w_sx, p_sx, Yv], [expr, e_w, e_Y])
+            ys, jvals, r_y, r_z = [], [], [], []
+            y_part = 0
+            for nd in nodes:
+                yv, jv = nd.jacobians[part](*nd.inputs(W, Pm))
+                n_part = len(range(nd.ny)[nd.rows[part]])
+                ys.append(place(nd, part, yv))
+                jvals.append(nonzeros(jv))
+                rr, cc = (np.asarray(a) for a in nd.jacobians[part].sparsity_out(1).get_triplet())  # n_part × (n_z·n_c)
+                r_y.append(y_part + (cc // nd.nz) * n_part + rr)
+                r_z.append(nd.z_off + cc)
+                y_part += n_part * nd.nc
+            e, ew, eY = d_outer(W, Pm, ca.vertcat(*ys))
+            d = ew
+            if nz(e_Y):
+                jb = ca.vertcat(*jvals)
+                if not ca.depends_on(e_Y, ca.vertcat(w_sx, p_sx, Yv)):  # constant: one sparse product
+                    M, pattern = _bilinear_map(_csr(e_Y.T), np.concatenate(r_y), Zcsr, np.concatenate(r_z),
+                                               (e_Y.shape[0], self._n_w))
+                    d = ew + ca.sparsity_cast(ca.mtimes(M, jb), pattern)
+                else:
+                    M, pattern = _bilinear_map(sp.identity(y_part, format="csr"), np.concatenate(r_y), Zcsr,
+                                               np.concatenate(r_z), (y_part, self._n_w))
+                    d = ew + ca.mtimes(eY, ca.sparsity_cast(ca.mtimes(M, jb), pattern))
+            if fun_name == "grad_f":  # a dense column, as CasADi's own
+                d = ca.densify(d.T)
+            return ca.Function("nlp_" + fun_name, [W, Pm], [e, d], ["x", "p"], out_names)
+
+        grad_f = first_order(f_sx, "all" if ca.depends_on(f_sx, rows("fg")) else "l", "grad_f", ["f", "grad_f_x"])
+        jac_g = first_order(g_sx, "all" if ca.depends_on(g_sx, rows("l")) else "fg", "jac_g", ["g", "jac_g_x"])
+
+        # Hessian of the Lagrangian.
+        sig_s, lam_s = S.sym("sigma"), S.sym("lambda", self.n_constraints)
+        phi = sig_s * f_sx + ca.dot(lam_s, g_sx)
+        phi_Y = ca.gradient(phi, Yv)
+        phi_ww = ca.hessian(phi, w_sx)[0]
+        phi_Yw, phi_YY = ca.jacobian(phi_Y, w_sx), ca.jacobian(phi_Y, Yv)
+        d2_outer = ca.Function("outer_second", [w_sx, p_sx, Yv, sig_s, lam_s], [phi_Y, phi_ww, phi_Yw, phi_YY])
+        need_y = any(ca.depends_on(nonzeros(e), Yv) for e in (phi_Y, phi_ww, phi_Yw, phi_YY))
+        need_j = nz(phi_Yw) or nz(phi_YY)
+        Yh, Jh = ca.MX.zeros(n_y), None
+        if need_j:
+            Yh, Jh = values_and_jacobian(W, Pm, "all")
+        elif need_y:
+            Yh = values(W, Pm)
+        mu, Hww, HYw, HYY = d2_outer(W, Pm, Yh, sig, lam)
+        hvals, r_a, r_b = [], [], []
+        for nd in nodes:
+            mu_c = ca.reshape(mu[nd.y_off:nd.y_off + nd.ny * nd.nc], nd.ny, nd.nc)
+            hvals.append(nonzeros(nd.hess(*nd.inputs(W, Pm), mu_c)))
+            rr, cc = (np.asarray(v) for v in nd.hess.sparsity_out(0).get_triplet())  # n_z × (n_z·n_c)
+            r_a.append(nd.z_off + (cc // nd.nz) * nd.nz + rr)
+            r_b.append(nd.z_off + cc)
+        M, pattern = _bilinear_map(Zcsr, np.concatenate(r_a), Zcsr, np.concatenate(r_b),
+                                   (self._n_w, self._n_w), triu=True)
+        H = ca.sparsity_cast(ca.mtimes(M, ca.vertcat(*hvals)), pattern)  # triu(Zᵀ·blockdiag(H_c)·Z)
+        extra = None
+        if nz(phi_ww):
+            extra = Hww
+        if need_j:
+            JYh = ca.mtimes(Jh, Zs)
+            if nz(phi_Yw):
+                cross = ca.mtimes(JYh.T, HYw)
+                extra = cross + cross.T if extra is None else extra + cross + cross.T
+            if nz(phi_YY):
+                quad = ca.mtimes([JYh.T, HYY, JYh])
+                extra = quad if extra is None else extra + quad
+        if extra is not None:
+            H = H + ca.triu(extra)
+        hess = ca.Function("nlp_hess_l", [W, Pm, sig, lam], [H],
+                           ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"])
+        return {"grad_f": grad_f, "jac_g": jac_g, "hess_lag": hess}
 
     def _describe_w(self, j: int) -> str:
         """Name of NLP variable ``j`` (for error messages)."""
@@ -1239,6 +1516,7 @@ class Transcription:
             "meshes": {k: m.describe() for k, m in self.meshes.items()},
             "options": {k: v for k, v in self.options.nlpsol_options()["ipopt"].items()},
             "graph": self.options.graph,
+            "derivatives": "nodes" if self._by_nodes else "graph",
             "symbolic_time": self.symbolic_time,
             "ipopt_t_wall": {k: float(v) for k, v in stats.items()
                              if k.startswith("t_wall_") and isinstance(v, (int, float))},

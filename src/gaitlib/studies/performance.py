@@ -226,6 +226,40 @@ def gait_table(res: dict | None = None) -> pd.DataFrame:
     return df[[c for c in cols if c in df.columns]].rename(columns={"thesis": "thesis time (GPOPS-II, labelled)"})
 
 
+def build_table(res: dict) -> pd.DataFrame:
+    """``bench_build.py``: per model and derivative path ("graph": CasADi differentiates the
+    whole NLP graph; "nodes": per-node derivative functions assembled by the chain rule),
+    the build split (problem, symbolic NLP, solver with derivatives; s), the solve (status,
+    iterations, s, ms per iteration, evaluations vs IPOPT's rest) and end to end (s)."""
+    cols = {"model": "model", "derivatives": "derivatives", "problem_s": "problem (s)", "symbolic_s": "symbolic NLP (s)",
+            "solver_s": "solver + derivatives (s)", "build_s": "build (s)", "status": "status",
+            "iterations": "iterations", "solve_s": "solve (s)", "ms_per_iteration": "ms / iteration",
+            "evals_s": "evaluations (s)", "ipopt_rest_s": "IPOPT rest (s)", "e2e_s": "build + solve (s)",
+            "objective": "objective"}
+    df = pd.DataFrame(res["rows"])
+    return df[[c for c in cols if c in df.columns]].rename(columns=cols)
+
+
+def build_findings(res: dict) -> list[str]:
+    """What ``bench_build.py`` measured, in sentences computed from its rows: the build
+    speed-up per model, per-iteration evaluation cost of both paths and end to end."""
+    df = pd.DataFrame(res["rows"])
+    out = []
+    for model, g in df.groupby("model", sort=False):
+        a, b = (g[g.derivatives == d].iloc[0] if (g.derivatives == d).any() else None for d in ("graph", "nodes"))
+        if a is None or b is None:
+            continue
+        line = (f"{model}: build {a.build_s:.1f} s with whole-graph derivatives, {b.build_s:.1f} s with per-node "
+                f"derivatives ({a.build_s / b.build_s:.0f}× faster)")
+        if "solve_s" in g and pd.notna(a.get("solve_s")) and pd.notna(b.get("solve_s")):
+            ea, eb = 1e3 * a.evals_s / max(a.iterations, 1), 1e3 * b.evals_s / max(b.iterations, 1)
+            line += (f"; evaluations {ea:.0f} vs {eb:.0f} ms per iteration; the solves took {a.iterations} vs "
+                     f"{b.iterations} iterations ({a.status} / {b.status}, objectives {a.objective:.4g} vs "
+                     f"{b.objective:.4g}): build + solve {a.e2e_s:.0f} s vs {b.e2e_s:.0f} s")
+        out.append(line + ".")
+    return out
+
+
 def msk_profile_tables(res: dict | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
     """``bench_msk_profile.py``: (runs, graph sizes). Runs: per IPOPT option variant, status,
     iterations, solve time (s), ms per iteration, IPOPT's split of the solve (Lagrangian
