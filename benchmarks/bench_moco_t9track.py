@@ -19,6 +19,10 @@ max constraint violation, RMS per coordinate), writes ``results/moco_t9track.jso
 CSV in ``results/moco_raw/``, and ends with one line per scheme::
 
     speedup_vs_moco SCHEME X
+    speedup_vs_moco_e2e SCHEME Y  (gaitlib variant)
+
+Y = Moco's setup + solve / the fastest gaitlib variant's setup + solve (medians), among the
+variants that converged in every repeat; the variant is named.
 
 X = Moco solve time / gaitlib solve time, both measured in this run (medians over
 ``--repeats``). *Solve time* is the wall time of the IPOPT call (CasADi ``nlpsol``) in
@@ -140,6 +144,10 @@ def main(argv=None):
                                  [sys.executable, str(HERE / "t9track.py"), "--scheme", scheme,
                                   "--ipopt-defaults", "--out", str(RAW)],
                                  f"gaitlib_{scheme}_ipoptdefaults"))
+            variants.append(("gaitlib (per-node derivatives)",
+                             [sys.executable, str(HERE / "t9track.py"), "--scheme", scheme,
+                              "--derivatives", "nodes", "--out", str(RAW)],
+                             f"gaitlib_{scheme}_nodes"))
             if not args.no_mx_variant:
                 variants.append(("gaitlib (MX, not expanded)",
                                  [sys.executable, str(HERE / "t9track.py"), "--scheme", scheme,
@@ -186,7 +194,7 @@ def main(argv=None):
 
     # ------------------------------------------------------------------ summary
     tools = ["moco", "gaitlib"] + ([] if args.no_defaults_variant else
-                                   ["gaitlib (IPOPT defaults)"]) + (
+                                   ["gaitlib (IPOPT defaults)"]) + ["gaitlib (per-node derivatives)"] + (
         [] if args.no_mx_variant else ["gaitlib (MX, not expanded)"])
     speedups, lines = {}, []
     head = ("| scheme | tool | rep | status | setup s | solve s | it | ms/it | objective | "
@@ -213,6 +221,7 @@ def main(argv=None):
                             "gaitlib_solve_median": med["gaitlib"],
                             "all_succeeded": ok}
         for tool, key in (("gaitlib (IPOPT defaults)", "speedup_ipopt_defaults"),
+                          ("gaitlib (per-node derivatives)", "speedup_nodes"),
                           ("gaitlib (MX, not expanded)", "speedup_mx_noexpand")):
             if tool in med:
                 speedups[scheme][key] = med["moco"] / med[tool]
@@ -223,6 +232,11 @@ def main(argv=None):
                   if r["scheme"] == scheme and r["tool"] == tool]
             e2e[tool] = statistics.median(ts) if ts else float("nan")
         speedups[scheme]["end_to_end_median"] = e2e
+        # setup + solve against the fastest gaitlib variant that converged in every repeat
+        ok = {t: v for t, v in e2e.items() if t != "moco" and all(
+            r["success"] for r in runs if r["scheme"] == scheme and r["tool"] == t)}
+        best = min(ok, key=ok.get) if ok else "gaitlib"
+        speedups[scheme]["speedup_e2e"] = {"tool": best, "speedup": e2e["moco"] / e2e[best]}
     finished = dt.datetime.now(dt.timezone.utc)
     meta = {"started_utc": started.isoformat(timespec="seconds"),
             "finished_utc": finished.isoformat(timespec="seconds"),
@@ -259,6 +273,8 @@ def main(argv=None):
                   f"{s['gaitlib_solve_median']:.2f} s = **{s['speedup']:.1f}×**"
                   + (f"; gaitlib with IPOPT defaults {s['speedup_ipopt_defaults']:.1f}×"
                      if "speedup_ipopt_defaults" in s else "")
+                  + (f"; gaitlib with per-node derivatives {s['speedup_nodes']:.1f}×"
+                     if "speedup_nodes" in s else "")
                   + (f"; gaitlib MX not expanded {s['speedup_mx_noexpand']:.1f}×"
                      if "speedup_mx_noexpand" in s else "")
                   + "; setup + solve: " + ", ".join(
@@ -289,6 +305,8 @@ def main(argv=None):
             print(f"WARNING: a {scheme} solve did not succeed (see the table's status column)")
     for scheme, s in speedups.items():
         print(f"speedup_vs_moco {scheme} {s['speedup']:.2f}")
+    for scheme, s in speedups.items():
+        print(f"speedup_vs_moco_e2e {scheme} {s['speedup_e2e']['speedup']:.2f}  ({s['speedup_e2e']['tool']})")
 
 
 if __name__ == "__main__":
