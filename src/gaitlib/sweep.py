@@ -37,7 +37,8 @@ import sys
 import time
 import traceback
 import uuid
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
@@ -45,7 +46,7 @@ from typing import Any, Callable
 from . import blas
 from .cache import NotCached
 
-__all__ = ["RunRecord", "sweep", "ACCEPTED_STATUSES", "BLAS_ENV"]
+__all__ = ["RunRecord", "sweep", "local_cluster", "ACCEPTED_STATUSES", "BLAS_ENV"]
 
 #: IPOPT return statuses counted as a solved run (``RunRecord.ok``); the status itself is
 #: always kept, so an acceptable-level stop stays visible.
@@ -194,6 +195,35 @@ def _refuse_missing(records: list[RunRecord]) -> list[RunRecord]:
     return records
 
 
+def _start_cluster(n: int):
+    """A LocalCluster of ``n`` single-threaded worker processes with gaitlib's BLAS settings."""
+    import dask
+    from distributed import LocalCluster
+
+    env = _worker_env()
+    with dask.config.set({"distributed.nanny.pre-spawn-environ": env}):
+        return LocalCluster(n_workers=n, threads_per_worker=1, processes=True, env=env,
+                            dashboard_address=None, silence_logs=40)
+
+
+@contextmanager
+def local_cluster(n_workers: int | None = None, *, scheduler: str | None = None,
+                  serial: bool = False) -> Iterator[str | None]:
+    """One LocalCluster for several :func:`sweep` calls: yields its scheduler address (pass
+    it as ``scheduler=``) and closes it afterwards. Starting a cluster costs seconds, which
+    several short sweeps (a gap diagnosis's baseline starts and candidates) would otherwise pay
+    each. With ``scheduler`` (an existing cluster) or ``serial`` nothing is started and that
+    ``scheduler`` is yielded unchanged."""
+    if scheduler is not None or serial:
+        yield scheduler
+        return
+    cluster = _start_cluster(int(n_workers or os.cpu_count() or 1))
+    try:
+        yield cluster.scheduler_address
+    finally:
+        cluster.close()
+
+
 def sweep(func: Callable[[Any], Any], items, *, scheduler: str | None = None, n_workers: int | None = None,
           serial: bool = False, progress: bool = True) -> list[RunRecord]:
     """Run ``func(arg)`` for every ``(name, arg)`` of ``items``, in parallel on dask.distributed.
@@ -238,17 +268,13 @@ def sweep(func: Callable[[Any], Any], items, *, scheduler: str | None = None, n_
     if not pairs:
         return []
 
-    import dask
-    from distributed import Client, LocalCluster, as_completed
+    from distributed import Client, as_completed
 
     cluster = None
     if scheduler is None:
         n = int(n_workers or os.cpu_count() or 1)
         n = max(1, min(n, len(pairs)))
-        env = _worker_env()
-        with dask.config.set({"distributed.nanny.pre-spawn-environ": env}):
-            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, env=env,
-                                   dashboard_address=None, silence_logs=40)
+        cluster = _start_cluster(n)
         client = Client(cluster)
         where = f"LocalCluster({n} workers x 1 thread, {cluster.scheduler_address})"
     elif isinstance(scheduler, (str, os.PathLike)) and Path(scheduler).is_file():

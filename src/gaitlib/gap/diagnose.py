@@ -66,6 +66,7 @@ import pandas as pd
 from ..problems import gait as gait_ocp
 from ..ocp import _json_default  # the same JSON encoding as saved solutions
 from .. import effects as effects_mod
+from .. import sweep as sweep_mod
 from . import io as gio
 from . import locate
 from .method import BIC_THRESHOLD, DEFAULT_BASE, EXPLAINED_PCT, PROFILE_GRID
@@ -735,13 +736,17 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
     ds = as_dataset(data, like, fill_from, n_subjects)
     spec0 = base_spec(base)
     names, skipped = candidates(spec0, ds.gait, effects)
-    b = baseline_fits(spec0, {"data": ds}, warm, objective=objective, root=root, use_cache=use_cache, detail=True,
-                      **sweep_kw)
-    base_sol = b["data"]["best"]
-    if base_sol is None:
-        raise BaselineFailed({st: s.stats["status"] for st, s in b["data"].items() if st != "best" and s is not None})
-    fits = candidate_fits(spec0, {"data": ds}, {"data": base_sol}, names, objective=objective, root=root,
-                          use_cache=use_cache, alternates=alternates_of(b), **sweep_kw)["data"]
+    kw = dict(sweep_kw)
+    with sweep_mod.local_cluster(kw.pop("n_workers", None), scheduler=kw.pop("scheduler", None),
+                                 serial=kw.get("serial", False)) as scheduler:  # one cluster for every sweep
+        b = baseline_fits(spec0, {"data": ds}, warm, objective=objective, root=root, use_cache=use_cache,
+                          detail=True, scheduler=scheduler, **kw)
+        base_sol = b["data"]["best"]
+        if base_sol is None:
+            raise BaselineFailed({st: s.stats["status"] for st, s in b["data"].items()
+                                  if st != "best" and s is not None})
+        fits = candidate_fits(spec0, {"data": ds}, {"data": base_sol}, names, objective=objective, root=root,
+                              use_cache=use_cache, alternates=alternates_of(b), scheduler=scheduler, **kw)["data"]
     settings = {"objective": objective, "candidates": names, "warm": warm is not None}
     return assemble(ds, spec0, base_sol, fits, objective=objective, resamples=resamples, seed=seed, skipped=skipped,
                     settings=settings, solution=solution)
