@@ -179,6 +179,27 @@ def test_existing_cluster_gives_bitwise_the_serial_results(serial, dask_cluster,
     assert gen2[0].value == 5.0
 
 
+def test_dask_scheduler_address_setting_sends_sweeps_to_that_cluster(dask_cluster, monkeypatch):
+    """With dask's own ``DASK_SCHEDULER_ADDRESS`` setting (here through dask's config, as the
+    environment variable sets it), a sweep without ``scheduler=`` runs on that cluster — its
+    workers are the fixture's ``w0``/``w1`` processes, not a LocalCluster's — and
+    :func:`sweep.local_cluster` yields that address without starting a cluster."""
+    import dask
+    from distributed import Client
+
+    address, _ = dask_cluster
+    with Client(address) as c:
+        workers = set(c.scheduler_info()["workers"])
+    with dask.config.set({"scheduler-address": address}):
+        recs = sw.sweep(math.sqrt, {"a": 9.0, "b": 4.0}, progress=False)
+        with sw.local_cluster() as sched:
+            assert sched == address
+    assert [r.value for r in recs] == [3.0, 2.0]
+    assert {r.worker for r in recs} <= workers
+    with sw.local_cluster(serial=True) as sched:
+        assert sched is None
+
+
 def _needs_a_solve(x):
     from gaitlib import cache
 

@@ -195,6 +195,14 @@ def _refuse_missing(records: list[RunRecord]) -> list[RunRecord]:
     return records
 
 
+def _configured_scheduler() -> str | None:
+    """dask's own setting of a scheduler address (``DASK_SCHEDULER_ADDRESS`` in the
+    environment, or ``scheduler-address`` in a dask config file), or None."""
+    import dask
+
+    return dask.config.get("scheduler-address", None) or None
+
+
 def _start_cluster(n: int):
     """A LocalCluster of ``n`` single-threaded worker processes with gaitlib's BLAS settings."""
     import dask
@@ -214,6 +222,7 @@ def local_cluster(n_workers: int | None = None, *, scheduler: str | None = None,
     several short sweeps (a gap diagnosis's baseline starts and candidates) would otherwise pay
     each. With ``scheduler`` (an existing cluster) or ``serial`` nothing is started and that
     ``scheduler`` is yielded unchanged."""
+    scheduler = scheduler or _configured_scheduler()
     if scheduler is not None or serial:
         yield scheduler
         return
@@ -235,8 +244,10 @@ def sweep(func: Callable[[Any], Any], items, *, scheduler: str | None = None, n_
     items : mapping name → arg, or a sequence of ``(name, arg)`` pairs; names are unique
         strings.
     scheduler : address of an existing dask scheduler (``"tcp://host:port"``) or path of its
-        scheduler file; ``None`` (default): start a :class:`distributed.LocalCluster` for
-        this sweep and close it afterwards. An existing cluster is never shut down.
+        scheduler file; ``None`` (default): dask's configured scheduler address if one is set
+        (``DASK_SCHEDULER_ADDRESS``, so a whole book build can run on a cluster started with
+        ``dask scheduler`` / ``dask worker``), else start a :class:`distributed.LocalCluster`
+        for this sweep and close it afterwards. An existing cluster is never shut down.
     n_workers : LocalCluster worker processes (default ``os.cpu_count()``, at most the
         number of runs); ignored with ``scheduler``.
     serial : run in this process, one after another, without dask.
@@ -271,6 +282,7 @@ def sweep(func: Callable[[Any], Any], items, *, scheduler: str | None = None, n_
     from distributed import Client, as_completed
 
     cluster = None
+    scheduler = scheduler or _configured_scheduler()
     if scheduler is None:
         n = int(n_workers or os.cpu_count() or 1)
         n = max(1, min(n, len(pairs)))
