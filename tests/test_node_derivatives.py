@@ -124,3 +124,22 @@ def test_graph_and_node_derivatives_give_the_same_functions():
     assert sa.success and sb.success
     assert sb.objective == pytest.approx(sa.objective, rel=1e-6)
     assert sb.info["derivatives"] == "nodes" and sa.info["derivatives"] == "graph"
+
+
+def test_the_spec_carries_the_derivative_path_and_keeps_every_existing_key():
+    """``GaitSpec.derivatives``: unset, the spec (and every cache key) is what it was; set,
+    it is part of the key and reaches the solver's options — in any process, since it
+    travels with the spec."""
+    from dataclasses import replace
+
+    from gaitlib.problems import gait as gait_ocp
+
+    spec = gait_ocp.GaitSpec(model="SK", cost="DT", n_intervals=3, degree=2)
+    assert "derivatives" not in spec.to_dict()
+    nodes = replace(spec, derivatives="nodes")
+    assert nodes.to_dict()["derivatives"] == "nodes" and nodes.key() != spec.key()
+    assert gait_ocp.GaitSpec.from_dict(nodes.to_dict()) == nodes
+    assert gait_ocp.build(nodes).options.derivatives == "nodes"
+    assert gait_ocp.build(spec).options.derivatives == ocp.DEFAULT_DERIVATIVES
+    with pytest.raises(ValueError, match="derivatives"):
+        gait_ocp.GaitSpec(model="SK", cost="DT", derivatives="symbolic")

@@ -80,6 +80,8 @@ def _cmd_run(args) -> int:
     from ..studies import gait
 
     kw = dict(n_intervals=args.intervals, degree=args.degree, scheme=args.scheme, max_iter=args.max_iter)
+    if args.derivatives:
+        kw["derivatives"] = args.derivatives
     if args.free_contact is not None:
         kw["free_contact"] = args.free_contact
     spec = gait.natural_gait_spec(args.model, args.cost, args.speed, **kw)
@@ -122,6 +124,8 @@ def _cmd_sweep(args) -> int:
     if not costs or not speeds:
         raise CLIError("--costs and --speeds need at least one comma-separated name each")
     kw = dict(n_intervals=args.intervals, degree=args.degree, max_iter=args.max_iter)
+    if args.derivatives:
+        kw["derivatives"] = args.derivatives
     specs = {f"{args.model}_{c}_{s}": gait_ocp.GaitSpec(model=args.model, cost=c, speed_class=s, **kw)
              for c in costs for s in speeds}
     root = check_cache(args.cache, not args.no_cache)

@@ -170,3 +170,7 @@ def _int_options(p, mesh, max_iter: int = 1000):
     p.add_argument("--degree", type=int_at_least(1), default=mesh[1],
                    help=f"collocation points per interval (default {mesh[1]}; thesis: 5)")
     p.add_argument("--max-iter", type=int_at_least(1), default=max_iter, help="IPOPT iteration limit")
+    p.add_argument("--derivatives", choices=("graph", "nodes"), default=None,
+                   help="how the NLP's exact derivatives are built: 'graph' (CasADi differentiates the whole "
+                        "NLP; the default) or 'nodes' (per-node derivatives, built in seconds; a separate "
+                        "cache entry, IPOPT may reach another local optimum)")

@@ -9,8 +9,11 @@ from pathlib import Path
 
 
 def _base(args, speed_class: str) -> dict:
-    return dict(model=args.model, cost=args.cost, speed_class=speed_class, n_intervals=args.intervals,
+    base = dict(model=args.model, cost=args.cost, speed_class=speed_class, n_intervals=args.intervals,
                 degree=args.degree, max_iter=args.max_iter)
+    if args.derivatives:
+        base["derivatives"] = args.derivatives
+    return base
 
 
 def _spec(base: dict):

@@ -228,7 +228,7 @@ for _name, _w in _T62_NMSK.items():
 
 #: Spec options that are left out of :meth:`GaitSpec.to_dict` (hence of every cache key)
 #: while unset: added after the store was written, they must not change existing keys.
-KEY_STABLE_OPTIONS = ("swing_load_max",)
+KEY_STABLE_OPTIONS = ("swing_load_max", "derivatives")
 
 
 @dataclass(frozen=True)
@@ -298,6 +298,11 @@ class GaitSpec:
         foot off + margin to the next foot contact − margin, :func:`swing_windows`). An
         ablation of the Fidelity II study (:mod:`gaitlib.studies.fidelity`): it measures what
         an unloaded swing foot costs in tracking. Tracking runs with fixed final time only.
+    derivatives : ``None`` (:data:`gaitlib.ocp.DEFAULT_DERIVATIVES`) or ``"graph"`` /
+        ``"nodes"`` (:class:`gaitlib.ocp.SolverOptions`): how the NLP's exact derivatives are
+        built. The same problem; set explicitly it is part of the cache key, because IPOPT's
+        path (and so the local optimum) can differ between the two. It travels with the spec,
+        so sweep workers and a gap diagnosis's fits use it too.
     """
 
     model: str = "SK"
@@ -328,8 +333,11 @@ class GaitSpec:
     hat_reference: tuple = ()
     effects: tuple = ()
     swing_load_max: float | None = None
+    derivatives: str | None = None
 
     def __post_init__(self):
+        if self.derivatives not in (None, "graph", "nodes"):
+            raise ValueError(f"derivatives must be None, 'graph' or 'nodes', got {self.derivatives!r}")
         if self.model not in MODELS:
             raise ValueError(f"unknown model {self.model!r}; known {MODELS}")
         if self.tf_bounds:
@@ -1040,7 +1048,8 @@ def build(spec: GaitSpec) -> GaitProblem:
     )
     problem = Problem(phases=(phase,), parameters=tuple(params), name=f"gait_{spec.model}_{spec.cost}".replace(".", ""))
     mesh = Mesh(spec.n_intervals, spec.scheme, spec.degree)
-    options = SolverOptions(tol=spec.tol, max_iter=spec.max_iter, hessian=spec.hessian)
+    options = SolverOptions(tol=spec.tol, max_iter=spec.max_iter, hessian=spec.hessian,
+                            **({"derivatives": spec.derivatives} if spec.derivatives else {}))
     return GaitProblem(spec, model, ref, problem, mesh, options, guess, p_body, p_contact, t_stim,
                        node=node, effects=fx, edot=edot)
 
