@@ -3,7 +3,8 @@ and data) solved on two derivative paths (or two machines, two code versions).
 
     .venv/bin/python benchmarks/compare_stores.py A_ROOT B_ROOT --labels graph nodes --out NAME
 
-For every key present in both roots (``<root>/gait/<key>/summary.json``): IPOPT status,
+For every key present in both roots (``<root>/gait/<key>/summary.json``, and the jumps'
+``<root>/jump/<key>/solution.json``, their final continuation stage): IPOPT status,
 iterations, build and solve time (s, as recorded when each was solved) and objective of each.
 The keys of warm-started solves include their start's content, so a chain that diverges
 early has different keys further down and is not compared. Writes
@@ -27,6 +28,11 @@ OUT = Path(__file__).resolve().parent / "results"
 
 def entries(root: Path) -> dict:
     out = {}
+    for f in sorted(Path(root).glob("jump/*/solution.json")):  # a jump: its final continuation stage
+        d = json.loads(f.read_text())
+        out[f.parent.name] = {"status": d.get("status"), "iterations": d.get("iterations"),
+                              "build_s": d.get("build_time"), "solve_s": d.get("solve_time"),
+                              "objective": d.get("objective"), "run": "jump (final stage)"}
     for f in sorted(Path(root).glob("gait/*/summary.json")):
         s = json.loads(f.read_text())
         st = s.get("stats", s)
