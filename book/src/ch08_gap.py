@@ -295,6 +295,30 @@ display(mesh_tab)
 display(Markdown(gap_study.mesh_verdict(mesh_tab, diagnose.BIC_THRESHOLD)))
 
 # %% [markdown]
+# #### The same data and the same problem on the other derivative path
+#
+# Every solve above builds the NLP's exact derivatives by letting CasADi differentiate the
+# whole NLP graph. gaitlib can also assemble them from per-node derivative functions
+# (`GaitSpec(derivatives="nodes")`, `gaitlib gap --derivatives nodes`): the same functions to
+# round-off (`tests/test_node_derivatives.py`) and the same problem, so nothing about the
+# model or the data changes — only the round-off along IPOPT's path. The Schwartz *Free* data
+# diagnosed on both paths at both meshes, and the *Slow* data (which this chapter does not
+# diagnose otherwise) at `gaitlib gap`'s default 10 × 3:
+
+# %%
+dS_nodes = gap_study.sk_diagnosis(derivatives="nodes")
+dS_coarse_nodes = gap_study.sk_diagnosis(mesh=(10, 3), derivatives="nodes")
+dSlow = gap_study.sk_diagnosis(speed_class="Slow", mesh=(10, 3))
+dSlow_nodes = gap_study.sk_diagnosis(speed_class="Slow", mesh=(10, 3), derivatives="nodes")
+path_runs = {"Free, 20 × 5, whole-graph derivatives (this chapter)": dS, "Free, 20 × 5, per-node derivatives": dS_nodes,
+             "Free, 10 × 3, whole-graph derivatives": dS_coarse, "Free, 10 × 3, per-node derivatives": dS_coarse_nodes,
+             "Slow, 10 × 3, whole-graph derivatives": dSlow, "Slow, 10 × 3, per-node derivatives": dSlow_nodes}
+path_tab = gap_study.mesh_table(path_runs, index="run")
+display(path_tab)
+labels = list(path_runs)
+display(Markdown(gap_study.path_verdict(path_tab, list(zip(labels[::2], labels[1::2])), diagnose.BIC_THRESHOLD)))
+
+# %% [markdown]
 # ### The second lab: gaitutils normative data
 #
 # The gaitutils normal data (an independent lab; speed 1.28 m/s, stride 0.99 s) have

@@ -82,16 +82,21 @@ def twin_validation(seeds=TWIN_SEEDS, base: dict | None = None, serial: bool = T
 
 
 def sk_diagnosis(source: str = "schwartz2008", speed_class: str = "Free", resamples: int = 200,
-                 serial: bool = True, mesh: tuple | None = None, **kw) -> diagnose.Diagnosis:
+                 serial: bool = True, mesh: tuple | None = None, derivatives: str | None = None,
+                 **kw) -> diagnose.Diagnosis:
     """The SK diagnosis (:func:`gaitlib.gap.diagnose`) of a committed data set. gaitutils has
     no GRFs: they are taken from Schwartz 2008 (same class) to make the problem complete and
     excluded from the gap (:func:`gaitlib.gap.io.load_real` ``fill_from``). ``mesh``:
-    ``(intervals, degree)``, default :data:`SK_BASE`'s (the thesis's 20 × 5)."""
+    ``(intervals, degree)``, default :data:`SK_BASE`'s (the thesis's 20 × 5).
+    ``derivatives``: the NLP derivative path of every solve (``GaitSpec.derivatives``;
+    None: the default)."""
     fill = "schwartz2008" if source == "gaitutils" else None
     ds = gio.load_real(speed_class, source, fill_from=fill)
     base = dict(SK_BASE, speed_class=speed_class, source=source)
     if mesh is not None:
         base.update(n_intervals=int(mesh[0]), degree=int(mesh[1]))
+    if derivatives is not None:
+        base["derivatives"] = derivatives
     if not serial and ds.filled:
         raise ValueError("a filled data set is solved in this process only (serial=True): see own_data")
     with own_data(ds.gait if ds.filled else None):
@@ -236,18 +241,19 @@ def circularity(tv_full, diag) -> str:
             "library and data from another model variant are not yet tested in this chapter.")
 
 
-def mesh_table(diags: dict) -> pd.DataFrame:
-    """The same data diagnosed on several meshes (``diags``: mesh label → Diagnosis): the
-    baseline's status, RMS z and significant cells, the verdict, the top effect and the best
-    converged candidate with its ΔBIC and % closed (:func:`summary`)."""
+def mesh_table(diags: dict, index: str = "mesh") -> pd.DataFrame:
+    """The same data diagnosed on several meshes (``diags``: mesh label → Diagnosis; or
+    other variants, named by ``index``): the baseline's status, RMS z and significant cells,
+    the verdict, the top effect and the best converged candidate with its ΔBIC and % closed
+    (:func:`summary`)."""
     rows = []
     for lab, d in diags.items():
         s = summary(d)
-        rows.append({"mesh": lab, "baseline": s["baseline_status"], "RMS z": s["rms_z"],
+        rows.append({index: lab, "baseline": s["baseline_status"], "RMS z": s["rms_z"],
                      "significant cells": f"{s['significant_cells']} of {s['cells']}", "verdict": s["verdict"],
                      "top effect": s["top"] or "—", "best candidate": s["best"] or "—",
                      "its ΔBIC": s["best_dBIC"], "its % closed": s["best_pct"]})
-    return pd.DataFrame(rows).set_index("mesh")
+    return pd.DataFrame(rows).set_index(index)
 
 
 def mesh_verdict(table: pd.DataFrame, threshold: float) -> str:
@@ -262,6 +268,30 @@ def mesh_verdict(table: pd.DataFrame, threshold: float) -> str:
     return (f"**The real-data verdict depends on the mesh** ({parts}; naming threshold ΔBIC ≤ {threshold:g}): "
             "a user running `gaitlib gap` at its default coarse mesh would read another verdict than this "
             "chapter's. The cause of the difference is not measured here.")
+
+
+def path_verdict(table: pd.DataFrame, pairs: list, threshold: float) -> str:
+    """Whether the real-data verdict survives a change of the NLP derivative path alone
+    (``pairs``: (label on one path, label on the other) rows of a :func:`mesh_table` with
+    ``index="run"``, each pair the same mesh): the same problem, derivatives equal to
+    round-off (tests/test_node_derivatives.py), so a different verdict is a different local
+    optimum of the fits, not a different model."""
+    def word(r):
+        return r["verdict"] + (f" ({r['top effect']})" if r["top effect"] != "—" else "") + (
+            f", best candidate {r['best candidate']} at ΔBIC {r['its ΔBIC']:.1f}" if r["best candidate"] != "—" else "")
+
+    same, parts = [], []
+    for a, b in pairs:
+        ra, rb = table.loc[a], table.loc[b]
+        same.append((ra["verdict"], ra["top effect"]) == (rb["verdict"], rb["top effect"]))
+        parts.append(f"{a}: {word(ra)}; {b}: {word(rb)}")
+    head = ("**The real-data verdict survives the change of derivative path**" if all(same) else
+            "**The real-data verdict changes with the derivative path alone**")
+    tail = ("" if all(same) else
+            " The two paths differ by round-off in the derivatives only; the fits end in different local "
+            "optima, so the ranking of close candidates is not a property of the data alone. A verdict that "
+            "flips under round-off should not be read as a diagnosis.")
+    return f"{head} (naming threshold ΔBIC ≤ {threshold:g}) — " + " | ".join(parts) + "." + tail
 
 
 def profile_table(diag: diagnose.Diagnosis, effect: str, stems=("emg_TA", "emg_MG", "emg_RF", "emg_LH")) -> pd.DataFrame:
