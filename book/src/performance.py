@@ -139,7 +139,9 @@ if prof is not None:
 # systems unchanged) that gives lower bounds on the solve time. Finally the compiled
 # per-node Hessians are assembled into IPOPT's exact Hessian (checked against the solver's own)
 # and the book's problem is solved with it, beside the book's solver, from the same start.
-# gaitlib's solver does not use this code; it is a measurement of what it could gain. The
+# gaitlib's solver does not compile anything: this is a measurement of what compiling could
+# gain. (The uncompiled per-node assembly is now gaitlib's `derivatives="nodes"`, above; this
+# benchmark keeps its own older assembly, which goes through a copy of the NLP.) The
 # C-to-virtual-machine ratio is a microbenchmark on this shared 2-core machine and varied
 # between runs of the script (`benchmarks/README.md` lists them); the floors move with it.
 
