@@ -49,7 +49,7 @@ from .contact import param_index
 from . import data as data_mod
 from .ocp import Parameter
 
-__all__ = ["EffectParam", "Effect", "EFFECTS", "TWIN_EFFECTS", "Context", "Bound", "bind", "validate",
+__all__ = ["EffectParam", "Effect", "EFFECTS", "TWIN_EFFECTS", "LAB_EFFECTS", "MODEL_EFFECTS", "PLATE_THRESHOLD_N", "Context", "Bound", "bind", "validate",
            "data_columns", "adjust_data", "theta_of", "ARM"]
 
 
@@ -676,10 +676,186 @@ ACTIVATION_TIMING = Effect(
 )
 
 
+# ---- laboratory effects: how the data were measured and processed ---------------------
+#
+# Data-model effects like ``left_shift``: the motion is the model's, the *data* are read
+# differently. Each changes the tracked references inside the NLP (``reference``) and, for
+# the gap of its solution, the data the same way (``data_adjust``); the SDs are left as
+# they are (they describe the subjects' spread, not the error). The left/right step-time
+# asymmetry of a laboratory is ``left_shift`` (an extra lag of the left leg).
+
+#: Vertical force (N) above which a foot counts as on the force plate (a typical plate
+#: threshold; :data:`GRF_AP_BIAS` acts only there, as a plate's offset is zeroed in swing).
+PLATE_THRESHOLD_N = 10.0
+
+
+def _replace_gait(gait, mean, note):
+    import dataclasses
+
+    return dataclasses.replace(gait, mean=mean, notes=tuple(gait.notes) + (note,))
+
+
+def _offset_reference(joint):
+    def reference(d, th, ctx, t):
+        return {f"ref_{joint}_{s}": d[f"ref_{joint}_{s}"] - th["c"] for s in cv.SIDES}
+
+    return reference
+
+
+def _offset_adjust(joint):
+    def adjust(gait, th):
+        c = float(th["c"])
+        if c == 0.0:
+            return gait
+        mean = gait.mean.copy()
+        for s in cv.SIDES:
+            mean[f"{joint}_{s}"] = mean[f"{joint}_{s}"] - c
+        return _replace_gait(gait, mean, f"{joint} angle offset {c:+.4f} rad removed")
+
+    return adjust
+
+
+def _angle_offset(joint: str, label: str) -> Effect:
+    return Effect(
+        name=f"{joint}_offset",
+        title=f"{label} angle offset (marker placement)",
+        doc=f"""A constant offset of the measured {label} angle: markers placed a little off the
+    anatomical landmarks (or a joint centre estimated off) shift a joint angle by a roughly
+    constant amount over the cycle (Della Croce et al. 2005 report several degrees). The data
+    are read as the true angle plus c: the NLP tracks the data's {label} angle minus c (both
+    legs: the public data's left leg is generated from the right one, so it carries the same
+    offset), and the gap of its solution is computed against the data minus c.
+
+    A data-model effect (no physics changes); its null value c = 0 is the baseline. The
+    offset is in the model's sign convention for the {label} coordinate
+    (:data:`gaitlib.conventions.DATA_SIGN`: the data's {label} angle times
+    {cv.DATA_SIGN[joint]:+g}).
+
+    Parameters
+    ----------
+    c : offset of the measured {label} angle, rad (model convention); bounds [−0.26, 0.26]
+        (±15°); null 0.
+    """,
+        params=(EffectParam("c", "rad", -0.26, 0.26, 0.0, f"{label} angle offset"),),
+        twin_magnitudes=(0.035, 0.07, 0.14),
+        reference=_offset_reference(joint),
+        data_adjust=_offset_adjust(joint),
+    )
+
+
+HIP_OFFSET = _angle_offset("hip", "hip")
+KNEE_OFFSET = _angle_offset("knee", "knee")
+ANKLE_OFFSET = _angle_offset("ankle", "ankle")
+
+_GRF_REFS = tuple(f"grf_{a}_{s}" for s in cv.SIDES for a in ("x", "y"))
+
+
+def _grf_scale_reference(d, th, ctx, t):
+    return {f"ref_{g}": d[f"ref_{g}"] / (1 + th["s"]) for g in _GRF_REFS}
+
+
+def _grf_scale_adjust(gait, th):
+    s = float(th["s"])
+    if s == 0.0:
+        return gait
+    mean = gait.mean.copy()
+    for g in _GRF_REFS:
+        mean[g] = mean[g] / (1 + s)
+    return _replace_gait(gait, mean, f"force-plate gain {1 + s:.4f} removed")
+
+
+GRF_SCALE = Effect(
+    name="grf_scale",
+    title="force-plate gain (calibration)",
+    doc="""A force plate whose calibration is off by a factor reports (1 + s) times the true
+    ground reaction force. The NLP tracks the data's GRFs divided by (1 + s) (both
+    components, both feet), and the gap of its solution is computed against the data so
+    corrected. The data's joint moments are left as published: a laboratory's inverse
+    dynamics would carry part of the gain into them, which this effect does not model.
+
+    A data-model effect; its null value s = 0 is the baseline.
+
+    Parameters
+    ----------
+    s : relative gain error of the plates, 1; bounds [−0.2, 0.2]; null 0.
+    """,
+    params=(EffectParam("s", "1", -0.2, 0.2, 0.0, "relative force-plate gain error"),),
+    twin_magnitudes=(0.03, 0.06, 0.1),
+    reference=_grf_scale_reference,
+    data_adjust=_grf_scale_adjust,
+)
+
+
+def _on_plate(gait) -> dict:
+    """Per side, 1 where the foot is on the plate (vertical force above
+    :data:`PLATE_THRESHOLD_N`), else 0, on the data's grid. A left leg generated from the
+    right one (:func:`left_generated`) gets the right leg's indicator through the same
+    order-5 Fourier shift (so its bias is what the generation made of the right leg's)."""
+    on = {s: (gait.mean[f"grf_y_{s}"].to_numpy(float) > PLATE_THRESHOLD_N).astype(float) for s in cv.SIDES}
+    if left_generated(gait):
+        on["l"] = data_mod.fourier_shift(on["r"], gait.left_shift, FOURIER_ORDER)
+    return on
+
+
+def _grf_ap_bias_columns(ref, tau_grid):
+    gait = ref.gait
+    t = np.linspace(0.0, 1.0, len(gait.mean))
+    return {f"fx.grf_ap_bias.on_{s}": np.interp(np.mod(np.asarray(tau_grid, float), 1.0), t, v)
+            for s, v in _on_plate(gait).items()}
+
+
+def _grf_ap_bias_reference(d, th, ctx, t):
+    return {f"ref_grf_x_{s}": d[f"ref_grf_x_{s}"] - th["b"] * d[f"fx.grf_ap_bias.on_{s}"] for s in cv.SIDES}
+
+
+def _grf_ap_bias_adjust(gait, th):
+    b = float(th["b"])
+    if b == 0.0:
+        return gait
+    mean = gait.mean.copy()
+    for s, on in _on_plate(gait).items():
+        mean[f"grf_x_{s}"] = mean[f"grf_x_{s}"] - b * on
+    return _replace_gait(gait, mean, f"force-plate AP bias {b:+.3f} N removed")
+
+
+GRF_AP_BIAS = Effect(
+    name="grf_ap_bias",
+    title="force-plate anterior–posterior bias",
+    doc=f"""A force plate whose anterior–posterior channel has an offset (zero drift, cross-talk
+    from the vertical channel at rest) adds a constant b to the AP force while the foot is
+    on the plate (vertical force above {PLATE_THRESHOLD_N:g} N, :data:`PLATE_THRESHOLD_N`;
+    in swing the plate is zeroed by processing). The NLP tracks the data's AP force minus b
+    in stance (both feet; the stance indicator comes from the data's own vertical force, and
+    for a left leg generated from the right one it is the right leg's indicator shifted by
+    the same order-5 Fourier fit), and the gap of its solution is computed against the data
+    so corrected.
+
+    A data-model effect; its null value b = 0 is the baseline.
+
+    Parameters
+    ----------
+    b : AP force offset in stance, N (+ forward, the model's x); bounds [−20, 20]; null 0.
+    """,
+    params=(EffectParam("b", "N", -20.0, 20.0, 0.0, "AP force offset in stance"),),
+    twin_magnitudes=(4.0, 8.0, 16.0),
+    reference=_grf_ap_bias_reference,
+    columns=_grf_ap_bias_columns,
+    data_adjust=_grf_ap_bias_adjust,
+)
+
+
 #: The registry of candidate effects by name.
 EFFECTS: dict[str, Effect] = {e.name: e for e in (
     SEGMENT_INERTIA, BODY_MASS, HAT_COM, ARM_SWING, FRICTION, FOOT_CONTACT, LEFT_SHIFT,
-    CO_CONTRACTION, JOINT_STIFFNESS, ACTIVATION_TIMING)}
+    CO_CONTRACTION, JOINT_STIFFNESS, ACTIVATION_TIMING,
+    HIP_OFFSET, KNEE_OFFSET, ANKLE_OFFSET, GRF_SCALE, GRF_AP_BIAS)}
+
+#: The laboratory (measurement and processing) effects: how the data were recorded, not
+#: what the body does.
+LAB_EFFECTS = ("hip_offset", "knee_offset", "ankle_offset", "grf_scale", "grf_ap_bias")
+#: The model effects: what the body does that the model lacks (and ``left_shift``, how the
+#: public data's left leg was made).
+MODEL_EFFECTS = tuple(n for n in EFFECTS if n not in LAB_EFFECTS)
 
 #: Effects validated on twins of the SK model: those of physics whose signature lies in the
 #: angles, torques and GRFs. (``left_shift`` concerns data whose left leg is generated from

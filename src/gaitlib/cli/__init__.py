@@ -18,6 +18,9 @@ Commands
                      ranking of candidate effects, shrink; ``diagnosis.json`` + figures (gaitlib.gap)
 ``gap-twin --effect NAME --magnitude X --seed N --out CSV``   a twin data set with a known
                      injected effect, in the tidy format
+``gap-validate --out DIR``   the gap diagnosis on real data manipulated by known amounts
+                     (in-library and out-of-library; gaitlib.gap.validate): ``validation.json``,
+                     ``cases.csv``, ``scores.csv``, ``confusion.csv``
 ``cache verify [--remove] [--root DIR]``   check every cached solution against its checksums;
                      ``--remove`` deletes the corrupt or incomplete ones (they are re-solved on use)
 
@@ -37,7 +40,8 @@ existing non-empty ``--out`` is refused unless ``--overwrite``, which replaces o
 files the command owns: ``run`` — the files its new ``summary.json`` lists and those the
 old one listed; ``sweep`` — ``sweep.csv`` and the run folders of the new and the old
 ``sweep.csv``; ``gap`` — ``diagnosis.json``, ``located.csv``, ``ranking.csv``,
-``shrink_*.csv`` and its figures; ``gap-twin`` — the CSV and its ``.truth.json``. Other
+``shrink_*.csv`` and its figures; ``gap-twin`` — the CSV and its ``.truth.json``;
+``gap-validate`` — its four files. Other
 files in the folder are kept.
 """
 

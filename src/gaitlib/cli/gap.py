@@ -69,7 +69,8 @@ def cmd_gap(args) -> int:
                        seed=args.seed, root=root, use_cache=not args.no_cache, serial=args.serial,
                        n_workers=args.workers, scheduler=args.scheduler, progress=True)
         d.save(o.tmp, figures=not args.no_figures)
-    cols = ["rank", "effect", "n_params", "start", "nests_baseline", "status", "pct_closed", "dAIC", "dBIC"]
+    cols = ["rank", "effect", "n_params", "start", "nests_baseline", "status", "pct_closed", "dAIC", "dBIC",
+            "residual_ratio"]
     print(d.ranking[cols].to_string(index=False, float_format=lambda v: f"{v:.2f}"))
     print(json.dumps({"top_effect": d.top_effect, "verdict": d.verdict, "rss_baseline": d.located.rss,
                       "n_eff": d.located.n_eff, "baseline_status": d.baseline.stats["status"]}, indent=1))
@@ -129,6 +130,35 @@ def cmd_gap_twin(args) -> int:
     return 0
 
 
+VALIDATE_FILES = ("validation.json", "cases.csv", "scores.csv", "confusion.csv")
+
+
+def cmd_gap_validate(args) -> int:
+    """``gaitlib gap-validate --out DIR``: the non-circular validation (:mod:`gaitlib.gap.validate`):
+    manipulated real data diagnosed as a user's CSV; writes validation.json, cases.csv,
+    scores.csv, confusion.csv."""
+    from . import common as cli
+    from ..gap import validate as V
+
+    sets = ("independent", "out-of-library") if args.set == "all" else (args.set,)
+    base = _base(args, args.speed)
+    _spec(base)
+    root = cli.check_cache(args.cache, not args.no_cache)
+    out = Path(args.out)
+    table = V.draws(sets, args.per_band)
+    print(f"gaitlib gap-validate: {len(table)} manipulated data sets + the unedited one ({', '.join(sets)}; "
+          f"method {V.METHOD.hash()}); baseline {args.model} {args.cost} {args.intervals} x {args.degree}", flush=True)
+    with cli.Output(out, overwrite=args.overwrite, files=VALIDATE_FILES, last=("validation.json",),
+                    what="the validation's files (validation.json, cases.csv, scores.csv, confusion.csv)") as o:
+        v = V.run(sets, per_band=args.per_band, speed_class=args.speed, base=base, root=root,
+                  use_cache=not args.no_cache, serial=args.serial, n_workers=args.workers, scheduler=args.scheduler,
+                  progress=True)
+        v.save(o.tmp)
+    print(v.scores().to_string(index=False, float_format=lambda x: f"{x:.0f}"))
+    print(f"wrote {out / 'validation.json'}")
+    return 0
+
+
 def _common(p, mesh=(10, 3)):
     from .common import _add_output_options, _int_options
 
@@ -181,3 +211,15 @@ def add_parsers(sub) -> None:
     t.add_argument("--out", required=True, help="output CSV (its truth goes to <stem>.truth.json beside it)")
     _common(t)
     t.set_defaults(func=cmd_gap_twin)
+
+    v = sub.add_parser("gap-validate", help="validate the gap diagnosis on real data manipulated by known amounts "
+                                            "(in-library and out-of-library effects)")
+    v.add_argument("--out", required=True, help="output directory")
+    v.add_argument("--set", default="all", choices=["all", "independent", "out-of-library"])
+    v.add_argument("--per-band", type=int_at_least(1), default=1, help="draws per manipulation and magnitude band")
+    v.add_argument("--speed", default="Free", help="speed class of the real data (default Free)")
+    v.add_argument("--serial", action="store_true", help="solve in this process without dask")
+    v.add_argument("--workers", type=int_at_least(1), default=None, help="LocalCluster workers (default: cores)")
+    v.add_argument("--scheduler", default=None, help="existing dask scheduler address")
+    _common(v)
+    v.set_defaults(func=cmd_gap_validate)

@@ -42,8 +42,10 @@ residual, :func:`gaitlib.gap.locate.resels`): ΔAIC = n_eff ln(RSS_k / RSS_0) + 
 ΔBIC = n_eff ln(RSS_k / RSS_0) + k ln n_eff (k = parameters added; for profiled effects the
 magnitude counts as one). Raw figures (% of the RSS closed) are reported beside them.
 Effects are ranked by ΔBIC; the top effect must have ΔBIC ≤ :data:`BIC_THRESHOLD`
-("very strong" evidence on Kass & Raftery's scale) and a converged solve, else the
-diagnosis is ``"unexplained"``. Verdict ``"explained"`` if it also closes ≥ 50 % of the
+("very strong" evidence on Kass & Raftery's scale) and a converged solve, and (the
+out-of-library test, :attr:`gaitlib.gap.method.Method.runner_up_margin`) a ΔBIC below
+every other ranked candidate's by the margin, else the diagnosis is ``"unexplained"``
+(``contenders``: the candidates within the margin of the best). Verdict ``"explained"`` if it also closes ≥ 50 % of the
 RSS, ``"partial"`` otherwise.
 
 Interval: the data's means are redrawn B times as mean + SD*/√n · g(τ) (g: smooth unit
@@ -69,7 +71,7 @@ from .. import effects as effects_mod
 from .. import sweep as sweep_mod
 from . import io as gio
 from . import locate
-from .method import BIC_THRESHOLD, DEFAULT_BASE, EXPLAINED_PCT, PROFILE_GRID
+from .method import BIC_THRESHOLD, DEFAULT_BASE, EXPLAINED_PCT, METHOD, PROFILE_GRID, RUNNER_UP_MARGIN
 from .noise import smooth_noise
 from .nullstart import null_start_many
 from .solve import solve_many
@@ -80,7 +82,7 @@ __all__ = ["BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "Fit", "Diagnosis", 
            "candidates", "base_spec", "as_dataset", "baseline_fits", "pick_best", "BASELINE_STARTS",
            "COARSE_MESH", "GRF_SD_FACTOR", "RETRY_MARGIN", "grf_weighted", "candidate_fits", "needs_retry",
            "alternates_of", "lowest_objective", "BaselineFailed", "nesting", "ABOVE_LOCATED", "FIT_STARTS",
-           "with_effects"]
+           "with_effects", "contenders_of"]
 
 
 def base_spec(base=None) -> gait_ocp.GaitSpec:
@@ -242,9 +244,10 @@ class Diagnosis:
                           "dAIC": "n_eff ln(RSS_k/RSS_0) + 2k", "dBIC": "n_eff ln(RSS_k/RSS_0) + k ln n_eff",
                           "threshold_dBIC": BIC_THRESHOLD, "explained_pct": EXPLAINED_PCT},
             "located": {"summary": self.located.summary(), "table": rec(self.located.table),
-                        "channels": rec(self.located.channels)},
+                        "channels": rec(self.located.channels), "residuals": rec(self.located.residuals)},
             "ranking": rec(self.ranking),
             "top_effect": self.top_effect,
+            "contenders": self.settings.get("contenders", []),
             "verdict": self.verdict,
             "shrink": {k: {"table": rec(v), "pct_closed": float(self.ranking.set_index("effect").loc[k, "pct_closed"]),
                            "interval_95": self.intervals.get(k)} for k, v in self.shrink.items()},
@@ -353,7 +356,9 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
         row = {"effect": name, "title": e.title, "n_params": f.n_params, "identify": f.identify,
                "parameters": f.thetas.get(name, {}), "status": f.status, "ok": f.ok, "start": f.start,
                "nests_baseline": nests, "search": f.search, "rss_before": loc0.rss, "rss_after": np.nan,
-               "pct_closed": np.nan, "dAIC": np.nan, "dBIC": np.nan}
+               "pct_closed": np.nan, "dAIC": np.nan, "dBIC": np.nan, "residual_ratio": np.nan}
+        if f.located is not None and f.located.residuals is not None:
+            row["residual_ratio"] = float(f.located.residuals["peak_ratio"].max())
         if f.located is not None:
             row["rss_after"] = rk = f.located.rss
             if nests and f.search == "ok" and rk > loc0.rss * (1.0 + RETRY_MARGIN):
@@ -377,7 +382,8 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
         rank[:m] = np.arange(1, m + 1)
         ranking.insert(0, "rank", rank)
     elig = ranking[(ranking["ok"]) & (ranking["dBIC"] <= BIC_THRESHOLD)] if not ranking.empty else ranking
-    if len(elig):
+    contenders = contenders_of(ranking)
+    if len(elig) and len(contenders) <= 1:
         top_effect = str(elig.iloc[0]["effect"])
         verdict = "explained" if float(elig.iloc[0]["pct_closed"]) >= EXPLAINED_PCT else "partial"
     else:
@@ -403,9 +409,25 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
         ranking["pct_closed_hi"] = ranking["effect"].map(lambda k: intervals.get(k, [np.nan, np.nan])[1])
     sol_loc = locate.locate(solution, ds) if solution is not None else None
     st = dict(settings or {})
-    st.update({"resamples": resamples, "seed": seed, "bic_threshold": BIC_THRESHOLD})
+    st.update({"resamples": resamples, "seed": seed, "bic_threshold": BIC_THRESHOLD,
+               "runner_up_margin": RUNNER_UP_MARGIN, "contenders": contenders if len(elig) else [],
+               "method": METHOD.to_dict(), "method_hash": METHOD.hash()})
     return Diagnosis(ds, spec0, objective, base_sol, loc0, fits, ranking, top_effect, verdict, shrink, intervals,
                      dict(skipped or {}), st, sol_loc)
+
+
+def contenders_of(ranking: pd.DataFrame, margin: float = RUNNER_UP_MARGIN) -> list:
+    """The ranked, converged candidates whose ΔBIC is within ``margin`` of the best one's
+    (the best one first); with ``margin`` 0 (no out-of-library test) only the best one."""
+    if ranking.empty:
+        return []
+    r = ranking[ranking["ok"] & np.isfinite(ranking["dBIC"].astype(float))]
+    if r.empty:
+        return []
+    best = float(r["dBIC"].min())
+    if margin <= 0:
+        return [str(r.loc[r["dBIC"].idxmin(), "effect"])]
+    return [str(e) for e in r.loc[r["dBIC"] < best + margin, "effect"]]
 
 
 def _shrink_table(loc0: locate.Located, lk: locate.Located) -> pd.DataFrame:

@@ -13,7 +13,7 @@ from .. import marks as mk
 from .locate import PHASES
 from .method import BIC_THRESHOLD
 
-__all__ = ["gap_heatmap", "ranking_bars", "shrink_heatmaps", "confusion_plot", "channel_curves"]
+__all__ = ["gap_heatmap", "ranking_bars", "shrink_heatmaps", "confusion_plot", "channel_curves", "validation_plot"]
 
 
 def _label(ch: str) -> str:
@@ -217,3 +217,28 @@ def data_views(loc_a, loc_b, channels, labels=("data as tracked", "left leg shif
     axs[0][0].legend(fontsize=7)
     fig.tight_layout()
     return mk.mark_all(fig, mark)
+
+
+def validation_plot(rows, threshold: float | None = None, title: str = ""):
+    """The non-circular validation (:class:`gaitlib.gap.validate.Validation` ``rows``): for
+    each manipulation of the independent set, how much worse the baseline fits after it
+    (``added_pct``, % of the unedited data's RSS; x) against the injected effect's own ΔBIC
+    (y; dashed: the naming threshold); filled markers named right, open ones not."""
+    import matplotlib.pyplot as plt
+
+    threshold = BIC_THRESHOLD if threshold is None else threshold
+    r = rows[rows["set"] == "independent"]
+    fig, ax = plt.subplots(figsize=(7.5, 4.2))
+    for i, (inj, g) in enumerate(r.groupby("injection", sort=False)):
+        col, ok = f"C{i}", g["correct"].astype(bool)
+        ax.scatter(g.loc[ok, "added_pct"], g.loc[ok, "expected_dBIC"], s=46, color=col)
+        ax.scatter(g.loc[~ok, "added_pct"], g.loc[~ok, "expected_dBIC"], s=46, facecolors="none", edgecolors=col)
+        ax.plot([], [], "o", color=col, label=inj)
+    ax.axhline(threshold, ls="--", color="0.4", lw=1)
+    ax.set_xlabel("baseline RSS added by the manipulation (% of the unedited data's)")
+    ax.set_ylabel("ΔBIC of the injected effect")
+    ax.legend(fontsize=7, loc="best", title="filled: named right", title_fontsize=7)
+    ax.set_title(title or "manipulated real data: visibility of the injection vs evidence for the injected effect",
+                 fontsize=9)
+    fig.tight_layout()
+    return fig

@@ -33,6 +33,14 @@ valid (conservative inside the band) one-sided p-value. Multiple comparisons: Bo
 over the 50 points of the channel (no smoothness assumption; conservative for smooth
 curves). A channel × phase cell is significant if any of its points is at α = 0.05.
 
+Residual loads. The HAT's residual forces and moment (the generalised forces on the
+pelvis coordinates that no actuator supplies) are located too, against OpenSim's residual
+guidelines (:func:`residual_thresholds`) rather than a data SD: an effect the residual
+actuators absorb (a load the model lacks) would show there. They are not part of the RSS
+(a guideline is not a noise model). The gait problem bounds them (thesis Eq 4.8: 1 N,
+1 N, 0.1 N·m), far below the guidelines for a child (≈ 20 N and ≈ 3 N·m), so residuals
+cannot absorb an effect of this library: its loads show in the tracked channels.
+
 Effective sample size (for the information criteria of :mod:`gaitlib.gap.diagnose`):
 the residual curves are smooth, so their 50 points are not independent. Per channel we
 count resels as spm1d does for 1-D fields: FWHM = √(4 ln 2 / λ) samples with λ =
@@ -53,11 +61,16 @@ from .. import conventions as cv
 from ..problems import gait as gait_ocp
 from .. import effects as effects_mod
 from .io import DataSet, filled_channels
+from ..validity import RESIDUAL_FORCE_FRACTION, RESIDUAL_MOMENT_FRACTION
 
 __all__ = ["PHASES", "PHASE_NAMES", "N_GRID", "phase_edges", "phase_of", "sim_channels", "Located", "locate",
-           "resels", "ALPHA", "SD_FLOOR"]
+           "resels", "ALPHA", "SD_FLOOR", "residual_thresholds", "residual_table",
+           "COM_HEIGHT_FRACTION"]
 
 PHASES = ("LR", "MSt/TSt", "PSw", "ISw", "MSw", "TSw")
+#: COM height as a fraction of body height in standing (as :func:`gaitlib.validity.check`'s
+#: default): ≈ 0.55, just above the hip joint (which Winter 2009, Table 4.1, puts at 0.530).
+COM_HEIGHT_FRACTION = 0.55
 PHASE_NAMES = {"LR": "loading response", "MSt/TSt": "mid/terminal stance", "PSw": "pre-swing",
                "ISw": "initial swing", "MSw": "mid swing", "TSw": "terminal swing"}
 N_GRID = 50
@@ -93,7 +106,8 @@ def _emg_map(source: str) -> dict:
 
 def sim_channels(sol: "gait_ocp.GaitSolution", source: str = "schwartz2008") -> pd.DataFrame:
     """The solution's channels on normalised time τ = t / t_f (index, one period, sorted):
-    angles ``hip_r`` …, net torques ``tau_hip_r`` …, GRFs ``grf_x_r`` …, pelvis tilt and,
+    angles ``hip_r`` …, net torques ``tau_hip_r`` …, GRFs ``grf_x_r`` …, pelvis tilt, the
+    HAT residual loads ``res_R_x``, ``res_R_y`` (N), ``res_R_z`` (N·m) and,
     for NMSK (excitations) or MSK (generator activations), ``emg_<stem>_<side>`` on the
     data's EMG channel names."""
     tf = float(sol.stats["tf_s"])
@@ -105,6 +119,9 @@ def sim_channels(sol: "gait_ocp.GaitSolution", source: str = "schwartz2008") -> 
     for g in gait_ocp.GRF_CHANNELS:
         out[g] = sol.grf[g].to_numpy()
     out["pelvis_tilt"] = sol.q["pelvis_tilt"].to_numpy()
+    if getattr(sol, "residuals", None) is not None:
+        for r in cv.RESIDUALS:
+            out[f"res_{r}"] = sol.residuals[r].to_numpy()
     for m, stem in _emg_map(source).items():
         for s in cv.SIDES:
             if sol.excitations is not None:
@@ -174,6 +191,7 @@ class Located:
     channels: pd.DataFrame
     excluded: list = field(default_factory=list)
     n_subjects: int = 1
+    residuals: pd.DataFrame | None = None  # :func:`residual_table`; not in the RSS
 
     @property
     def rss(self) -> float:
@@ -200,7 +218,9 @@ class Located:
         return {"rss": self.rss, "n_points": self.n_points, "n_eff": self.n_eff, "rms_z": self.rms_z,
                 "n_subjects": self.n_subjects,
                 "significant_cells": int(self.table["significant"].sum()), "cells": int(len(self.table)),
-                "excluded": [{"channel": d["id"], "reason": d["reason"]} for d in self.excluded]}
+                "excluded": [{"channel": d["id"], "reason": d["reason"]} for d in self.excluded],
+                "residuals_over_guideline": (None if self.residuals is None
+                                             else [str(c) for c in self.residuals.loc[self.residuals["over"], "channel"]])}
 
 
 def locate(sim, ds, thetas: dict | None = None, exclude=()) -> Located:
@@ -249,7 +269,40 @@ def locate(sim, ds, thetas: dict | None = None, exclude=()) -> Located:
                       "rms_z": float(np.sqrt(np.mean(z**2))), "significant": bool(np.any(p < ALPHA))})
     points = pd.concat(rows, ignore_index=True) if rows else pd.DataFrame()
     table = _aggregate(points)
-    return Located(points, table, pd.DataFrame(chans), exc, n)
+    res = residual_table(sim, gait) if all(f"res_{r}" in sim.columns for r in cv.RESIDUALS) else None
+    return Located(points, table, pd.DataFrame(chans), exc, n, res)
+
+
+def residual_thresholds(gait) -> dict:
+    """OpenSim's residual guidelines (Hicks et al. 2015, J Biomech Eng 137:020905; the same
+    fractions as the validity gates, :data:`gaitlib.validity.RESIDUAL_FORCE_FRACTION` and
+    :data:`~gaitlib.validity.RESIDUAL_MOMENT_FRACTION`: peak residual force ≤ 5 % of the peak
+    external force, peak residual moment ≤ 1 % of COM height × that force) for the data's
+    child: peak external force = the
+    peak magnitude of the data's total GRF (both feet), COM height = :data:`COM_HEIGHT_FRACTION`
+    × body height. Returns channel → threshold (N, N, N·m)."""
+    m = gait.mean
+    fx = m["grf_x_r"].to_numpy(float) + m["grf_x_l"].to_numpy(float)
+    fy = m["grf_y_r"].to_numpy(float) + m["grf_y_l"].to_numpy(float)
+    f_peak = float(np.max(np.hypot(fx, fy)))
+    return {"R_x": RESIDUAL_FORCE_FRACTION * f_peak, "R_y": RESIDUAL_FORCE_FRACTION * f_peak,
+            "R_z": RESIDUAL_MOMENT_FRACTION * COM_HEIGHT_FRACTION * float(gait.body_height) * f_peak}
+
+
+def residual_table(sim: pd.DataFrame, gait) -> pd.DataFrame:
+    """The HAT residual loads as located channels: per residual, its peak and RMS over the
+    cycle, the guideline threshold (:func:`residual_thresholds`), peak/threshold and whether
+    it is over. The residuals have no data SD: they are compared with the guideline, not
+    standardised, and are not part of the RSS (they are bounded by the problem, Eq 4.8)."""
+    thr = residual_thresholds(gait)
+    rows = []
+    for r in cv.RESIDUALS:
+        v = sim[f"res_{r}"].to_numpy(float)
+        peak = float(np.max(np.abs(v)))
+        rows.append({"channel": f"residual:{r}", "unit": "N*m" if r == "R_z" else "N", "peak": peak,
+                     "rms": float(np.sqrt(np.mean(v**2))), "threshold": thr[r], "peak_ratio": peak / thr[r],
+                     "over": peak > thr[r]})
+    return pd.DataFrame(rows)
 
 
 def _aggregate(points: pd.DataFrame) -> pd.DataFrame:

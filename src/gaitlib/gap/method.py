@@ -1,15 +1,69 @@
-"""The gap diagnosis's settings: the thresholds and grids :mod:`gaitlib.gap.diagnose` decides
-with and its figures draw."""
+"""The gap diagnosis's settings in one frozen object: the thresholds and grids
+:mod:`gaitlib.gap.diagnose` decides with and its figures draw.
+
+:data:`METHOD` is the method in use; :meth:`Method.hash` names it. The validation of
+:mod:`gaitlib.gap.validate` derives its draws (effects, magnitudes, seeds) from that hash,
+so any change of the method redraws the validation instead of re-scoring the draws the
+method was tuned on. The module-level names (``BIC_THRESHOLD`` …) are the fields of
+:data:`METHOD`.
+"""
 
 from __future__ import annotations
 
-__all__ = ["BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "EXPLAINED_PCT"]
+import hashlib
+import json
+from dataclasses import asdict, dataclass
+
+__all__ = ["Method", "METHOD", "BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "EXPLAINED_PCT", "RUNNER_UP_MARGIN"]
+
+
+@dataclass(frozen=True)
+class Method:
+    """How the diagnosis decides.
+
+    Attributes
+    ----------
+    bic_threshold : ΔBIC a top effect must reach (≤) to be named ("very strong" evidence on
+        Kass & Raftery's scale).
+    explained_pct : % of the RSS a named effect must close for the verdict "explained"
+        (else "partial").
+    profile_grid : fixed magnitudes tried for ``identify="profile"`` effects that need a
+        re-solve, ((effect, (magnitudes …)), …).
+    base : the default baseline, ((field, value), …) of a
+        :class:`~gaitlib.problems.gait.GaitSpec`: SK, data tracking (Eq 4.11), 10 × 3 LGR.
+    runner_up_margin : the out-of-library test (0: off). The top effect is named only if its
+        ΔBIC is below every other ranked candidate's by at least this much (a Bayes factor
+        of the top effect *over the runner-up*, not only over the baseline); otherwise the
+        diagnosis is "unexplained" and names the contenders. When the data hold a gap no
+        library effect represents, several effects each absorb a part of it and none stands
+        out; when one effect is the cause, it does.
+    """
+
+    bic_threshold: float = -10.0
+    explained_pct: float = 50.0
+    profile_grid: tuple = (("co_contraction", (0.1, 0.2, 0.35, 0.5)), ("joint_stiffness", (-0.5, 1.0, 2.0, 3.0)))
+    base: tuple = (("model", "SK"), ("cost", "DT"), ("n_intervals", 10), ("degree", 3))
+    runner_up_margin: float = 10.0
+
+    def to_dict(self) -> dict:
+        return json.loads(json.dumps(asdict(self)))
+
+    def hash(self) -> str:
+        """16 hex digits of the SHA-256 of the method's fields (canonical JSON)."""
+        text = json.dumps(self.to_dict(), sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+#: The method in use.
+METHOD = Method()
 
 #: ΔBIC a top effect must reach (≤) to be named.
-BIC_THRESHOLD = -10.0
+BIC_THRESHOLD = METHOD.bic_threshold
 #: Fixed magnitudes tried for ``identify="profile"`` effects that need a re-solve.
-PROFILE_GRID = {"co_contraction": (0.1, 0.2, 0.35, 0.5), "joint_stiffness": (-0.5, 1.0, 2.0, 3.0)}
+PROFILE_GRID = {k: tuple(v) for k, v in METHOD.profile_grid}
 #: Default baseline: SK, data-tracking cost (Eq 4.11), 10 × 3 LGR.
-DEFAULT_BASE = dict(model="SK", cost="DT", n_intervals=10, degree=3)
+DEFAULT_BASE = dict(METHOD.base)
 #: % of the RSS a named effect must close for the verdict "explained" (else "partial").
-EXPLAINED_PCT = 50.0
+EXPLAINED_PCT = METHOD.explained_pct
+#: ΔBIC by which the named effect must beat the runner-up (0: no such test).
+RUNNER_UP_MARGIN = METHOD.runner_up_margin

@@ -1,0 +1,128 @@
+"""The non-circular validation's manipulations (gaitlib.gap.validate): data round trips
+through the tidy reader against the laboratory effects that should undo them, and draws
+that follow the method's hash."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from gaitlib import conventions as cv
+from gaitlib import effects as effects_mod
+from gaitlib.gap import io as gio
+from gaitlib.gap import method as M
+from gaitlib.gap import validate as V
+
+
+@pytest.fixture(scope="module")
+def frame():
+    return V.real_frame("Free")
+
+
+def _read(tmp_path, df, name):
+    p = tmp_path / f"{name}.csv"
+    df.to_csv(p, index=False)
+    return gio.read_data(p).gait
+
+
+@pytest.fixture(scope="module")
+def base_gait(frame, tmp_path_factory):
+    return _read(tmp_path_factory.mktemp("v"), frame, "unedited")
+
+
+@pytest.mark.parametrize("joint,quantity", [("hip", "hip_flexion"), ("knee", "knee_flexion"),
+                                            ("ankle", "ankle_dorsiflexion")])
+def test_offset_injection_is_undone_by_its_effect(tmp_path, frame, base_gait, joint, quantity):
+    """+c degrees on the data's joint angle is c·π/180 times DATA_SIGN in the model's
+    coordinate; the effect at that value gives back the unedited data (both legs)."""
+    c = 3.7
+    g = _read(tmp_path, V.inject(frame, f"{joint}_offset", c), "x")
+    cm = cv.DATA_SIGN[joint] * math.radians(c)
+    for s in cv.SIDES:
+        assert np.allclose(g.mean[f"{joint}_{s}"] - base_gait.mean[f"{joint}_{s}"], cm, atol=1e-9)
+    back = effects_mod.adjust_data(g, {f"{joint}_offset": {"c": cm}})
+    assert np.allclose(back.mean.to_numpy(float), base_gait.mean.to_numpy(float), atol=1e-9)
+    assert V.INJECTIONS[f"{joint}_offset"].expected == f"{joint}_offset"
+
+
+def test_plate_injections_are_undone_by_their_effects(tmp_path, frame, base_gait):
+    s = -0.06
+    g = _read(tmp_path, V.inject(frame, "plate_gain", s), "gain")
+    back = effects_mod.adjust_data(g, {"grf_scale": {"s": s}})
+    assert np.allclose(back.mean.to_numpy(float), base_gait.mean.to_numpy(float), atol=1e-9)
+    b_bw = 0.015
+    g = _read(tmp_path, V.inject(frame, "plate_ap_bias", b_bw), "bias")
+    b_n = b_bw * base_gait.body_mass * cv.G * cv.DATA_SIGN.get("grf_x", 1.0)
+    back = effects_mod.adjust_data(g, {"grf_ap_bias": {"b": b_n}})
+    assert np.allclose(back.mean.to_numpy(float), base_gait.mean.to_numpy(float), atol=1e-9)
+    on = base_gait.mean["grf_y_r"] > effects_mod.PLATE_THRESHOLD_N
+    assert 0.4 < on.mean() < 0.8  # the bias acts in stance only
+
+
+def test_load_scale_scales_every_load_and_nothing_else(tmp_path, frame, base_gait):
+    m = 0.1
+    g = _read(tmp_path, V.inject(frame, "load_scale", m), "load")
+    for c in g.mean.columns:
+        ratio_ok = np.allclose(g.mean[c], (1 + m) * base_gait.mean[c], atol=1e-9)
+        same = np.allclose(g.mean[c], base_gait.mean[c], atol=1e-12)
+        if c.startswith(("tau_", "pow_", "grf_")):
+            assert ratio_ok, c
+        else:
+            assert same, c
+
+
+def test_out_of_library_manipulations_change_only_their_channel(tmp_path, frame, base_gait):
+    for name, stems in (("knee_rom", ("knee",)), ("hip_swing_bump", ("hip",)),
+                        ("ankle_moment_gain", ("tau_ankle", "pow_ankle")), ("impact_peak", ("grf_y",))):
+        g = _read(tmp_path, V.inject(frame, name, 0.2 if name != "hip_swing_bump" else 5.0), name)
+        changed = {c for c in g.mean.columns if not np.allclose(g.mean[c], base_gait.mean[c], atol=1e-12)}
+        assert changed and all(c.rsplit("_", 1)[0] in stems for c in changed), (name, changed)
+        assert V.INJECTIONS[name].expected == "unexplained"
+    # the knee's excursion scales about its mean: the mean stays, the range grows by 1.2
+    g = _read(tmp_path, V.inject(frame, "knee_rom", 0.2), "rom")
+    k0, k1 = base_gait.mean["knee_r"].to_numpy(), g.mean["knee_r"].to_numpy()
+    assert np.ptp(k1) == pytest.approx(1.2 * np.ptp(k0), rel=1e-9)
+
+
+def test_draws_follow_the_method_hash():
+    d1, d2 = V.draws(), V.draws()
+    assert d1.equals(d2)
+    other = dataclasses.replace(M.METHOD, bic_threshold=-9.0)
+    assert other.hash() != M.METHOD.hash()
+    d3 = V.draws(method=other)
+    assert (d3["magnitude"] != d1["magnitude"]).all()
+    for _, r in d1.iterrows():
+        lo, hi = V.INJECTIONS[r["injection"]].bands[V.BANDS.index(r["band"])]
+        assert lo <= abs(r["magnitude"]) <= hi
+    assert set(d1["set"]) == {"independent", "out-of-library"}
+    assert (d1[d1["set"] == "out-of-library"]["band"] != "small").all()
+    for n, inj in V.INJECTIONS.items():
+        assert inj.expected == "unexplained" or inj.expected in effects_mod.EFFECTS, n
+
+
+def test_method_is_frozen_and_names_itself():
+    m = M.METHOD
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        m.bic_threshold = -5.0
+    assert M.BIC_THRESHOLD == m.bic_threshold and M.EXPLAINED_PCT == m.explained_pct
+    assert M.RUNNER_UP_MARGIN == m.runner_up_margin and M.DEFAULT_BASE == dict(m.base)
+    assert M.PROFILE_GRID == {k: tuple(v) for k, v in m.profile_grid}
+    assert m.hash() == M.Method().hash() and len(m.hash()) == 16
+    assert dataclasses.replace(m, runner_up_margin=m.runner_up_margin + 1).hash() != m.hash()
+
+
+def test_runner_up_margin_names_only_a_clear_winner():
+    """contenders_of: the ranked, converged candidates within the margin of the best ΔBIC;
+    the diagnosis names an effect only when it is alone there."""
+    import pandas as pd
+    from gaitlib.gap import diagnose as D
+
+    r = pd.DataFrame({"effect": ["a", "b", "c", "d"], "ok": [True, True, True, False],
+                      "dBIC": [-40.0, -31.0, -12.0, -80.0]})
+    assert D.contenders_of(r, 10.0) == ["a", "b"]  # b within 10 of a; d did not converge
+    assert D.contenders_of(r, 5.0) == ["a"]
+    assert D.contenders_of(r, 0.0) == ["a"]
+    assert D.contenders_of(r.iloc[:0], 10.0) == []
