@@ -181,7 +181,8 @@ def _fake_diagnosis(statuses: dict):
     """A Diagnosis-like object with candidates of the given statuses."""
     fits = {n: SimpleNamespace(effect=n, status=s, ok=s != FAILED) for n, s in statuses.items()}
     ranking = pd.DataFrame({"rank": range(1, len(fits) + 1), "effect": list(fits), "n_params": 1,
-                            "start": "baseline", "nests_baseline": True, "status": list(statuses.values()), "pct_closed": 10.0, "dAIC": -1.0, "dBIC": -1.0})
+                            "start": "baseline", "nests_baseline": True, "status": list(statuses.values()), "pct_closed": 10.0, "dAIC": -1.0, "dBIC": -1.0,
+                            "residual_ratio": 0.04})
 
     def save(out, figures=True):
         (out / "diagnosis.json").write_text(json.dumps({"verdict": "unexplained"}))

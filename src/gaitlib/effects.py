@@ -31,6 +31,10 @@ and GRFs unchanged in the SK model; they are visible only through muscle-level c
 (MSK generator activations, NMSK excitations) against EMG. :attr:`Effect.models` lists the
 models in which an effect can be switched on, :attr:`Effect.signature` where it shows.
 
+Laboratory effects (:data:`LAB_EFFECTS`: joint-angle offsets, force-plate gain and AP
+bias) are data-model effects like ``left_shift``: they change how the data are read
+(``reference`` and ``adjust_data``), not the physics; :data:`MODEL_EFFECTS` are the others.
+
 Units are SI; every effect documents its physics, parameters and bounds.
 """
 

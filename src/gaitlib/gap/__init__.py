@@ -6,9 +6,12 @@
 ``gaitlib.gap.make_twin(…)``       synthetic data with a known effect (:mod:`.twin`)
 ``gaitlib.gap.validate_twins(…)``  the diagnosis scored on twins
 ``gaitlib.gap.read_data(csv)``     any tidy CSV as a data set (:mod:`.io`)
+``gaitlib.gap.METHOD``             the diagnosis's settings, frozen, with a hash (:mod:`.method`)
+``gaitlib.gap.validate_on_real()`` the diagnosis on real data manipulated by known amounts
+                                   (:mod:`.validate`)
 
-Shell: ``gaitlib gap --data CSV --out DIR`` and ``gaitlib gap-twin --effect NAME
---magnitude X --seed N --out CSV``. Attributes load lazily (importing the package is cheap).
+Shell: ``gaitlib gap --data CSV --out DIR``, ``gaitlib gap-twin --effect NAME
+--magnitude X --seed N --out CSV`` and ``gaitlib gap-validate --out DIR``. Attributes load lazily (importing the package is cheap).
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ _LAZY = {
     "diagnose": ("diagnose", "diagnose"), "Diagnosis": ("diagnose", "Diagnosis"),
     "make_twin": ("twin", "make_twin"), "write_twin": ("twin", "write_twin"),
     "validate_twins": ("twin", "validate_twins"), "read_data": ("io", "read_data"), "load_real": ("io", "load_real"),
+    "METHOD": ("method", "METHOD"), "Method": ("method", "Method"), "validate_on_real": ("validate", "run"),
 }
 
 __all__ = list(_LAZY)
