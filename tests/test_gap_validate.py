@@ -126,3 +126,14 @@ def test_runner_up_margin_names_only_a_clear_winner():
     assert D.contenders_of(r, 5.0) == ["a"]
     assert D.contenders_of(r, 0.0) == ["a"]
     assert D.contenders_of(r.iloc[:0], 10.0) == []
+
+
+def test_model_variants_are_other_models_with_a_stated_family():
+    from gaitlib.problems import gait as gait_ocp
+
+    d = V.draws(("model-variant",))
+    assert len(d) == len(V.VARIANTS) * V.VARIANT_SEEDS and (d["unit"] == "seed").all()
+    for name, (fields, family) in V.VARIANTS.items():
+        spec = gait_ocp.GaitSpec(**fields)
+        assert spec != gait_ocp.GaitSpec()  # another model than the baseline's
+        assert all(e in effects_mod.MODEL_EFFECTS for e in family.split("|")), name

@@ -50,7 +50,7 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "NMSK_CANDIDATES", "effect_tabl
            "sk_diagnosis", "nmsk_attribution", "emg_gap_table", "exact_left_leg", "left_leg_check",
            "book_gaps", "twin_validation_full_mesh", "twin_full_mesh_lines", "twin_full_mesh_verdict",
            "left_leg_flips", "co_contraction_text", "findings", "VALIDATION_BASE", "injection_validation",
-           "validation_cases", "validation_lines", "visibility_text"]
+           "validation_cases", "validation_lines", "visibility_text", "variant_validation"]
 
 #: Baseline of the twin study: SK, data tracking (Eq 4.11), 10 × 3 LGR — the coarse mesh (the full 20 × 5 mesh costs ≈ 10× per solve and the twin study
 #: needs ≈ 170 solves per seed).
@@ -255,11 +255,17 @@ def injection_validation(serial: bool = False) -> gval.Validation:
     return gval.run(base=dict(VALIDATION_BASE), serial=serial, progress=False)
 
 
+def variant_validation(serial: bool = False) -> gval.Validation:
+    """:func:`gaitlib.gap.validate.run` on the model-variant twins (:data:`gaitlib.gap.
+    validate.VARIANTS`) with :data:`VALIDATION_BASE`."""
+    return gval.run(("model-variant",), base=dict(VALIDATION_BASE), serial=serial, progress=False)
+
+
 def validation_cases(v: gval.Validation) -> pd.DataFrame:
     """The validation's cases for printing: manipulation, band, magnitude (its unit), the
     expected answer, the named effect and verdict, the top two ranked candidates."""
     r = v.rows.copy()
-    r["magnitude"] = [f"{m:+.3g} {u}" for m, u in zip(r["magnitude"], r["unit"])]
+    r["magnitude"] = [f"seed {int(m)}" if u == "seed" else f"{m:+.3g} {u}" for m, u in zip(r["magnitude"], r["unit"])]
     r["right"] = np.where(r["correct"], "yes", "no")
     r["ranked first (ΔBIC, % closed)"] = [f"{a} ({b:.1f}, {c:.1f})" if isinstance(a, str) else "—"
                                           for a, b, c in zip(r["rank1"], r["rank1_dBIC"], r["rank1_pct"])]
@@ -298,6 +304,13 @@ def validation_lines(v: gval.Validation, target: float = 90.0) -> list[str]:
                    + (" A library effect was named for: " + "; ".join(
                        f"{a} {b} ({n}, {vd})" for a, b, n, vd in zip(named["injection"], named["band"], named["named"],
                                                                       named["verdict"])) + "." if len(named) else ""))
+    var = r[r["set"] == "model-variant"]
+    if len(var):
+        out.append(f"**Model-variant twins: {int(var['correct'].sum())} of {len(var)} named within the stated family "
+                   f"({100.0 * var['correct'].mean():.0f} %).** " + "; ".join(
+                       f"{a} (seed {int(m)}): {n} ({vd}; expected one of {e.replace('|', ', ')})"
+                       for a, m, n, vd, e in zip(var["injection"], var["magnitude"], var["named"], var["verdict"],
+                                                 var["expected"])) + ".")
     out.append(f"The unedited data, diagnosed the same way: {u['named']} ({u['verdict']}); ranked first "
                f"{u.get('rank1')} at ΔBIC {u.get('rank1_dBIC', float('nan')):.1f}, second {u.get('rank2')} at "
                f"{u.get('rank2_dBIC', float('nan')):.1f}. Every injection sits on top of this gap of the real data.")
