@@ -43,6 +43,7 @@ from . import diagnose
 from .solve import solve_many
 from ..effects import TWIN_EFFECTS
 from .diagnose import BIC_THRESHOLD
+from .method import RUNNER_UP_MARGIN
 
 __all__ = ["NOISE_LENGTH", "smooth_noise", "twin_spec", "twin_frame", "make_twin", "write_twin", "DEFAULT_BASE"]
 
@@ -250,6 +251,12 @@ def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), 
         "n_subjects": real.n, "noise_length": NOISE_LENGTH, "baseline_failed": base_failed})
 
 
+def _best_other(rk: pd.DataFrame, inj: str) -> float:
+    """The lowest ΔBIC of the ranked, converged candidates other than ``inj`` (NaN: none)."""
+    o = rk[(rk.index != inj) & rk["ok"].astype(bool) & np.isfinite(rk["dBIC"].astype(float))]
+    return float(o["dBIC"].min()) if len(o) else np.nan
+
+
 #: Target of the twin check: top-1 accuracy (%) at the middle magnitude.
 TARGET_TOP1_PCT = 90.0
 #: Target of the twin check: mean shrink of the injected gap (%, each twin capped at 100 %).
@@ -334,6 +341,7 @@ class TwinValidation:
                 "identified_magnitude": true_mag,
                 "dBIC_top": float(rk.loc[d.top_effect, "dBIC"]) if d.top_effect in rk.index else np.nan,
                 "dBIC_true": float(rk.loc[inj, "dBIC"]) if inj in rk.index else np.nan,
+                "dBIC_best_other": _best_other(rk, inj), "contenders": list(d.settings.get("contenders", [])),
                 "n_eff": d.located.n_eff, "base_start": d.baseline.stats.get("start"),
                 "retried": sum(f.solution is not None and "retry_start" in f.solution.stats for f in d.fits.values()),
                 "true_start": (d.fits[inj].solution.stats.get("retry_start", "best")
@@ -423,14 +431,16 @@ class TwinValidation:
         diagnoses of why: ``fit_failed`` — an injected effect whose own candidate fit ends at
         or above the baseline fit's RSS (the fit, not the criterion, failed);
         ``true_not_named`` — the injected effect would not have been named even with its own
-        fit's ΔBIC (not below :data:`gaitlib.gap.diagnose.BIC_THRESHOLD`, or not below the
-        named effect's)."""
+        fit's ΔBIC (not below :data:`gaitlib.gap.diagnose.BIC_THRESHOLD`, or not below every
+        other ranked candidate's by the runner-up margin,
+        :data:`gaitlib.gap.method.RUNNER_UP_MARGIN`)."""
         w = self.rows[~self.rows["correct"].astype(bool)].copy()
         inj = w["injected"] != "none"
         rt, rb = w["rss_true"].astype(float), w["rss_base"].astype(float)
         w["fit_failed"] = inj & np.isfinite(rt) & (rt >= rb)
-        bt, bn = w["dBIC_true"].astype(float), w["dBIC_top"].astype(float)
-        w["true_not_named"] = ~(np.isfinite(bt) & (bt <= BIC_THRESHOLD) & (~np.isfinite(bn) | (bt < bn)))
+        bt, bo = w["dBIC_true"].astype(float), w["dBIC_best_other"].astype(float)
+        clear = (bt <= bo - RUNNER_UP_MARGIN) if RUNNER_UP_MARGIN > 0 else (bt < bo)
+        w["true_not_named"] = ~(np.isfinite(bt) & (bt <= BIC_THRESHOLD) & (~np.isfinite(bo) | clear))
         return w
 
     def to_dict(self) -> dict:
