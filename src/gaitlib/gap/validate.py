@@ -255,6 +255,12 @@ class Validation:
                 "rows": json.loads(self.rows.to_json(orient="records")),
                 "scores": json.loads(self.scores().to_json(orient="records"))}
 
+    @classmethod
+    def load(cls, folder) -> "Validation":
+        """A validation written by :meth:`save` (``validation.json``)."""
+        j = json.loads((Path(folder) / "validation.json").read_text())
+        return cls(pd.DataFrame(j["rows"]), j["unedited"], j["settings"])
+
     def save(self, out) -> Path:
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)

@@ -40,6 +40,8 @@ from ..gap import io as gio
 from ..gap import locate
 from ..gap import twin
 from ..gap import validate as gval
+from ..gap import method as gap_method
+from . import performance as perf
 from .. import data as data_mod
 from . import msk
 from ..gap.solve import solve_on
@@ -50,7 +52,8 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "NMSK_CANDIDATES", "effect_tabl
            "sk_diagnosis", "nmsk_attribution", "emg_gap_table", "exact_left_leg", "left_leg_check",
            "book_gaps", "twin_validation_full_mesh", "twin_full_mesh_lines", "twin_full_mesh_verdict",
            "left_leg_flips", "co_contraction_text", "findings", "VALIDATION_BASE", "injection_validation",
-           "validation_cases", "validation_lines", "visibility_text", "variant_validation"]
+           "validation_cases", "validation_lines", "visibility_text", "variant_validation",
+           "VALIDATION_RUNS", "stored_validation"]
 
 #: Baseline of the twin study: SK, data tracking (Eq 4.11), 10 × 3 LGR — the coarse mesh (the full 20 × 5 mesh costs ≈ 10× per solve and the twin study
 #: needs ≈ 170 solves per seed).
@@ -247,6 +250,29 @@ def circularity(tv_full, diag) -> str:
 #: Baseline of the validation on manipulated real data: ``gaitlib gap``'s default mesh
 #: (10 × 3), per-node derivatives (the faster path; the validation is 27 diagnoses).
 VALIDATION_BASE = dict(model="SK", cost="DT", n_intervals=10, degree=3, derivatives="nodes")
+
+
+#: Where the validation's results are stored (under the benchmark results folder,
+#: :func:`gaitlib.studies.performance.results_dir`), and the commands that wrote them.
+VALIDATION_RUNS = {
+    "real": "gaitlib gap-validate --set independent,out-of-library --derivatives nodes --out "
+            "benchmarks/results/gap_validation/real",
+    "variants": "gaitlib gap-validate --set model-variant --derivatives nodes --out "
+                "benchmarks/results/gap_validation/variants",
+}
+
+
+def stored_validation(name: str = "real") -> gval.Validation:
+    """The stored result of one validation run (:data:`VALIDATION_RUNS`), refused if it was
+    made with another method than :data:`gaitlib.gap.method.METHOD` (its draws and verdicts
+    would not be this method's)."""
+    folder = perf.results_dir() / "gap_validation" / name
+    v = gval.Validation.load(folder)
+    now = gap_method.METHOD.hash()
+    if v.settings.get("method_hash") != now:
+        raise RuntimeError(f"{folder}: a validation of method {v.settings.get('method_hash')}, the method is now "
+                           f"{now}: rerun `{VALIDATION_RUNS[name]}`")
+    return v
 
 
 def injection_validation(serial: bool = False) -> gval.Validation:
