@@ -137,3 +137,24 @@ def test_model_variants_are_other_models_with_a_stated_family():
         spec = gait_ocp.GaitSpec(**fields)
         assert spec != gait_ocp.GaitSpec()  # another model than the baseline's
         assert all(e in effects_mod.MODEL_EFFECTS for e in family.split("|")), name
+
+
+def test_stored_validation_is_refused_for_another_method(tmp_path, monkeypatch):
+    import pandas as pd
+    from gaitlib.studies import gap as G
+    from gaitlib.studies import performance as perf
+
+    rows = pd.DataFrame([{"set": "independent", "band": "middle", "correct": True, "named": "grf_scale",
+                          "expected": "grf_scale"}])
+    folder = tmp_path / "gap_validation" / "real"
+    V.Validation(rows, {"named": "unexplained"}, {"method_hash": M.METHOD.hash()}).save(folder)
+    monkeypatch.setattr(perf, "results_dir", lambda: tmp_path)
+    v = G.stored_validation("real")
+    assert v.rows.equals(rows) and v.scores()["top1_pct"].tolist() == [100.0]
+    V.Validation(rows, {}, {"method_hash": "0" * 16}).save(folder)
+    with pytest.raises(RuntimeError, match="rerun `gaitlib gap-validate"):
+        G.stored_validation("real")
+    # the stored results in the repository are the current method's
+    monkeypatch.undo()
+    for name in G.VALIDATION_RUNS:
+        assert G.stored_validation(name).settings["method_hash"] == M.METHOD.hash()
