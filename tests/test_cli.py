@@ -368,3 +368,13 @@ def test_sweep_exit_status_and_owned_run_folders(capsys, tmp_path, monkeypatch):
     rc, _, _ = _run(base + ["--speeds", "Free", "--overwrite"], capsys)
     assert rc == 0 and sorted(p.name for p in (tmp_path / "o").iterdir()) == ["mine", "sweep.csv"]
     assert solved["SK_DT_Free"].n_intervals == 4
+
+
+def test_gap_validate_checks_its_sets_before_any_solve(capsys, monkeypatch, tmp_path):
+    from gaitlib.gap import validate as V
+
+    monkeypatch.setattr(V, "run", lambda *a, **k: pytest.fail("solved despite a bad option"))
+    rc, _, err = _run(["gap-validate", "--set", "independent,nope", "--out", str(tmp_path / "v"),
+                       "--cache", str(tmp_path / "c")], capsys)
+    assert rc == 2 and "unknown set(s) nope" in _one_line(err, "gap-validate")
+    assert not (tmp_path / "v").exists()
