@@ -237,7 +237,8 @@ wrong[["twin", "injected", "magnitude", "top", "dBIC_top", "dBIC_true", "identif
 # %% [markdown]
 # **Where the diagnosis errs.** For each misnamed twin, the criterion of the true model
 # fitted the same way (`dBIC_true`, magnitude fixed at the injected value) beside that of
-# what was named (`dBIC_top`; empty when nothing passed the threshold):
+# what was named (`dBIC_top`; empty when nothing was named — no candidate passed the
+# threshold, or none beat the others by the runner-up margin):
 
 # %%
 thr = diagnose.BIC_THRESHOLD
@@ -246,7 +247,8 @@ print(f"misnamed twins where even the true model, fitted the same way, would not
       f"{len(true_not_better)} of {len(wrong)}")
 for r in true_not_better.itertuples():
     print(f"  {r.twin}: ΔBIC true = {r.dBIC_true:.1f}, named = {r.dBIC_top:.1f}" if np.isfinite(r.dBIC_top) else
-          f"  {r.twin}: ΔBIC true = {r.dBIC_true:.1f} (threshold {thr:g}), nothing named")
+          f"  {r.twin}: ΔBIC true = {r.dBIC_true:.1f} (threshold {thr:g}; best other candidate "
+          f"{r.dBIC_best_other:.1f}, runner-up margin {gap_method.RUNNER_UP_MARGIN:g}), nothing named")
 
 # %% [markdown]
 # Where that count equals the number of misnamed twins, the ranking is not what fails:

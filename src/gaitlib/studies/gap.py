@@ -225,6 +225,9 @@ def summary(diag: diagnose.Diagnosis) -> dict:
         b = ok.iloc[0]
         s.update(best=str(b["effect"]), best_pct=float(b["pct_closed"]), best_dBIC=float(b["dBIC"]),
                  interval=list(diag.intervals.get(str(b["effect"]), [np.nan, np.nan])))
+        if len(ok) > 1:
+            s.update(second=str(ok.iloc[1]["effect"]), second_dBIC=float(ok.iloc[1]["dBIC"]))
+    s["contenders"] = list(diag.settings.get("contenders", []))
     return s
 
 
@@ -651,6 +654,13 @@ def _diagnosis_text(s: dict, full: bool) -> str:
         return (f"the diagnosis names **{s['top']}** ({s['verdict']}, {s['best_pct']:.0f} % closed, "
                 f"interval {s['interval'][0]:.0f}–{s['interval'][1]:.0f} %).")
     what = f"best {s['best']}, {s['best_pct']:.0f} % closed, ΔBIC = {s['best_dBIC']:.1f}; threshold {diagnose.BIC_THRESHOLD:g}"
+    if len(s.get("contenders", [])) > 1:  # passes the threshold, but does not stand out
+        others = ", ".join(s["contenders"][1:])
+        why = (f"{s['best']} passes the threshold but not the out-of-library test: {others} "
+               f"{'is' if len(s['contenders']) == 2 else 'are'} within the runner-up margin of "
+               f"{gap_method.RUNNER_UP_MARGIN:g} (second {s.get('second')} at ΔBIC {s.get('second_dBIC', np.nan):.1f})")
+        return (f"No candidate stands out: **unexplained** ({what}; {why})." if full
+                else f"**unexplained** ({what}; {why}).")
     return (f"No candidate passes the criterion: **unexplained** ({what})." if full else f"**unexplained** ({what}).")
 
 
