@@ -84,6 +84,8 @@ def _twin_rows():
     rows["true_start"] = [None, "moved", None, "best", None, None, None, None]
     rows["rss_true_fixed"] = rows["rss_base"] / 2
     rows["rss_gen"] = 10.0
+    # the best ΔBIC among the other ranked candidates (the runner-up margin's comparison)
+    rows["dBIC_best_other"] = [0.0, 0.0, 0.0, -15.0, 0.0, 0.0, np.nan, -11.0]
     gen = {k: {"status": "Solve_Succeeded" if k != "x" else "Infeasible_Problem_Detected"} for k in "abcx"}
     return twin.TwinValidation(rows, {}, gen, {"effects": ("a", "b")})
 
@@ -125,8 +127,13 @@ def test_twin_misses_say_why():
     assert not w.loc["none#2", "fit_failed"]     # nothing injected
     # true model named only if ΔBIC ≤ threshold and below the named effect's
     assert w.loc["b@1#2", "true_not_named"]      # +5 is above the threshold
-    assert not w.loc["a@0#1", "true_not_named"]  # −12 ≤ −10 and nothing named
+    assert not w.loc["a@0#1", "true_not_named"]  # −12 ≤ −10, and 10 below the best other (0)
     assert D.BIC_THRESHOLD == -10.0
+    # with another candidate within the runner-up margin (−5 > −12 + 10), it would not be named
+    tv = _twin_rows()
+    tv.rows.loc[tv.rows["twin"] == "a@0#1", "dBIC_best_other"] = -5.0
+    assert D.RUNNER_UP_MARGIN == 10.0
+    assert tv.misses().set_index("twin").loc["a@0#1", "true_not_named"]
 
 
 def test_twin_full_mesh_text():
