@@ -587,5 +587,5 @@ if len(ch7):
 # ## Findings
 
 # %%
-display(Markdown("\n\n".join(gap_study.findings(tv, tvf, dS, dU, dN, chkS, chkU, bg, emg, val=val))))
+display(Markdown("\n\n".join(gap_study.findings(tv, tvf, dS, dU, dN, chkS, chkU, bg, emg, val=val, valv=valv))))
 print(f"notebook time: {time.perf_counter() - T0:.0f} s")

@@ -686,14 +686,16 @@ def _left_line(lab: str, c: dict) -> str:
 
 
 def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis, diag_n: diagnose.Diagnosis, check_s: dict,
-             check_u: dict, gaps: pd.DataFrame, emg: pd.DataFrame, val: gval.Validation | None = None) -> list[str]:
+             check_u: dict, gaps: pd.DataFrame, emg: pd.DataFrame, val: gval.Validation | None = None,
+             valv: gval.Validation | None = None) -> list[str]:
     """The chapter's findings as Markdown paragraphs, every number and verdict from the
     results: the twin checks (``tv`` on the coarse mesh, :func:`twin_validation`;
     ``tv_full`` on 20 × 5, :func:`twin_validation_full_mesh`), the SK diagnoses of Schwartz
     2008 (``diag_s``) and gaitutils (``diag_u``) with their :func:`left_leg_check`, the
     book's own solutions (:func:`book_gaps`) and the NMSK attribution (``diag_n``,
     :func:`nmsk_attribution`, with its :func:`emg_gap_table` ``emg``) and, if given, the
-    validation on manipulated real data (``val``, :func:`injection_validation`)."""
+    validation on manipulated real data (``val``, :func:`injection_validation`) and on
+    model-variant twins (``valv``, :func:`variant_validation`)."""
     s, sf = tv.summary(), tv_full.summary()
     acc = tv.accuracy()
     sS, sU = summary(diag_s), summary(diag_u)
@@ -730,6 +732,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     if val is not None:
         out.append("**Manipulated real data (not circular).** " + " ".join(validation_lines(val)[:-1])
                    + " " + visibility_text(val))
+    if valv is not None:
+        out.append(" ".join(validation_lines(valv)[:-1]))
     conv = gaps[gaps["status"] == "Solve_Succeeded"]
     left_top = conv["largest cell"].str.contains("_l ").mean() * 100
     c = conv.sort_values("RMS z, angles/torques/GRFs")
