@@ -300,7 +300,7 @@ def _summary(d: diagnose.Diagnosis, expected: str | None = None) -> dict:
 
 def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_class: str = "Free",
         base: dict | None = None, work_dir=None, resamples: int = 0, progress: bool = False,
-        method: Method = METHOD, **diag_kw) -> Validation:
+        **diag_kw) -> Validation:
     """Diagnose every draw of :func:`draws` (and the unedited data) with
     :func:`gaitlib.gap.diagnose` — baseline ``base`` (default: the method's), all
     applicable library effects as candidates. The manipulated CSVs are written to
@@ -308,8 +308,7 @@ def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_clas
     :func:`gaitlib.gap.io.read_data`, as ``gaitlib gap --data`` reads a user's file."""
     import tempfile
 
-    if method is not METHOD:
-        raise ValueError("the diagnosis runs with gaitlib.gap.method.METHOD; validate that method")
+    method = METHOD  # the diagnosis runs with it: the draws are its own
     base = dict(method.base if base is None else base, speed_class=speed_class)
     table = draws(sets, per_band, method)
     frame = real_frame(speed_class)

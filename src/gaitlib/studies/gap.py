@@ -51,8 +51,8 @@ from . import predictive as pr
 __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "NMSK_CANDIDATES", "effect_table", "twin_validation",
            "sk_diagnosis", "nmsk_attribution", "emg_gap_table", "exact_left_leg", "left_leg_check",
            "book_gaps", "twin_validation_full_mesh", "twin_full_mesh_lines", "twin_full_mesh_verdict",
-           "left_leg_flips", "co_contraction_text", "findings", "VALIDATION_BASE", "injection_validation",
-           "validation_cases", "validation_lines", "visibility_text", "variant_validation",
+           "left_leg_flips", "co_contraction_text", "findings",
+           "validation_cases", "validation_lines", "visibility_text",
            "VALIDATION_RUNS", "stored_validation"]
 
 #: Baseline of the twin study: SK, data tracking (Eq 4.11), 10 × 3 LGR — the coarse mesh (the full 20 × 5 mesh costs ≈ 10× per solve and the twin study
@@ -250,11 +250,6 @@ def circularity(tv_full, diag) -> str:
             "not yet tested in this chapter.")
 
 
-#: Baseline of the validation on manipulated real data: ``gaitlib gap``'s default mesh
-#: (10 × 3), per-node derivatives (the faster path; the validation is 27 diagnoses).
-VALIDATION_BASE = dict(model="SK", cost="DT", n_intervals=10, degree=3, derivatives="nodes")
-
-
 #: Where the validation's results are stored (under the benchmark results folder,
 #: :func:`gaitlib.studies.performance.results_dir`), and the commands that wrote them.
 VALIDATION_RUNS = {
@@ -276,18 +271,6 @@ def stored_validation(name: str = "real") -> gval.Validation:
         raise RuntimeError(f"{folder}: a validation of method {v.settings.get('method_hash')}, the method is now "
                            f"{now}: rerun `{VALIDATION_RUNS[name]}`")
     return v
-
-
-def injection_validation(serial: bool = False) -> gval.Validation:
-    """:func:`gaitlib.gap.validate.run` on the Schwartz 2008 *Free* data with
-    :data:`VALIDATION_BASE`: every manipulation of both sets, one draw per band."""
-    return gval.run(base=dict(VALIDATION_BASE), serial=serial, progress=False)
-
-
-def variant_validation(serial: bool = False) -> gval.Validation:
-    """:func:`gaitlib.gap.validate.run` on the model-variant twins (:data:`gaitlib.gap.
-    validate.VARIANTS`) with :data:`VALIDATION_BASE`."""
-    return gval.run(("model-variant",), base=dict(VALIDATION_BASE), serial=serial, progress=False)
 
 
 def validation_cases(v: gval.Validation) -> pd.DataFrame:
@@ -694,8 +677,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     2008 (``diag_s``) and gaitutils (``diag_u``) with their :func:`left_leg_check`, the
     book's own solutions (:func:`book_gaps`) and the NMSK attribution (``diag_n``,
     :func:`nmsk_attribution`, with its :func:`emg_gap_table` ``emg``) and, if given, the
-    validation on manipulated real data (``val``, :func:`injection_validation`) and on
-    model-variant twins (``valv``, :func:`variant_validation`)."""
+    validation on manipulated real data (``val``) and on model-variant twins (``valv``), both
+    :func:`stored_validation`."""
     s, sf = tv.summary(), tv_full.summary()
     acc = tv.accuracy()
     sS, sU = summary(diag_s), summary(diag_u)
