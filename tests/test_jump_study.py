@@ -8,7 +8,9 @@ band, the friction ratio of Eq 3.6 and the bookkeeping of failed solves.
 
 from __future__ import annotations
 
+import math
 import warnings
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
@@ -207,3 +209,36 @@ def test_animation(toe):
     assert "<img" in html or "data:image" in html
     t, Q = toe.poses()
     assert Q.shape == (len(t), toe.model.n) and np.all(np.diff(t) > 0)
+
+
+def test_standing_top_is_table_3_1_by_hand():
+    from gaitlib.jump import JumpModel
+    h = 0.116 * math.sin(math.radians(28.8)) + 0.503 + 0.440 + 0.660  # foot·sin(incline) + shank + thigh + HT
+    assert JumpModel(toe=True).standing_top == pytest.approx(h, abs=5e-4)
+
+
+def test_strength_limits_keep_the_thesis_keys_and_bound_every_phase():
+    from gaitlib import mtg
+    from gaitlib.problems import jump as J
+
+    base = J.SPECS["toe"]
+    assert "torque_limits" not in base.to_dict()  # the stored jumps keep their keys
+    st = J.spec("toe", torque_limits="strength")
+    assert st.to_dict()["torque_limits"] == "strength" and J.cache_location(st) != J.cache_location(base)
+    with pytest.raises(ValueError, match="torque_limits"):
+        J.spec("toe", torque_limits="human")
+    jp = J.build(replace(st, n_intervals=3, continuation=()))
+    model = jp.model
+    env = J.strength_envelope(model)
+    kw = dict(body_mass=model.total_mass, body_height=model.standing_top)
+    for ph in jp.problem.phases:
+        assert "strength" in [c.name for c in ph.path_constraints]
+        # box: the metatarsal joint within ± the two-leg ankle plantarflexor peak (Eq 5.21 scaling)
+        pf = 2 * mtg.strength_limits(None, **kw)["ankle"][0]
+        lo, hi = ph.bounds["tau_mtp"]
+        assert lo * st.tau_scale == pytest.approx(pf) and hi * st.tau_scale == pytest.approx(-pf)
+    # the envelope is two legs × the MTG pair's extreme net torque at the state
+    for j, q, qd in (("knee", -1.0, 5.0), ("hip", 0.8, -3.0), ("ankle", 0.1, 2.0)):
+        lo, hi = mtg.max_joint_torque(j, q, qd, None, **kw)
+        assert env["envelope"][j](q, qd) == pytest.approx((2 * lo, 2 * hi))
+        assert 2 * lo >= env["peak"][j][0] - 1e-9 and 2 * hi <= env["peak"][j][1] + 1e-9

@@ -188,7 +188,8 @@ def test_check_reads_a_jump_like_solution():
     traj = pd.DataFrame({"phase": "thrust", "mtp": 0.0, "ankle": 0.1, "knee": -1.0, "hip": 1.0,
                          "tau_mtp": 10.0, "tau_ankle": -50.0, "tau_knee": 1500.0, "tau_hip": -100.0,
                          "grf_x": 0.0, "grf_y": 700.0}, index=idx)
-    model = SimpleNamespace(joints=("mtp", "ankle", "knee", "hip"), total_mass=73.8, incline=math.radians(28.8))
+    model = SimpleNamespace(joints=("mtp", "ankle", "knee", "hip"), total_mass=73.8, incline=math.radians(28.8),
+                            standing_top=0.116 * math.sin(math.radians(28.8)) + 0.503 + 0.440 + 0.660)  # Table 3.1 by hand
     sol = SimpleNamespace(trajectory=traj, jump_height={}, model=model, status="Solve_Succeeded")
     g = V.check(sol)
     assert g.failed == ["strength"]
@@ -207,7 +208,8 @@ def test_book_gates_table_from_given_solutions():
     idx = pd.Index(np.linspace(0, 1, 5), name="time")
     traj = pd.DataFrame({"phase": "thrust", "ankle": 0.0, "knee": -0.5, "hip": 0.5, "tau_ankle": -10.0,
                          "tau_knee": 900.0, "tau_hip": -10.0, "grf_x": 0.0, "grf_y": 700.0}, index=idx)
-    model = SimpleNamespace(joints=("ankle", "knee", "hip"), total_mass=72.0, incline=math.radians(28.8))
+    model = SimpleNamespace(joints=("ankle", "knee", "hip"), total_mass=72.0, incline=math.radians(28.8),
+                            standing_top=0.116 * math.sin(math.radians(28.8)) + 0.503 + 0.440 + 0.660)
     jump = SimpleNamespace(trajectory=traj, jump_height={}, model=model, status="Solve_Succeeded")
     lost = SimpleNamespace(ok=False, status="error", value=None)
     g = SV.book_gates(solutions={"jump": jump, "lost": lost})

@@ -184,6 +184,14 @@ class JumpModel:
         """kg (73.80 toe-included, 73.21 toeless)."""
         return float(sum(JUMP_SEGMENTS[s][0] for s in self.segments))
 
+    @cached_property
+    def standing_top(self) -> float:
+        """Standing height of the model's top, m: the ankle's height above the MTP point
+        (foot length × sin incline) + shank + thigh + HT (thesis Table 3.1) — the body
+        height the MTG strength scaling (Eq 5.21) uses for this model."""
+        L = {k: v[1] for k, v in JUMP_SEGMENTS.items()}
+        return float(L["foot"] * math.sin(self.incline) + L["shank"] + L["thigh"] + L["ht"])
+
     def standing_q(self) -> np.ndarray:
         """Free coordinates of the standing posture with the MTP point at the origin."""
         return np.zeros(self.n)

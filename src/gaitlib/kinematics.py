@@ -15,12 +15,14 @@ top-left block of ``M`` (:func:`gaitlib.plots.ellipse_outline`).
 
 from __future__ import annotations
 
+import casadi as ca
 import numpy as np
 
 from gaitlib import conventions as cv
 from gaitlib import contact
 
 __all__ = [
+    "ellipsoid_bottoms_sx",
     "shape_matrix",
     "ellipsoid_bottom",
     "ellipsoid_radii",
@@ -58,6 +60,19 @@ def ellipsoid_bottoms(model, q, p_contact=None) -> np.ndarray:
     centres, Rs = model.ellipsoid_poses(np.asarray(q, dtype=float), p_contact)
     radii = ellipsoid_radii(p_contact)
     return np.array([ellipsoid_bottom(c, R, r) for c, R, r in zip(centres, Rs, radii)])
+
+
+def ellipsoid_bottoms_sx(model, q, p_contact=None):
+    """:func:`ellipsoid_bottoms` as a CasADi expression of ``q`` (SX/MX, 11) → (6, 1) m:
+    ``c_y − sqrt(e_yᵀ R D² Rᵀ e_y)`` per ellipsoid, from the model's ``ellipsoid_poses``."""
+    p = contact.default_params() if p_contact is None else np.asarray(p_contact, dtype=float)
+    out = model.function("ellipsoid_poses")(q, p)
+    radii = ellipsoid_radii(p)
+    rows = []
+    for i in range(len(radii)):
+        R = out[1 + i]
+        rows.append(out[0][i, 1] - ca.sqrt(ca.sumsqr(R[1, :] * ca.DM(radii[i]).T)))
+    return ca.vertcat(*rows)
 
 
 def pose_from_data(model, gait_data, times, p_contact=None, penetration: float = 0.002,

@@ -71,6 +71,7 @@ import numpy as np
 from gaitlib.conventions import BODY_HEIGHT, BODY_MASS, SIDES
 
 __all__ = [
+    "strength_limits",
     "GENERATORS",
     "MTG_JOINTS",
     "MTG_NAMES",
@@ -1054,3 +1055,27 @@ def demanded_active_torque(
     T0, _, _, tP, w = _generator_parts(g, th, om, params, body_mass, body_height)
     r = tau_m - T0 * tP * (1.0 - BETA_P * w)
     return r if _is_ca(tau_m, q, qd) else _out(r)
+
+
+def strength_limits(mtg_params=None, *, body_mass: float = BODY_MASS, body_height: float = BODY_HEIGHT,
+                    legs: int = 1) -> dict[str, tuple[float, float]]:
+    """Peak active torque per joint and direction, model convention (N·m):
+    ``{"hip": (τ_min < 0, τ_max > 0), "knee": …, "ankle": …, "mtp": …}``.
+
+    Each bound is the peak of the generator that produces that sign, s^τ τ0 E (thesis
+    Eq 5.8 with a = 1, t^A = 1, t^V = E the eccentric plateau; τ0 by Eq 5.21 for
+    ``body_mass`` kg × ``body_height`` m), times ``legs``. ``mtg_params``: generator →
+    :class:`MTGParams` (None: Eq 5.22 defaults, s^τ = 1). The metatarsal joint
+    has no MTG: the ankle plantarflexor's peak bounds it in both directions."""
+    out = {}
+    for j in MTG_JOINTS:
+        lim = {}
+        for d in ("ext", "flex"):
+            g = f"{j}_{d}"
+            p = (mtg_params or {}).get(g, DEFAULT_PARAMS)
+            peak = float(p.s_tau) * tau0(g, body_mass, body_height) * max(1.0, GYMNAST[g].E) * legs
+            lim[TORQUE_SIGN[g] > 0] = peak
+        out[j] = (-lim[False], lim[True])
+    pf = out["ankle"][0]  # plantarflexion is negative
+    out["mtp"] = (pf, -pf)
+    return out

@@ -104,12 +104,12 @@ import pandas as pd
 
 from . import conventions as cv
 from . import mtg
+from .mtg import strength_limits
 from .sweep import ACCEPTED_STATUSES
 from . import data as data_mod
 from . import params as params_mod
 from .model import ChildModel
 from .problems import gait as gait_ocp
-from .jump import JUMP_SEGMENTS
 
 __all__ = ["CONVERGED_STATUSES", "SWING_LOAD_BW", "SWING_MARGIN", "DOUBLE_SUPPORT_MAX", "DOUBLE_SUPPORT_WALKING",
            "RESIDUAL_FORCE_FRACTION", "RESIDUAL_MOMENT_FRACTION", "ROM_DEG", "ROM_TOL_DEG", "PERIODICITY_TOL",
@@ -222,30 +222,6 @@ def _na(check, why):
 # --------------------------------------------------------------------------------------
 # Strength
 # --------------------------------------------------------------------------------------
-
-
-def strength_limits(mtg_params=None, *, body_mass: float = cv.BODY_MASS, body_height: float = cv.BODY_HEIGHT,
-                    legs: int = 1) -> dict[str, tuple[float, float]]:
-    """Peak active torque per joint and direction, model convention (N·m):
-    ``{"hip": (τ_min < 0, τ_max > 0), "knee": …, "ankle": …, "mtp": …}``.
-
-    Each bound is the peak of the generator that produces that sign, s^τ τ0 E (thesis
-    Eq 5.8 with a = 1, t^A = 1, t^V = E the eccentric plateau; τ0 by Eq 5.21 for
-    ``body_mass`` kg × ``body_height`` m), times ``legs``. ``mtg_params``: generator →
-    :class:`gaitlib.mtg.MTGParams` (None: Eq 5.22 defaults, s^τ = 1). The metatarsal joint
-    has no MTG: the ankle plantarflexor's peak bounds it in both directions."""
-    out = {}
-    for j in mtg.MTG_JOINTS:
-        lim = {}
-        for d in ("ext", "flex"):
-            g = f"{j}_{d}"
-            p = (mtg_params or {}).get(g, mtg.DEFAULT_PARAMS)
-            peak = float(p.s_tau) * mtg.tau0(g, body_mass, body_height) * max(1.0, mtg.GYMNAST[g].E) * legs
-            lim[mtg.TORQUE_SIGN[g] > 0] = peak
-        out[j] = (-lim[False], lim[True])
-    pf = out["ankle"][0]  # plantarflexion is negative
-    out["mtp"] = (pf, -pf)
-    return out
 
 
 # --------------------------------------------------------------------------------------
@@ -517,18 +493,11 @@ def _check_contact_a(res, name) -> Gates:
                         notes={"periodicity": "kinematics fixed to the data's periodic Fourier fit"})
 
 
-def _jump_height(model) -> float:
-    """Standing height of the jump model's top (m): the ankle's height above the MTP point
-    (foot length × sin incline) + shank + thigh + HT (thesis Table 3.1)."""
-    L = {k: v[1] for k, v in JUMP_SEGMENTS.items()}
-    return float(L["foot"] * math.sin(model.incline) + L["shank"] + L["thigh"] + L["ht"])
-
-
 def _check_jump(sol, name) -> Gates:
     model = sol.model
     tr_ = sol.trajectory
     joints = list(model.joints)
-    h = _jump_height(model)
+    h = model.standing_top
     lim = strength_limits(None, body_mass=model.total_mass, body_height=h, legs=2)
     return check_frames(status=sol.status, q=tr_[joints], torques=tr_[[f"tau_{j}" for j in joints]],
                         grf=tr_[["grf_x", "grf_y"]], residuals=None, kind="jump", strength=lim,

@@ -228,7 +228,11 @@ for _name, _w in _T62_NMSK.items():
 
 #: Spec options that are left out of :meth:`GaitSpec.to_dict` (hence of every cache key)
 #: while unset: added after the store was written, they must not change existing keys.
-KEY_STABLE_OPTIONS = ("swing_load_max", "derivatives")
+KEY_STABLE_OPTIONS = ("swing_load_max", "derivatives", "jerk_ranges")
+
+#: How the Jrk term (Eq 4.11) normalises the jerk of each coordinate (:class:`GaitSpec`
+#: ``jerk_ranges``; :func:`reference`).
+JERK_RANGES = ("reference", "data")
 
 
 @dataclass(frozen=True)
@@ -298,6 +302,14 @@ class GaitSpec:
         foot off + margin to the next foot contact − margin, :func:`swing_windows`). An
         ablation of the Fidelity II study (:mod:`gaitlib.studies.fidelity`): it measures what
         an unloaded swing foot costs in tracking. Tracking runs with fixed final time only.
+    jerk_ranges : ``None`` / ``"reference"`` (the book so far) or ``"data"``: the
+        denominators of the Jrk term (Eq 4.11: "the minimum and maximum values of … jerks
+        … were obtained from the experimental data"). ``"reference"``: the range of each
+        coordinate's reference jerk — for pelvis_tx (speed × t) and the HAT tilt (0), which
+        have no measured jerk, a fallback of 1 m/s³ / 1 rad/s³, which pins the HAT to a
+        constant speed and tilt. ``"data"``: those two from the data instead — pelvis_tx
+        from the data's horizontal GRF (the centre of mass's jerk Σ Ḟ_x / m), the tilt from
+        the data's pelvic tilt; the others as ``"reference"``. See :func:`reference`.
     derivatives : ``None`` (:data:`gaitlib.ocp.DEFAULT_DERIVATIVES`) or ``"graph"`` /
         ``"nodes"`` (:class:`gaitlib.ocp.SolverOptions`): how the NLP's exact derivatives are
         built. The same problem; set explicitly it is part of the cache key, because IPOPT's
@@ -334,8 +346,11 @@ class GaitSpec:
     effects: tuple = ()
     swing_load_max: float | None = None
     derivatives: str | None = None
+    jerk_ranges: str | None = None
 
     def __post_init__(self):
+        if self.jerk_ranges not in (None,) + JERK_RANGES:
+            raise ValueError(f"jerk_ranges must be None or one of {JERK_RANGES}, got {self.jerk_ranges!r}")
         if self.derivatives not in (None, "graph", "nodes"):
             raise ValueError(f"derivatives must be None, 'graph' or 'nodes', got {self.derivatives!r}")
         if self.model not in MODELS:
@@ -456,10 +471,13 @@ class Reference:
     ranges: dict  # channel → (max − min) for normalisation
 
 
-def reference(gait: data_mod.GaitData, model: ChildModel, p_contact=None, order: int = 12) -> Reference:
+def reference(gait: data_mod.GaitData, model: ChildModel, p_contact=None, order: int = 12,
+              jerk_ranges: str = "reference") -> Reference:
     """Model-channel references from data: joint angles (data), metatarsal (planned), HAT
     (pelvis_tx = speed·t, pelvis_ty from the lowest ellipsoid at 2 mm penetration,
-    pelvis_tilt = 0); torques; GRFs; Fourier-fit derivatives for the guess and jerk ranges."""
+    pelvis_tilt = 0); torques; GRFs; Fourier-fit derivatives for the guess and jerk ranges.
+    ``jerk_ranges``: :data:`JERK_RANGES` (:class:`GaitSpec`); ``"data"`` replaces the jerk
+    ranges of pelvis_tx and pelvis_tilt by :func:`data_jerk_ranges`."""
     T = gait.cycle_time
     t = gait.time
     # thigh="lab": hip reference = data hip + data pelvic tilt, so that with an upright HAT
@@ -496,7 +514,25 @@ def reference(gait: data_mod.GaitData, model: ChildModel, p_contact=None, order:
         ranges[c] = float(np.ptp(grf[c]))
     for c in ("mtp_r", "mtp_l", "pelvis_tilt"):
         ranges[c] = max(ranges[c], 10 * cv.DEG)  # planned / zero references: avoid 1/0
+    if jerk_ranges == "data":
+        ranges.update(data_jerk_ranges(gait, order))
+    elif jerk_ranges != "reference":
+        raise ValueError(f"jerk_ranges must be one of {JERK_RANGES}, got {jerk_ranges!r}")
     return Reference(gait=gait, q=qref, deriv=deriv, tau=tau, grf=grf, ranges=ranges)
+
+
+def data_jerk_ranges(gait: data_mod.GaitData, order: int = 12, n: int = 401) -> dict[str, float]:
+    """Jrk denominators (max − min over the cycle) of the two HAT coordinates whose
+    reference has no jerk, from the data: ``jerk_pelvis_tx`` (m/s³) — the centre of mass's
+    horizontal jerk, the time derivative of the total horizontal GRF over the body mass
+    (Newton: m ẍ_COM = Σ F_x); ``jerk_pelvis_tilt`` (rad/s³) — the third derivative of the
+    data's pelvic tilt. Derivatives of the order-``order`` Fourier fit, on ``n`` points."""
+    T = gait.cycle_time
+    fine = np.linspace(0.0, T, n)
+    fx = (gait.mean["grf_x_r"] + gait.mean["grf_x_l"]).to_numpy()
+    jerk_x = _fourier_derivatives(fx, T, order, n_der=1)(fine)[1] / cv.BODY_MASS
+    jerk_tilt = _fourier_derivatives(gait.mean["pelvis_tilt"].to_numpy(), T, order)(fine)[3]
+    return {"jerk_pelvis_tx": float(np.ptp(jerk_x)), "jerk_pelvis_tilt": float(np.ptp(jerk_tilt))}
 
 
 def _with_hat_reference(ref: Reference, hat: tuple) -> Reference:
@@ -782,7 +818,7 @@ def build(spec: GaitSpec) -> GaitProblem:
             if spec.track_class else gait_class)
     p_body = params_mod.body_params(spec.body_params, model)
     p_contact = params_mod.contact_params(spec.contact_params)
-    ref = reference(gait, model, p_contact)
+    ref = reference(gait, model, p_contact, jerk_ranges=spec.jerk_ranges or "reference")
     if spec.hat_reference:
         ref = _with_hat_reference(ref, spec.hat_reference)
     T = gait.cycle_time

@@ -99,6 +99,7 @@ import pandas as pd
 from .. import cache
 from .. import contact as contact_mod
 from .. import conventions as cv
+from .. import mtg
 from .. import ocp
 from ..collocation import Mesh
 from ..jump import JumpModel
@@ -108,6 +109,8 @@ __all__ = [
     "THESIS",
     "SPECS",
     "JumpSpec",
+    "TORQUE_LIMITS",
+    "strength_envelope",
     "JumpProblem",
     "JumpSolution",
     "joint_bounds",
@@ -143,6 +146,9 @@ THESIS = {
     "toe": {"jump_height_cm": 66.0, "mu_s": 1.0, "knee_min_deg": -122.0},
     "ellipsoid": {"jump_height_cm": 89.0, "mu_s": 0.12, "knee_min_deg": -150.0},
 }
+
+#: The jump's torque limits (:class:`JumpSpec` ``torque_limits``).
+TORQUE_LIMITS = ("table3.5", "strength_peak", "strength")
 
 LABELS = {
     "toeless": "toeless, kinematic contact",
@@ -207,6 +213,19 @@ class JumpSpec:
         for IPOPT only; every frame is in N·m).
     tol, max_iter : IPOPT (Table 3.11: 1e-6, 5000).
     ipopt : further IPOPT options as ``(name, value)`` pairs.
+    torque_limits : ``"table3.5"`` (the thesis: Table 3.5's torque bounds, up to 4000 N·m)
+        or ``"strength"`` (ours, the physiological version): the joint torques are also
+        bounded by the body's strength — at hip, knee and ankle a path constraint
+        τ_min(q, q̇) ≤ τ ≤ τ_max(q, q̇) in every phase, the envelope of the Ch 5 muscle
+        torque generators with the agonist fully active (:func:`gaitlib.mtg.max_joint_torque`:
+        torque–angle × torque–velocity + passive, Eq 5.8), scaled by Eq 5.21 to this
+        model's mass and standing height, × 2 legs; at the metatarsal joint (no MTG) a box
+        of ± the ankle plantarflexors' peak (:func:`gaitlib.mtg.strength_limits`).
+        ``"strength_peak"``: only boxes, each joint's peak (the eccentric plateau) in each
+        direction. A ``"strength"`` solve without a guess starts from the
+        ``"strength_peak"`` solution of the same spec (solved, or reloaded from the cache,
+        through its mesh continuation): part of the procedure, recorded in
+        ``solution.info["continuation"]``.
     """
 
     name: str = "toe"
@@ -237,8 +256,11 @@ class JumpSpec:
     max_iter: int = 5000
     ipopt: tuple = ()
     print_level: int = 0
+    torque_limits: str = "table3.5"
 
     def __post_init__(self):
+        if self.torque_limits not in TORQUE_LIMITS:
+            raise ValueError(f"torque_limits must be one of {TORQUE_LIMITS}, got {self.torque_limits!r}")
         if self.name not in THESIS:
             raise ValueError(f"unknown jump {self.name!r}; known {tuple(THESIS)}")
         n_w = 4 if self.name == "ellipsoid" else 2
@@ -264,7 +286,12 @@ class JumpSpec:
         return LABELS[self.name]
 
     def to_dict(self) -> dict:
-        return asdict(self)
+        """The spec as a dict; ``torque_limits`` is left out at its default (the thesis's
+        bounds), so the keys of the jumps stored before it existed stay."""
+        d = asdict(self)
+        if d["torque_limits"] == "table3.5":
+            d.pop("torque_limits")
+        return d
 
 
 #: The thesis's three jumps (Tables 3.8, 3.10) at our production mesh.
@@ -295,6 +322,26 @@ class JumpProblem:
     guess: ocp.Guess
     p_contact: np.ndarray | None
     y_stand: float  # root height of the initial standing posture, m
+
+
+def strength_envelope(model: JumpModel, legs: int = 2) -> dict:
+    """The body's strength for :class:`JumpSpec` ``torque_limits="strength"``: the adult
+    Gymnast MTGs scaled (Eq 5.21) to ``model``'s mass and standing height (its top,
+    :attr:`JumpModel.standing_top`), × ``legs`` (the jump's legs are doubled).
+
+    Returns ``{"peak": joint → (τ_min, τ_max) N·m`` (:func:`gaitlib.mtg.strength_limits`:
+    the eccentric plateau; the metatarsal joint ± the ankle plantarflexors' peak),
+    ``"envelope": joint → f(q, q̇) → (τ_min, τ_max)`` for hip, knee and ankle
+    (:func:`gaitlib.mtg.max_joint_torque`, CasADi or float)}``."""
+    kw = dict(body_mass=model.total_mass, body_height=model.standing_top)
+    peak = mtg.strength_limits(None, legs=legs, **kw)
+
+    def envelope_of(j):
+        def f(q, qd):
+            lo, hi = mtg.max_joint_torque(j, q, qd, None, **kw)
+            return legs * lo, legs * hi
+        return f
+    return {"peak": peak, "envelope": {j: envelope_of(j) for j in mtg.MTG_JOINTS}}
 
 
 def _names(model: JumpModel, free: bool):
@@ -351,6 +398,11 @@ def build(sp: JumpSpec) -> JumpProblem:
     TS = sp.tau_scale
     implicit = sp.dynamics == "implicit"
     jb = {j: joint_bounds(j) for j in joints}
+    if sp.torque_limits in ("strength", "strength_peak"):
+        peak = strength_envelope(model)["peak"]
+        for j in joints:
+            lo, hi = jb[j]["tau"]
+            jb[j] = {**jb[j], "tau": (max(lo, peak[j][0]), min(hi, peak[j][1]))}
 
     def names(free):
         qn, qdn, taun, udn = _names(model, free)
@@ -579,6 +631,22 @@ def build(sp: JumpSpec) -> JumpProblem:
             goals=(apex_goal,),
         )
         phases = [crouch, thrust, fl]
+
+    if sp.torque_limits == "strength":  # the MTG envelope at every node of every phase
+        env = strength_envelope(model)["envelope"]
+        mtg_joints = [j for j in joints if j in env]
+
+        def strength(x, u, p, t):
+            rows = []
+            for j in mtg_joints:
+                lo, hi = env[j](x[j], x[f"qd_{j}"])
+                rows += [(TS * x[f"tau_{j}"] - hi) / TS, (TS * x[f"tau_{j}"] - lo) / TS]
+            return ca.vertcat(*rows)
+        n = len(mtg_joints)
+        lb = np.tile([-np.inf, 0.0], n)
+        ub = np.tile([0.0, np.inf], n)
+        phases = [replace(ph, path_constraints=ph.path_constraints + (
+            ocp.PathConstraint("strength", strength, lb, ub),)) for ph in phases]
 
     if sp.w_reg:
         def reg(x, u, p, t):
@@ -920,7 +988,7 @@ def solve(sp: JumpSpec | str, guess: ocp.Guess | ocp.Solution | None = None, *,
             return ocp.Solution.load(found), True
 
     sol, from_cache = cache.solve_or_load(cache_location(sp, root) if cached else None,
-                                          lambda: (_solve_continued(sp, guess), False), load,
+                                          lambda: (_solve_continued(sp, guess, root), False), load,
                                           marker="solution.json", use_cache=cached,
                                           write=lambda s_f: s_f[0].save)
     model = JumpModel(toe=sp.toe, damping=sp.damping)
@@ -930,10 +998,15 @@ def solve(sp: JumpSpec | str, guess: ocp.Guess | ocp.Solution | None = None, *,
     return out
 
 
-def _solve_continued(sp: JumpSpec, guess) -> ocp.Solution:
+def _solve_continued(sp: JumpSpec, guess, root=None) -> ocp.Solution:
     """Solve ``sp`` from ``guess``, or, without one, through its mesh continuation
     (:attr:`JumpSpec.continuation`: each coarser mesh warm-starts the next)."""
     record = []
+    if sp.torque_limits == "strength" and guess is None:  # from the box-limited jump (see JumpSpec)
+        pre = solve(replace(sp, torque_limits="strength_peak"), use_cache=True, root=root)
+        record.append({"torque_limits": "strength_peak", "status": pre.status, "iterations": pre.solution.iterations,
+                       "objective": pre.solution.objective, **pre.jump_height})
+        guess = pre.solution
     steps = [n for n in sp.continuation if n < sp.n_intervals] if guess is None else []
     for n in steps:
         coarse = solve(replace(sp, n_intervals=n, continuation=()), guess)

@@ -81,11 +81,9 @@ RULE = ("reproduced: |ours − thesis| ≤ max(10 % of the thesis's value, the u
           "missing or another quantity; invalid: the solution failed a validity gate or did not converge "
           "(never counted as reproduced)")
 
-#: Flight COM rise of human standing vertical jumps, m: ≈ 0.2 m (untrained) to ≈ 0.7 m
-#: (trained adults) — e.g. Linthorne NP (2001) "Analysis of standing vertical jumps using a
-#: force platform", Am J Phys 69:1198–1204. The thesis-bounds jumps of Ch 3 are compared
-#: with it in the ``cause`` column (a physiological jump formulation is future work).
-PHYSIOLOGICAL_JUMP_RISE_M = (0.2, 0.7)
+#: Flight COM rise of human standing vertical jumps, m (:data:`gaitlib.studies.jump.HUMAN_JUMP_RISE_M`):
+#: the thesis-bounds jumps of Ch 3 are compared with it in the ``cause`` column.
+PHYSIOLOGICAL_JUMP_RISE_M = jump.HUMAN_JUMP_RISE_M
 
 _BOOK = "book/"
 #: A foot's load in the data's swing is given as the cause of a vertical-GRF miss when it
@@ -294,6 +292,7 @@ def _ch4() -> list[Row]:
     gait = data_mod.load_gait_data("Free")
     ph = ci.grf_error_by_phase(res) if res else None
     where = _anchor("ch04_contact", "Why the GRF fits differ from the thesis's: where the error is")
+    jerk = _jerk_causes("SK")
     rows = []
     for k, th in ci.THESIS_RMSE.items():
         if k == "c_wide":
@@ -310,6 +309,9 @@ def _ch4() -> list[Row]:
             if qty == "grf_y" and p is not None and p["share of squared error in swing (%)"] >= SWING_SHARE:
                 cause = (f"the {foot} foot carries {p['mean simulated force in swing (N)']:.0f} N in the data's swing: "
                          f"{p['share of squared error in swing (%)']:.0f} % of its squared error [{where}]")
+            jk = ("torque", qty[4:], side) if qty.startswith("tau_") else ("grf", qty[4:], side)
+            if cause == "unknown" and k != "a" and jk in jerk:  # (a) has no Jrk term (trajectory optimisation)
+                cause = jerk[jk]
             item = f"({k}) RMSE {qty}{' ' + side.upper() if side else ''} ({ci.THESIS_RMSE_SOURCE[k]})"
             rows.append(Row(4, item, tv, ours, unit, cause, names.get(k, ""), valid.get(k, ""), sd=sd))
     if {"a", "b", "c"} <= set(res):
@@ -357,6 +359,7 @@ def _ch5(bases: dict) -> list[Row]:
     gait = sg.tracking_data(data_mod.load_gait_data("Free"))
     # Tables 5.4 and 5.11: tracking RMSEs
     ablation = {"MSK": _ablation_causes("MSK")}
+    jerk = _jerk_causes("MSK")
     for model, table in (("MSK", "Table 5.4"), ("NMSK", "Table 5.11")):
         s = bases.get(model)
         valid = gate(s, model) if s is not None else ""
@@ -367,8 +370,11 @@ def _ch5(bases: dict) -> list[Row]:
             unit = {"angle": "deg", "torque": "N*m", "grf": "N"}[kind]
             sd = _rms_sd(gait, col, 1 / cv.DEG if kind == "angle" else 1.0)
             ours = float(r.get((kind, ch), np.nan)) if r is not None else np.nan
+            cause = ablation.get(model, {}).get((kind, part, side))
+            if cause is None and (kind, part, side) in jerk:  # the MSK measurement, named as such
+                cause = jerk[(kind, part, side)]
             rows.append(Row(5, f"{model} RMSE {kind} {part} {side.upper()} ({table})", tv, ours, unit,
-                            ablation.get(model, {}).get((kind, part, side), "unknown"),
+                            cause or "unknown",
                             s.name if s is not None else "", valid, sd=sd))
     # Table 5.10 and COT: the NMSK solution
     s = bases.get("NMSK")
@@ -427,6 +433,32 @@ def _ablation_causes(model: str = "MSK") -> dict:
     for (kind, part, side, unit), r in fidelity.channel_table(picked, model).iterrows():
         out[(kind, part, side)] = (f"tracking ablation: lowest {r[r['best change']]:.1f} {unit} "
                                    f"({r['best change']}), target {r['target']:.1f} {unit} met by: {r['met by']} [{where}]")
+    return out
+
+
+def _jerk_causes(model: str) -> dict:
+    """(kind, part, side) → what the Ch 2 problem of ``model`` gives at that channel with the
+    Jrk term's denominators from the data (:func:`gaitlib.studies.fidelity.jerk_study`,
+    swing foot unloaded) beside the book's reading; empty when the study is not stored."""
+    try:
+        with cache.only("the card reads stored solutions only"):
+            table, sols = fidelity.jerk_study(model)
+    except cache.NotCached:
+        return {}
+    runs = list(table.index)
+    book, data = sols[runs[2]], sols[runs[3]]
+    if data.stats["status"] not in validity.CONVERGED_STATUSES:
+        return {}
+    where = _anchor("ch02_gait", "The jerk term's denominators: a HAT pinned to a constant speed")
+    a = book.rmse.set_index(["kind", "channel"])["rmse"]
+    b = data.rmse.set_index(["kind", "channel"])["rmse"]
+    units = {"angle": "°", "torque": " N·m", "grf": " N"}
+    out = {}
+    for (kind, ch), v in b.items():
+        part, side = (ch[4:-2], ch[-1]) if kind == "grf" else (ch[:-2], ch[-1])
+        out[(kind, part, side)] = (f"Ch 2 {model}, swing unloaded ({table.loc[runs[3], 'gates']}): Jrk denominators of "
+                                   f"the HAT from the data {v:.1f}{units[kind]} vs the book's fallback "
+                                   f"{a[(kind, ch)]:.1f}{units[kind]} [{where}]")
     return out
 
 

@@ -18,8 +18,10 @@ Units: SI inside (m, N, s); tables say their unit in the column name.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import replace
 
+import casadi as ca
 import numpy as np
 import pandas as pd
 
@@ -224,7 +226,8 @@ def tracking_changes(model: str = "MSK") -> dict[str, dict]:
     alone to the swing-unloaded problem (:func:`ablation_specs`): parameters identified on
     our data instead of the thesis's (Ch 4 contact and body, Ch 5 MTGs, both = the Ch 5
     solve's sets), the tracking weights (Table 5.3's ¼ → 1 for the GRF or the coordinate
-    term), and the mesh (40 × 5 instead of 20 × 5)."""
+    term), the mesh (40 × 5 instead of 20 × 5), and the Jrk term's denominators of the HAT's
+    horizontal position and tilt from the data (:func:`jerk_specs`)."""
     w = dict(gait_ocp.COST_FUNCTIONS[model][gait_study.natural_gait_spec(model).cost])
     return {
         "Ch 4 contact & body (ours)": {"contact_params": "ch4", "body_params": "ch4"},
@@ -234,6 +237,7 @@ def tracking_changes(model: str = "MSK") -> dict[str, dict]:
         f"GRF weight ×{1 / w['GRF']:g}": {"weights": (("GRF", 1.0),)},
         f"coordinate weight ×{1 / w['Q']:g}": {"weights": (("Q", 1.0),)},
         "mesh 40 × 5": {"n_intervals": 40},
+        "Jrk ranges from the data": {"jerk_ranges": "data"},
     }
 
 
@@ -432,4 +436,193 @@ def cot_curve_findings(cot: pd.DataFrame, terms: pd.DataFrame, min_points: int =
                       "these motions, not re-optimised)." if moves else
                       "No single term's removal puts the minimum at Free: the Free motion costs more per metre "
                       "in several terms at once."))
+    return out
+
+
+# ======================================================================================
+# The angle floor: how close to the data's angles a motion of this model can get
+# ======================================================================================
+
+#: Depth of a loaded foot's lowest ellipsoid below the ground in :func:`kinematic_floor`, m
+#: (the contact carries the body weight at ≈ 1–2 mm; 0.5–5 mm spans the stance loads).
+STANCE_DEPTH = (0.0005, 0.005)
+
+
+def _stance(tau, gd, side: str, margin: float = data_mod.SWING_MARGIN) -> np.ndarray:
+    """Where the data say a foot stands, shortened by ``margin`` at both ends: the
+    complement of its :func:`~gaitlib.data.swing_windows` window widened by ``margin``."""
+    return ~data_mod.in_window(tau, data_mod.swing_windows(gd.events, gd.left_shift, -margin)[side])
+
+
+def kinematic_floor(speed_class: str = "Free", source: str = "schwartz2008", n: int = 100,
+                    clearance: float = TOUCH, depth: tuple = STANCE_DEPTH,
+                    track_mtp: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The geometric part of the angle error: at each of ``n`` instants of the cycle, the
+    pose closest to the tracking reference (:func:`gaitlib.problems.gait.reference`: the
+    data's angles, the planned metatarsal angles, the HAT estimate) whose feet agree with the
+    data's phases — the foot the data say stands loaded (its lowest ellipsoid ``depth`` m
+    below the ground), the foot they say swings (the validity gate's window) every
+    ellipsoid ≥ ``clearance`` m above it.
+
+    "Closest" in the Q term's own measure (thesis Eqs 4.9–4.11): Σ over pelvis_ty and the
+    eight joint angles of (change / the reference's range)²; pelvis_tx and the HAT tilt
+    stay at the reference (``track_mtp=False``: the metatarsal angles, a planned trajectory
+    in the reference, are left free). No dynamics and no smoothness: any motion of this model whose
+    feet touch the ground when the data's do is at least this far from the data's angles,
+    instant by instant. Returns ``(table, poses)``: per leg joint the RMSE and the largest
+    change (deg); the poses (n, 11) indexed by the cycle fraction."""
+    gd = data_mod.load_gait_data(speed_class, source)
+    model = ChildModel()
+    ref = gait_ocp.reference(gd, model)
+    tau = np.arange(n) / n
+    T = gd.cycle_time
+    Q0 = np.column_stack([np.interp(tau * T, ref.q.index, ref.q[c], period=T) for c in cv.COORDS])
+    rng = np.array([ref.ranges[c] for c in cv.COORDS])
+    k = len(cv.ELLIPSOIDS)
+    x = ca.SX.sym("q", len(cv.COORDS))
+    q0 = ca.SX.sym("q0", len(cv.COORDS))
+    b = kinematics.ellipsoid_bottoms_sx(model, x)
+    free = [1] + [i for i in range(3, len(cv.COORDS)) if track_mtp or not cv.COORDS[i].startswith("mtp")]
+    nlp = {"x": x, "p": q0, "f": ca.sumsqr((x[free] - q0[free]) / rng[free]), "g": b}
+    solver = ca.nlpsol("kinematic_floor", "ipopt", nlp, {"ipopt.print_level": 0, "print_time": False,
+                                                         "ipopt.tol": 1e-10, "ipopt.sb": "yes"})
+    stance = {s: _stance(tau, gd, s) for s in cv.SIDES}
+    swing = {s: data_mod.in_window(tau, data_mod.swing_windows(gd.events, gd.left_shift)[s]) for s in cv.SIDES}
+    lbj, ubj = np.full(len(cv.COORDS), -np.inf), np.full(len(cv.COORDS), np.inf)
+    for i, c in enumerate(cv.COORDS[3:], start=3):  # the gait problem's joint bounds (data ± 3 SD ± 15°)
+        lbj[i] = float((gd.mean[c] - 3 * gd.sd[c]).min()) - 15 * cv.DEG
+        ubj[i] = float((gd.mean[c] + 3 * gd.sd[c]).max()) + 15 * cv.DEG
+    out = np.empty_like(Q0)
+    for i in range(n):
+        lbg, ubg = np.full(2 * k, -np.inf), np.full(2 * k, np.inf)
+        loaded = []
+        for j, s in enumerate(cv.SIDES):
+            if swing[s][i]:  # every ellipsoid of a swinging foot clear of the ground
+                lbg[j * k:(j + 1) * k] = clearance
+            elif stance[s][i]:  # a standing foot: none deeper than depth[1], its lowest one loaded
+                lbg[j * k:(j + 1) * k] = -depth[1]
+                loaded.append(j)
+        lbx, ubx = lbj.copy(), ubj.copy()
+        for c in (0, 2):  # pelvis_tx and the HAT tilt at the reference
+            lbx[c] = ubx[c] = Q0[i, c]
+        best = None
+        # "the lowest ellipsoid ≥ depth[0] deep" is a disjunction: each ellipsoid of each
+        # standing foot in turn is the loaded one, the best pose over the choices is kept
+        for pick in itertools.product(range(k), repeat=len(loaded)):
+            ub = ubg.copy()
+            for j, e in zip(loaded, pick):
+                ub[j * k + e] = -depth[0]
+            r = solver(x0=Q0[i], p=Q0[i], lbx=lbx, ubx=ubx, lbg=lbg, ubg=ub)
+            if solver.stats()["success"] and (best is None or float(r["f"]) < best[0]):
+                best = (float(r["f"]), np.asarray(r["x"]).ravel())
+        if best is None:
+            raise RuntimeError(f"kinematic_floor: no pose at cycle fraction {tau[i]:.2f} meets the foot constraints")
+        out[i] = best[1]
+    poses = pd.DataFrame(out, index=pd.Index(tau, name="tau"), columns=list(cv.COORDS))
+    d = (poses[list(gait_ocp.LEG_JOINTS)].to_numpy() - Q0[:, [cv.COORDS.index(j) for j in gait_ocp.LEG_JOINTS]]) / cv.DEG
+    table = pd.DataFrame({"RMSE (deg)": np.sqrt((d**2).mean(axis=0)), "largest change (deg)": np.abs(d).max(axis=0)},
+                         index=pd.Index(gait_ocp.LEG_JOINTS, name="joint"))
+    return table, poses
+
+
+# ======================================================================================
+# The jerk normalisation: the HAT pinned to a constant speed and tilt
+# ======================================================================================
+
+def com_speed_range(gait) -> float:
+    """Range (max − min, m/s) of the centre of mass's horizontal speed over the data's
+    cycle, from Newton: v(t) = v(0) + ∫ Σ F_x dt / m (the data's total horizontal GRF,
+    the model's body mass; the mean is irrelevant to the range)."""
+    t = np.asarray(gait.time, dtype=float)
+    fx = (gait.mean["grf_x_r"] + gait.mean["grf_x_l"]).to_numpy()
+    v = np.concatenate([[0.0], np.cumsum(0.5 * (fx[1:] + fx[:-1]) * np.diff(t))]) / cv.BODY_MASS
+    return float(np.ptp(v))
+
+
+def jerk_specs(model: str = "SK", bound_bw: float = SWING_BOUND_BW) -> dict[str, gait_ocp.GaitSpec]:
+    """The chapter's tracking problem of ``model`` with the Jrk term's ranges of the
+    reference (the book) and from the data (:data:`gaitlib.problems.gait.JERK_RANGES`),
+    each with the swing foot free (the thesis) and unloaded (:func:`swing_bound`)."""
+    base = gait_study.natural_gait_spec(model)
+    bound = swing_bound(bound_bw)
+    return {"Jrk ranges of the reference (book)": base,
+            "Jrk ranges from the data": replace(base, jerk_ranges="data"),
+            "Jrk ranges of the reference, swing unloaded": replace(base, swing_load_max=bound),
+            "Jrk ranges from the data, swing unloaded": replace(base, jerk_ranges="data", swing_load_max=bound)}
+
+
+def jerk_study(model: str = "SK", *, use_cache: bool = True) -> tuple[pd.DataFrame, dict]:
+    """Solve (or reload) :func:`jerk_specs` from the data (as every book solve). One row per
+    run: :func:`ablation_row`, the mean angle RMSE (deg) and the range of the HAT's
+    horizontal speed over the cycle (m/s; the data's centre of mass: :func:`com_speed_range`)."""
+    sols = {k: r.value for k, r in gait_ocp.solve_specs(jerk_specs(model), use_cache=use_cache).items()}
+    rows = []
+    for k, s in sols.items():
+        row = ablation_row(k, s)
+        row["mean angle RMSE (deg)"] = float(s.rmse[s.rmse["kind"] == "angle"]["rmse"].mean())
+        row["HAT speed range (m/s)"] = float(np.ptp(s.qd["pelvis_tx"]))
+        rows.append(row)
+    return pd.DataFrame(rows).set_index("run"), sols
+
+
+def jerk_findings(tables: dict[str, pd.DataFrame], gait) -> list[str]:
+    """The chapter's sentences on the jerk normalisation, computed from :func:`jerk_study`'s
+    tables (model → table) and the data (:func:`com_speed_range`)."""
+    rng = gait_ocp.data_jerk_ranges(gait)
+    out = [f"**The data's centre of mass changes its horizontal speed by {com_speed_range(gait):.2f} m/s over the "
+           f"cycle** (the data's horizontal GRF over the body mass); its jerk spans "
+           f"{rng['jerk_pelvis_tx']:.0f} m/s³, the data's pelvic tilt's {rng['jerk_pelvis_tilt']:.0f} rad/s³. "
+           "The book's Jrk term divides the HAT's horizontal and tilt jerks by 1 (the reference, constant speed and "
+           "tilt, has no jerk): a jerk the size of the data's costs thousands of times more than a joint's."]
+    kinds = (("worst angle RMSE (deg)", "angles", "°"), ("worst torque RMSE (N·m)", "torques", " N·m"),
+             ("worst GRF RMSE (N)", "GRFs", " N"))
+    for model, t in tables.items():
+        rows = list(t.index)
+        for a, b in ((rows[0], rows[1]), (rows[2], rows[3])):
+            ra, rb = t.loc[a], t.loc[b]
+            ok = all(r["status"] in validity.CONVERGED_STATUSES for r in (ra, rb))
+            moves = ", ".join(f"{n} {ra[c]:.1f} → {rb[c]:.1f}{u}" for c, n, u in kinds)
+            out.append(f"**{model}, {a.split(', ')[-1] if ', ' in a else 'swing foot free'}:** "
+                       + ("" if ok else "(not every run converged; read with care) ")
+                       + f"HAT speed range {ra['HAT speed range (m/s)']:.3f} → {rb['HAT speed range (m/s)']:.3f} m/s; "
+                       f"worst RMSE {moves}; gates: {rb['gates']}.")
+    return out
+
+
+def kinematic_floor_table(clearances: tuple = (0.0, TOUCH, 0.01)) -> pd.DataFrame:
+    """:func:`kinematic_floor` at several swing clearances, with the planned metatarsal
+    angles tracked (the Q term) and left free: one row per case, the RMSE per leg joint and
+    the worst (deg)."""
+    rows = []
+    for track in (True, False):
+        for c in clearances:
+            t, _ = kinematic_floor(clearance=c, track_mtp=track)
+            rows.append({"swing clearance (mm)": 1e3 * c, "metatarsal": "tracked (planned)" if track else "free",
+                         **{f"{j} (deg)": v for j, v in t["RMSE (deg)"].items()},
+                         "worst (deg)": float(t["RMSE (deg)"].max())})
+    return pd.DataFrame(rows)
+
+
+def floor_findings(floor: pd.DataFrame, jerk_tables: dict[str, pd.DataFrame], clearance_mm: float = 1e3 * TOUCH,
+                   target_deg: float | None = None) -> list[str]:
+    """Sentences on the geometric angle floor (:func:`kinematic_floor_table`) beside the
+    valid solves of :func:`jerk_study` (the data's Jrk ranges, swing unloaded), and the
+    Fidelity II angle target (default :data:`TARGET_FACTOR` × the thesis's worst MSK angle
+    row, a labelled reference)."""
+    if target_deg is None:
+        target_deg = TARGET_FACTOR * max(v for (k, _, _), v in gait_study.THESIS_RMSE["MSK"].items() if k == "angle")
+    at = floor[np.isclose(floor["swing clearance (mm)"], clearance_mm)].set_index("metatarsal")["worst (deg)"]
+    tracked, free = float(at.iloc[0]), float(at.iloc[1])
+    out = [f"**Geometry alone** (no dynamics, {clearance_mm:g} mm swing clearance): the poses closest to the reference "
+           f"whose feet agree with the data's phases are {tracked:.1f}° (worst joint RMSE) from it with the planned "
+           f"metatarsal angles tracked, {free:.1f}° with them free. "
+           + (f"With the planned metatarsal trajectory the geometric floor alone is above the {target_deg:.1f}° target."
+              if tracked > target_deg else f"Both are within the {target_deg:.1f}° target.")]
+    for model, t in jerk_tables.items():
+        r = t.iloc[3]
+        if r["status"] not in validity.CONVERGED_STATUSES:
+            continue
+        out.append(f"**{model}, the data's Jrk ranges, swing unloaded** ({r['gates']}): worst angle RMSE "
+                   f"{r['worst angle RMSE (deg)']:.1f}°, {r['worst angle RMSE (deg)'] - tracked:+.1f}° from the "
+                   "geometric floor with the metatarsal tracked.")
     return out

@@ -10,12 +10,14 @@ import pandas as pd
 
 from .. import conventions as cv
 from ..problems.jump import (FORMULATION, LABELS, SPECS, TABLE_3_5, THESIS, JumpProblem, JumpSolution,  # noqa: F401
-                             JumpSpec, build, cache_location, initial_guess, joint_bounds, meshes, solve, spec)
+                             JumpSpec, build, cache_location, initial_guess, joint_bounds, meshes, solve, spec,
+                             strength_envelope)
 from .. import plots
 
 __all__ = ["solve_all", "results_table", "stats_table", "plot_channels", "animate", "THESIS", "SPECS",
            "JumpSpec", "JumpSolution", "joint_bounds", "spec", "solve", "build", "cache_location",
-           "THESIS_HEIGHT_ORDER", "AT_BOUND", "torques_at_bound", "findings"]
+           "THESIS_HEIGHT_ORDER", "AT_BOUND", "torques_at_bound", "findings", "HUMAN_JUMP_RISE_M", "strength_specs",
+           "solve_strength", "strength_use", "strength_table", "strength_findings"]
 
 
 def solve_all(names=("toeless", "toe", "ellipsoid"), use_cache: bool = False,
@@ -207,4 +209,102 @@ def findings(sols: dict, contact_params) -> list[str]:
     out.append("The 5-interval optima the final solves started from: "
                + ", ".join(f"{n} {cm(v)}" for n, v in coarse.items())
                + " — local optima of the same problem, far from the 10-interval ones.")
+    return out
+
+
+# --------------------------------------------------------------------------------------
+# The physiological jump: joint torques limited by the body's strength
+# --------------------------------------------------------------------------------------
+
+#: Flight COM rise of human standing vertical jumps, m: ≈ 0.2 m (untrained) to ≈ 0.7 m
+#: (trained adults) — e.g. Linthorne NP (2001) "Analysis of standing vertical jumps using a
+#: force platform", Am J Phys 69:1198–1204. A labelled reference range, not a result.
+HUMAN_JUMP_RISE_M = (0.2, 0.7)
+
+
+def strength_specs(names=tuple(THESIS)) -> dict[str, JumpSpec]:
+    """The thesis's jumps with the joint torques limited by the body's strength
+    (:class:`JumpSpec` ``torque_limits="strength"``), everything else as :data:`SPECS`."""
+    return {n: spec(n, torque_limits="strength") for n in names}
+
+
+def solve_strength(names=tuple(THESIS), use_cache: bool = True) -> dict[str, JumpSolution]:
+    """Solve (or reload) :func:`strength_specs`."""
+    return {n: solve(sp, use_cache=use_cache) for n, sp in strength_specs(names).items()}
+
+
+def strength_use(sol) -> dict[str, float]:
+    """Per joint, the largest |τ| over the jump as a fraction of the strength bound at the same
+    instant (:func:`gaitlib.problems.jump.strength_envelope`: the MTG envelope at that joint
+    angle and velocity for hip, knee and ankle; the box for the metatarsal joint); > 1 means
+    the bound is exceeded."""
+    env = strength_envelope(sol.model)
+    tr = sol.trajectory
+    out = {}
+    for j in sol.model.joints:
+        tau = tr[f"tau_{j}"].to_numpy(float)
+        if j in env["envelope"]:
+            lo, hi = env["envelope"][j](tr[j].to_numpy(float), tr[f"qd_{j}"].to_numpy(float))
+        else:
+            lo, hi = env["peak"][j]
+        out[j] = float(np.max(np.where(tau >= 0, tau / hi, tau / lo)))
+    return out
+
+
+def strength_table(sols: dict[str, JumpSolution], gates: dict[str, str] | None = None) -> pd.DataFrame:
+    """One row per strength-limited jump: IPOPT status and iterations, COM rise in flight
+    (cm) beside the human range (:data:`HUMAN_JUMP_RISE_M`) and the thesis's height (a
+    labelled reference), take-off v_y, required μ_s, the largest joint torque and its use
+    of the strength bound (:func:`strength_use`), and the validity gates (``gates``: name →
+    label, e.g. from :func:`gaitlib.validity.label`)."""
+    lo, hi = HUMAN_JUMP_RISE_M
+    rows = {}
+    for n, s in sols.items():
+        h = s.jump_height
+        use = strength_use(s)
+        rows[s.spec.label] = {
+            "IPOPT status": s.status, "iterations": s.stats["iterations"],
+            "COM rise in flight (cm)": 100 * h["com_rise_flight"],
+            "human range (cm), Linthorne 2001": f"{100 * lo:.0f}–{100 * hi:.0f}",
+            "jump height (cm), thesis, Sec 3.4.4": THESIS[n]["jump_height_cm"],
+            "take-off v_y,COM (m/s)": h["takeoff_vy"],
+            "required μ_s = max|Fx/Fy|": s.required_friction,
+            "largest |τ| (N·m)": max(s.trajectory[f"tau_{j}"].abs().max() for j in s.model.joints),
+            "largest τ / strength": max(use.values()),
+            "gates": (gates or {}).get(n, ""),
+        }
+    return pd.DataFrame(rows).T
+
+
+def strength_findings(sols: dict[str, JumpSolution], valid: dict[str, bool]) -> list[str]:
+    """The strength-limited jumps' sentences, computed: per jump convergence, validity and COM
+    rise against :data:`HUMAN_JUMP_RISE_M`; the thesis's claims (toes raise the jump; the
+    compliant contact raises it further and needs less friction) read on converged, valid
+    jumps only. ``valid``: name → whether the jump passes the validity gates."""
+    lo, hi = HUMAN_JUMP_RISE_M
+    ok = {n: s for n, s in sols.items() if s.success and valid.get(n, False)}
+    out = []
+    for n, s in sols.items():
+        r = s.jump_height["com_rise_flight"]
+        state = ("converged, valid" if n in ok else
+                 ("did NOT converge (" + s.status + ")") if not s.success else "converged, fails a validity gate")
+        out.append(f"**{s.spec.label}** ({state}): COM rise in flight {100 * r:.0f} cm — "
+                   + ("inside" if lo <= r <= hi else "outside")
+                   + f" the {100 * lo:.0f}–{100 * hi:.0f} cm of human standing jumps; take-off v_y "
+                   f"{s.jump_height['takeoff_vy']:.2f} m/s; required μ_s {s.required_friction:.2f}.")
+    claims = [("toeless", "toe", "the toes raise the jump"), ("toe", "ellipsoid", "the compliant contact raises it further")]
+    for a, b, claim in claims:
+        if a in ok and b in ok:
+            ra, rb = ok[a].jump_height["com_rise_flight"], ok[b].jump_height["com_rise_flight"]
+            out.append(f"Thesis: {claim} — with strength limits {LABELS[a]} {100 * ra:.0f} cm, {LABELS[b]} "
+                       f"{100 * rb:.0f} cm: {'holds' if rb > ra else 'does NOT hold'}.")
+        else:
+            out.append(f"Thesis: {claim} — not read: " + ", ".join(
+                LABELS[n] for n in (a, b) if n not in ok) + " not converged or not valid.")
+    if "ellipsoid" in ok and ({"toeless", "toe"} & set(ok)):
+        mu_e = ok["ellipsoid"].required_friction
+        welded = {n: ok[n].required_friction for n in ("toeless", "toe") if n in ok}
+        out.append(f"Required friction: ellipsoid contact {mu_e:.2f} vs welded "
+                   + ", ".join(f"{LABELS[n]} {v:.2f}" for n, v in welded.items())
+                   + (" — less, as in the thesis." if mu_e < min(welded.values()) else " — NOT less, unlike the thesis."))
     return out
