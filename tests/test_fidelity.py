@@ -133,7 +133,8 @@ def test_tracking_findings_count_channels_against_the_target():
     import pandas as pd
     tab = pd.DataFrame({"swing unloaded only": dict(_row(), **{"starts converged": "2/2"}),
                         "coordinate weight ×4": dict(_row(angle=11.9), **{"starts converged": "2/2"}),
-                        "mesh 40 × 5": dict(_row(status="Maximum_Iterations_Exceeded"), **{"starts converged": "0/2"})}).T
+                        "mesh 40 × 5": dict(_row(status="Maximum_Iterations_Exceeded"), **{"starts converged": "0/2"}),
+                        "Jrk ranges from the data": dict(_row(angle=6.0), **{"starts converged": "2/2"})}).T
     idx = pd.MultiIndex.from_tuples([("angle", "hip", "r", "deg"), ("grf", "y", "l", "N")],
                                     names=["kind", "channel", "side", "unit"])
     pc = pd.DataFrame({"swing unloaded only": [5.9, 47.0], "coordinate weight ×4": [4.5, 30.0],
@@ -141,7 +142,8 @@ def test_tracking_findings_count_channels_against_the_target():
     text = " ".join(fidelity.tracking_findings(tab, pc))
     assert "1 of 2 channels" in text and "grf y l" in text
     assert "mesh 40 × 5:** neither start converged" in text
-    assert "does not lower the angle error" in text and "hypothesis" in text
+    assert "does not lower the angle error" in text and "hypothesis" not in text
+    assert "One such thing, measured: the Jrk term's denominators of the HAT (Jrk ranges from the data: worst 6.0°" in text
 
 
 def test_cot_curve_findings_locate_the_minimum_and_the_term_that_moves_it():

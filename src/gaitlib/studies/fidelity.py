@@ -327,10 +327,13 @@ def tracking_findings(tracking: pd.DataFrame, per_channel: pd.DataFrame) -> list
         k = weight_rows[0]
         a0, a1 = ref["worst angle RMSE (deg)"], tracking.loc[k, "worst angle RMSE (deg)"]
         if a1 >= a0:
+            jrk = [r for r in usable if r.startswith("Jrk ranges")]
+            held = (f" One such thing, measured: the Jrk term's denominators of the HAT ({jrk[0]}: worst "
+                    f"{tracking.loc[jrk[0], 'worst angle RMSE (deg)']:.1f}°; the jerk-term section)."
+                    if jrk and tracking.loc[jrk[0], "worst angle RMSE (deg)"] < a0 else "")
             out.append(f"**Raising the coordinate term's weight does not lower the angle error** ({k}: worst "
                        f"{a0:.1f} → {a1:.1f}°): the angles are not held off the data by the weighting but by "
-                       "something the weight cannot move. A hypothesis, not yet measured: the data's angles leave the "
-                       "swing foot no clearance on this model (above), so a valid motion cannot follow them.")
+                       "something the weight cannot move." + held)
     cols = [c for c in [rows[0]] + usable if c in per_channel.columns]
     met_any = per_channel[cols].le(per_channel["target"], axis=0).any(axis=1)
     n = len(per_channel)
