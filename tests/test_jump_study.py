@@ -242,3 +242,21 @@ def test_strength_limits_keep_the_thesis_keys_and_bound_every_phase():
         lo, hi = mtg.max_joint_torque(j, q, qd, None, **kw)
         assert env["envelope"][j](q, qd) == pytest.approx((2 * lo, 2 * hi))
         assert 2 * lo >= env["peak"][j][0] - 1e-9 and 2 * hi <= env["peak"][j][1] + 1e-9
+
+
+def test_strength_findings_read_claims_on_converged_valid_jumps_only():
+    from types import SimpleNamespace
+
+    def fake(name, rise, ok=True, mu=0.5):
+        return SimpleNamespace(jump_height={"com_rise_flight": rise, "takeoff_vy": (2 * 9.81 * rise) ** 0.5},
+                               success=ok, status="Solve_Succeeded" if ok else "Infeasible_Problem_Detected",
+                               required_friction=mu, spec=SimpleNamespace(label=J.LABELS[name]))
+
+    sols = {"toeless": fake("toeless", 0.12, mu=2.1), "toe": fake("toe", 0.5, ok=False), "ellipsoid": fake("ellipsoid", 0.18, mu=0.34)}
+    text = " ".join(J.strength_findings(sols, {"toeless": True, "toe": False, "ellipsoid": True}))
+    assert "did NOT converge (Infeasible_Problem_Detected)" in text
+    assert "the toes raise the jump — not read" in text
+    assert "toes and compliant contact together raise it — with strength limits" in text and "12 cm" in text
+    assert "18 cm: holds" in text
+    assert "outside the 20–70 cm" in text  # 12 cm, below the human range
+    assert "ellipsoid contact 0.34 vs welded toeless, kinematic contact 2.10 — less, as in the thesis" in text

@@ -221,3 +221,18 @@ def test_book_gates_table_from_given_solutions():
     s = SV.summary(g)
     assert s.loc["strength", "failed"] == 1 and s.loc["converged", "failed"] == 1
     assert V.label(jump).startswith("invalid: torque 900 N·m")
+
+
+def test_a_torque_at_its_strength_bound_within_round_off_passes():
+    """A jump bounded by the same strength ends at the bound within IPOPT's tolerance: 1e-9
+    relative above it passes, 1e-4 above it fails."""
+    h = 0.116 * math.sin(math.radians(28.8)) + 0.503 + 0.440 + 0.660
+    model = SimpleNamespace(joints=("ankle", "knee", "hip"), total_mass=73.8, incline=math.radians(28.8), standing_top=h)
+    lim = V.strength_limits(None, body_mass=73.8, body_height=h, legs=2)
+    idx = pd.Index(np.linspace(0, 1, 5), name="time")
+    for excess, ok in ((1e-9, True), (1e-4, False)):
+        traj = pd.DataFrame({"phase": "thrust", "ankle": 0.0, "knee": -0.5, "hip": 0.5, "tau_ankle": -10.0,
+                             "tau_knee": 10.0, "tau_hip": lim["hip"][0] * (1 + excess), "grf_x": 0.0,
+                             "grf_y": 700.0}, index=idx)
+        sol = SimpleNamespace(trajectory=traj, jump_height={}, model=model, status="Solve_Succeeded")
+        assert ("strength" not in V.check(sol).failed) is ok

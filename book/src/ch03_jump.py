@@ -29,9 +29,9 @@
 import numpy as np
 import pandas as pd
 import matplotlib.pyplot as plt
-from IPython.display import HTML, display
+from IPython.display import HTML, Markdown, display
 
-from gaitlib import contact, conventions as cv, marks, plots
+from gaitlib import contact, conventions as cv, marks, plots, validity
 from gaitlib.jump import JUMP_SEGMENTS, JumpModel
 from gaitlib.studies import jump
 
@@ -320,6 +320,36 @@ HTML(plots.animation_html(jump.animate(sols["toe"], max_frames=30, dpi=60, mark=
 HTML(plots.animation_html(jump.animate(sols["ellipsoid"], max_frames=30, dpi=60, mark=marks.failure_label(sols["ellipsoid"]))))
 
 # %% [markdown]
+# ## The physiological jump: joint torques limited by strength
+#
+# The thesis's Table 3.5 lets every joint produce 1500–4000 N·m. The same three problems
+# again, with one change (`JumpSpec(torque_limits="strength")`): at hip, knee and ankle the
+# torque must stay, at every node of every phase, within what the muscles can produce at
+# that joint angle and angular velocity — the envelope of Ch 5's muscle torque generators
+# with the agonist fully active (torque–angle × torque–velocity + passive, thesis Eq 5.8),
+# scaled by Eq 5.21 to this model's mass and standing height and doubled for the two legs;
+# at the metatarsal joint (no generator) a box of ± the ankle plantarflexors' peak. Phases,
+# cost, contact and mesh are the thesis-bounds jumps'. Each solve starts from the same
+# problem with box limits only (each joint's peak strength), itself solved through the mesh
+# continuation: part of the specification, so the result is reproducible. The human range
+# beside the COM rise is a labelled reference (standing vertical jumps, Linthorne 2001).
+
+# %%
+strong = jump.solve_strength(NAMES)
+strong_gates = {n: validity.label(s, name=n) for n, s in strong.items()}
+marks.mark_table(jump.strength_table(strong, strong_gates),
+                 {s.spec.label: marks.failure_label(s) for s in strong.values()})
+
+# %%
+display(Markdown("\n\n".join(jump.strength_findings(strong, {n: validity.check(s).passed for n, s in strong.items()}))))
+
+# %%
+fig = jump.plot_channels(strong, "torques")
+for k, ax in enumerate(fig.axes):
+    marks.mark_axes(ax, marks.failure_label(list(strong.values())[k % len(strong)]))
+plt.show()
+
+# %% [markdown]
 # ## What we found
 #
 # Computed from the solutions above (nothing in this list is typed by hand):
@@ -331,19 +361,16 @@ for line in jump.findings(sols, contact_params):
 # %% [markdown]
 # **Why our heights differ from the thesis's.** Nothing in the thesis's formulation limits
 # the jump to a human one: Table 3.5 allows joint torques of 1500–4000 N·m — several times
-# what the leg muscles of a 74 kg adult produce — with no torque–velocity or power limit,
-# so the optimum is bounded only by the angle and angular-velocity ranges, the phase
-# durations and the take-off condition (the list above says which torques reach their
-# bounds, and by how many body weights the ground pushes). The problem also has many local
-# optima: which one IPOPT reaches depends on the initial guess and the mesh, as the
-# continuation table shows. The thesis's GPOPS-II solves started from guess postures taken
-# from an experimental jump (Table 3.6) and stopped at a nearby local optimum, within
-# per-phase state ranges it did not print ("defined based on … the posture of the human at
-# each phase", Sec 3.3), which kept them close to a human jump. Our solves start from a
-# generic crouch-and-extend guess with only the ranges listed above, so their optima are
-# super-human: the numbers are the printed formulation's, not a prediction of a human
-# jump, and with this multimodality we do not read differences between the models' heights
-# as evidence for or against the toes. What carries over is the contact comparison: a
+# what the leg muscles of a 74 kg adult produce — with no torque–velocity or power limit
+# (the list above says which torques reach their bounds, and by how many body weights the
+# ground pushes). The section on the physiological jump measures what the body's strength
+# changes, with everything else held. The problem also has local optima: the continuation
+# table shows the coarse optima the final solves started from. That the thesis's GPOPS-II
+# solves stayed near a human jump because they started from an experimental jump's postures
+# (Table 3.6) within per-phase state ranges it did not print ("defined based on … the
+# posture of the human at each phase", Sec 3.3) is a hypothesis we cannot test without
+# those ranges. The thesis-bounds numbers are the printed formulation's, not a prediction of
+# a human jump. What carries over is the contact comparison: a
 # welded foot transmits any tangential force, so |F_x/F_y| is limited by nothing, while
 # the velocity-based friction law of the ellipsoids caps it near their friction
 # coefficients — the thesis's own explanation of its 0.12 (Sec 3.4.3). Our cap is the

@@ -123,6 +123,10 @@ SWING_LOAD_BW = 0.02
 #: Margin at each end of the data's swing window, fraction of the cycle
 #: (:data:`gaitlib.data.SWING_MARGIN`, the events' SD).
 SWING_MARGIN = data_mod.SWING_MARGIN
+#: A torque counts as within its strength up to this relative excess: a solve whose torques
+#: are bounded by the same strength (a jump with ``torque_limits``) ends at its bound within
+#: IPOPT's constraint tolerance, i.e. round-off above it (measured: 1.2e-9 relative).
+STRENGTH_RTOL = 1e-6
 #: Largest fraction of the cycle with both feet loaded (> SWING_LOAD_BW) that is still walking.
 DOUBLE_SUPPORT_MAX = 0.40
 #: Double support of walking, fraction of the cycle (total of both phases): ≈ 20–25 %
@@ -355,11 +359,11 @@ def check_frames(*, status: str, q: pd.DataFrame | None = None, torques: pd.Data
                 ratio = val / lim if lim else np.inf
                 if worst is None or ratio > worst[0]:
                     worst = (ratio, c, val, lim)
-                if ratio > 1:
+                if ratio > 1 + STRENGTH_RTOL:
                     over.append(f"{c} {val:.0f} N·m (limit {lim:.0f})")
         if worst is not None:
             ratio, c, val, lim = worst
-            rows.append(_row("strength", abs(val), abs(lim), "N·m", ratio <= 1,
+            rows.append(_row("strength", abs(val), abs(lim), "N·m", ratio <= 1 + STRENGTH_RTOL,
                              f"worst {c}: {val:.1f} N·m = {100 * ratio:.0f} % of its peak {lim:.1f} N·m"
                              + (f"; over: {', '.join(over)}" if over else "") + f"; {strength_source}",
                              basis=f"{c} peak"))

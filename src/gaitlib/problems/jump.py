@@ -222,9 +222,9 @@ class JumpSpec:
         model's mass and standing height, × 2 legs; at the metatarsal joint (no MTG) a box
         of ± the ankle plantarflexors' peak (:func:`gaitlib.mtg.strength_limits`).
         ``"strength_peak"``: only boxes, each joint's peak (the eccentric plateau) in each
-        direction. A ``"strength"`` solve without a guess starts from the
-        ``"strength_peak"`` solution of the same spec (solved, or reloaded from the cache,
-        through its mesh continuation): part of the procedure, recorded in
+        direction. A ``"strength"`` solve without a guess starts its mesh continuation from
+        the ``"strength_peak"`` solution on the continuation's first (coarsest) mesh
+        (solved, or reloaded from the cache): part of the procedure, recorded in
         ``solution.info["continuation"]``.
     """
 
@@ -865,7 +865,8 @@ class JumpSolution:
                 "n_constraints": s.info.get("n_constraints"),
                 "mesh": f"{self.spec.n_intervals} x {self.spec.degree} LGR per phase",
                 "continuation": " → ".join(
-                    f"{c['n_intervals']}: {c['status']} ({c['iterations']} it, "
+                    f"{c['n_intervals']}{' (' + c['torque_limits'] + ')' if 'torque_limits' in c else ''}: "
+                    f"{c['status']} ({c['iterations']} it, "
                     f"{c['solve_time']:.1f} s)" for c in s.info.get("continuation", [])) or "–",
                 "from_cache": self.from_cache}
 
@@ -1002,12 +1003,15 @@ def _solve_continued(sp: JumpSpec, guess, root=None) -> ocp.Solution:
     """Solve ``sp`` from ``guess``, or, without one, through its mesh continuation
     (:attr:`JumpSpec.continuation`: each coarser mesh warm-starts the next)."""
     record = []
-    if sp.torque_limits == "strength" and guess is None:  # from the box-limited jump (see JumpSpec)
-        pre = solve(replace(sp, torque_limits="strength_peak"), use_cache=True, root=root)
-        record.append({"torque_limits": "strength_peak", "status": pre.status, "iterations": pre.solution.iterations,
-                       "objective": pre.solution.objective, **pre.jump_height})
-        guess = pre.solution
     steps = [n for n in sp.continuation if n < sp.n_intervals] if guess is None else []
+    if sp.torque_limits == "strength" and guess is None and steps:  # from the box-limited jump (see JumpSpec)
+        pre = solve(replace(sp, torque_limits="strength_peak", n_intervals=steps[0], continuation=()),
+                    use_cache=True, root=root)
+        record.append({"n_intervals": steps[0], "torque_limits": "strength_peak", "status": pre.status,
+                       "iterations": pre.solution.iterations, "solve_time": pre.solution.solve_time,
+                       "build_time": pre.solution.build_time, "objective": pre.solution.objective,
+                       **pre.jump_height, "required_friction": pre.required_friction})
+        guess = pre.solution
     for n in steps:
         coarse = solve(replace(sp, n_intervals=n, continuation=()), guess)
         c = coarse.solution

@@ -292,7 +292,8 @@ def strength_findings(sols: dict[str, JumpSolution], valid: dict[str, bool]) -> 
                    + ("inside" if lo <= r <= hi else "outside")
                    + f" the {100 * lo:.0f}–{100 * hi:.0f} cm of human standing jumps; take-off v_y "
                    f"{s.jump_height['takeoff_vy']:.2f} m/s; required μ_s {s.required_friction:.2f}.")
-    claims = [("toeless", "toe", "the toes raise the jump"), ("toe", "ellipsoid", "the compliant contact raises it further")]
+    claims = [("toeless", "toe", "the toes raise the jump"), ("toe", "ellipsoid", "the compliant contact raises it further"),
+              ("toeless", "ellipsoid", "toes and compliant contact together raise it")]
     for a, b, claim in claims:
         if a in ok and b in ok:
             ra, rb = ok[a].jump_height["com_rise_flight"], ok[b].jump_height["com_rise_flight"]
