@@ -86,7 +86,12 @@ def test_cli_writes_card(cli_card):
     assert not (blocked & c["verdict"].isin(["reproduced", "within data SD", "qualitatively reproduced"])).any()
     # the thesis-bounds jumps say why they are not a human jump
     jumps = c[(c["chapter"] == 3) & c["item"].str.contains("jump height \\(")]
-    assert len(jumps) == 3 and jumps["cause"].str.contains("human standing jumps").all()
+    thesis_bounds = jumps[~jumps["item"].str.contains("strength")]
+    assert len(thesis_bounds) == 3 and thesis_bounds["cause"].str.contains("human standing jumps").all()
+    # the strength-limited jumps (where stored) are rows of their own, against the same human range
+    strong = jumps[jumps["item"].str.contains("strength")]
+    assert strong["cause"].str.contains("MTG strength envelope").all()
+    assert strong["cause"].str.contains("human standing jumps").all()
     assert (card.counts(c).sum() == len(c))
 
 
