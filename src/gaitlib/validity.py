@@ -103,7 +103,6 @@ import numpy as np
 import pandas as pd
 
 from . import conventions as cv
-from . import mtg
 from .mtg import strength_limits
 from .sweep import ACCEPTED_STATUSES
 from . import data as data_mod
