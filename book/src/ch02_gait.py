@@ -258,8 +258,8 @@ display(Markdown("\n\n".join(fidelity.tracking_findings(tracking, per_channel)))
 # the experimental data" (thesis Sec 4.3.2, which puts the magnitude of jerk at ≈ 10⁵ rad/s³).
 # The public data have no pelvis position: the reference of the HAT's horizontal position is
 # the constant speed × time and its tilt is 0, so their jerk range is 0, and the book's
-# problem divides by a fallback of **1** (m/s³, rad/s³). A jerk the size of the data's then
-# costs thousands of times more than a joint's: the HAT walks at a constant speed. The other
+# problem divides by a fallback of **1** (m/s³, rad/s³): how much more a jerk of the HAT
+# then costs, and how constant its speed becomes, is computed below. The other
 # reading, ours from the data (`GaitSpec(jerk_ranges="data")`): the horizontal jerk of the
 # centre of mass from the data's horizontal GRF (Newton: $m\,\dddot x_{COM} = \sum \dot F_x$)
 # and the tilt's from the data's pelvic tilt; every other denominator unchanged. Below, the

@@ -521,6 +521,13 @@ def reference(gait: data_mod.GaitData, model: ChildModel, p_contact=None, order:
     return Reference(gait=gait, q=qref, deriv=deriv, tau=tau, grf=grf, ranges=ranges)
 
 
+def joint_angle_bounds(gait: data_mod.GaitData) -> dict[str, tuple[float, float]]:
+    """Bounds of the eight joint angles (rad): the data's mean ± 3 SD over the cycle, widened
+    by 15° (thesis: "based on the standard deviation")."""
+    return {c: (float((gait.mean[c] - 3 * gait.sd[c]).min()) - 15 * cv.DEG,
+                float((gait.mean[c] + 3 * gait.sd[c]).max()) + 15 * cv.DEG) for c in cv.COORDS[3:]}
+
+
 def data_jerk_ranges(gait: data_mod.GaitData, order: int = 12, n: int = 401) -> dict[str, float]:
     """Jrk denominators (max − min over the cycle) of the two HAT coordinates whose
     reference has no jerk, from the data: ``jerk_pelvis_tx`` (m/s³) — the centre of mass's
@@ -1034,11 +1041,7 @@ def build(spec: GaitSpec) -> GaitProblem:
     data_frame = tracking_frame(spec, ref)
 
     # ---- bounds (generous, from the data; thesis: "based on the standard deviation")
-    bounds = {}
-    for c in cv.COORDS[3:]:  # from speed_class's own data, also when tracking another class's
-        lo = float((gait_class.mean[c] - 3 * gait_class.sd[c]).min()) - 15 * cv.DEG
-        hi = float((gait_class.mean[c] + 3 * gait_class.sd[c]).max()) + 15 * cv.DEG
-        bounds[c] = (lo, hi)
+    bounds = joint_angle_bounds(gait_class)  # speed_class's own data, also when tracking another class's
     bounds["pelvis_tilt"] = (-30 * cv.DEG, 30 * cv.DEG)
     bounds["pelvis_ty"] = (0.5, 1.0)
     bounds["pelvis_tx"] = (-0.5, stride + 0.5)

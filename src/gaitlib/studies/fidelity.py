@@ -492,9 +492,8 @@ def kinematic_floor(speed_class: str = "Free", source: str = "schwartz2008", n: 
     stance = {s: _stance(tau, gd, s) for s in cv.SIDES}
     swing = {s: data_mod.in_window(tau, data_mod.swing_windows(gd.events, gd.left_shift)[s]) for s in cv.SIDES}
     lbj, ubj = np.full(len(cv.COORDS), -np.inf), np.full(len(cv.COORDS), np.inf)
-    for i, c in enumerate(cv.COORDS[3:], start=3):  # the gait problem's joint bounds (data ± 3 SD ± 15°)
-        lbj[i] = float((gd.mean[c] - 3 * gd.sd[c]).min()) - 15 * cv.DEG
-        ubj[i] = float((gd.mean[c] + 3 * gd.sd[c]).max()) + 15 * cv.DEG
+    for c, (lo, hi) in gait_ocp.joint_angle_bounds(gd).items():  # the gait problem's own bounds
+        lbj[cv.COORDS.index(c)], ubj[cv.COORDS.index(c)] = lo, hi
     out = np.empty_like(Q0)
     for i in range(n):
         lbg, ubg = np.full(2 * k, -np.inf), np.full(2 * k, np.inf)
@@ -576,7 +575,9 @@ def jerk_findings(tables: dict[str, pd.DataFrame], gait) -> list[str]:
            f"cycle** (the data's horizontal GRF over the body mass); its jerk spans "
            f"{rng['jerk_pelvis_tx']:.0f} m/s³, the data's pelvic tilt's {rng['jerk_pelvis_tilt']:.0f} rad/s³. "
            "The book's Jrk term divides the HAT's horizontal and tilt jerks by 1 (the reference, constant speed and "
-           "tilt, has no jerk): a jerk the size of the data's costs thousands of times more than a joint's."]
+           f"tilt, has no jerk): the same horizontal jerk then costs ({rng['jerk_pelvis_tx']:.0f}/1)² = "
+           f"{rng['jerk_pelvis_tx'] ** 2:,.0f} times, the same tilt jerk {rng['jerk_pelvis_tilt'] ** 2:,.0f} times "
+           "what it costs with the data's denominators."]
     kinds = (("worst angle RMSE (deg)", "angles", "°"), ("worst torque RMSE (N·m)", "torques", " N·m"),
              ("worst GRF RMSE (N)", "GRFs", " N"))
     for model, t in tables.items():
