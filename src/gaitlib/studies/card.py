@@ -10,7 +10,7 @@ stored gives a "not comparable" row) and returns a DataFrame with the columns :d
 ``unit``      SI-ish display unit of both (deg, N*m, N, cm, J/kg/m, %, 1 …)
 ``verdict``   :func:`verdict` (the rule below, stated once)
 ``cause``     a one-line measured reason with the book page/section that measures it,
-              or ``"unknown"``
+              ``"unknown"``, or empty for a reproduced row (it needs none)
 ``solution``  the stored solution (cache kind/key and what it is)
 ``valid``     its physical validity gates (:func:`gaitlib.validity.check`): ``"valid"``,
               ``"not converged (…)"`` and/or ``"invalid: …"``
@@ -149,6 +149,8 @@ class Row:
             cause = f"{'gates fail (valid column)' if cause == 'unknown' else cause}; the number alone: {alone}"
         if _missing(self.ours) and cause == "unknown":
             cause = "no stored solution"
+        if v in ("reproduced", "within data SD") and cause == "unknown":
+            cause = ""  # a reproduced row needs no cause
         def g6(x):  # 6 significant digits for numbers (text kept)
             return float(f"{float(x):.6g}") if _numeric(x) else x
 
@@ -376,10 +378,11 @@ def _ch5(bases: dict) -> list[Row]:
         for j, tv in mtg_id.THESIS_RMSE_DEG.items():
             rows.append(Row(5, f"MTG identification: {j} angle RMSE (Sec 5.1.2)", tv, prov["rmse_deg"].get(j, np.nan),
                             "deg", "unknown", name, v))
+        causes = _mtg_causes(gait_ocp.load_mtg_params(f))
         for g in mtg.GENERATORS:
             for k in ("s_tau", "s_V"):
                 rows.append(Row(5, f"MTG {g}: {k} (Table 5.2)", float(getattr(mtg.THESIS_PARAMS[g], k)),
-                                float(params[g][k]), "1", "unknown", name, v))
+                                float(params[g][k]), "1", causes[g], name, v))
     gait = sg.tracking_data(data_mod.load_gait_data("Free"))
     # Tables 5.4 and 5.11: tracking RMSEs
     ablation = {"MSK": _ablation_causes("MSK")}
@@ -441,6 +444,27 @@ def _ch5_unloaded() -> list[Row]:
              f"{cot / gross:.2f}×, the thesis's {msk.THESIS_COT / gross:.2f}× "
              f"[{_anchor('ch05_msk', 'The same on valid gaits: the swing foot unloaded')}]")
     return [Row(5, item, msk.THESIS_COT, cot, "J/kg/m", cause, n.name, gate(n, "NMSK"))]
+
+
+def _mtg_causes(ours: dict) -> dict[str, str]:
+    """generator → why its identified Γ is where it is: the smallest margin of Eq 5.15 (the
+    generator strong enough for the demanded torque, N·m) on our data for Eq 5.22's initial
+    set, the thesis's Table 5.2 and ``ours`` (:func:`gaitlib.studies.mtg_id.margins_table`).
+    Eq 5.23 penalises any departure from the initial values, so a generator whose initial
+    set already meets the demand (margin > 0) keeps it; one short of it moves."""
+    sets = {"initial": None, "thesis": mtg.THESIS_PARAMS, "ours": ours}
+    m = mtg_id.margins_table(sets, mtg_id.demanded_torques(mtg_id.chapter_spec())).xs("Eq 5.15", axis=1, level=1)
+    where = _anchor("ch05_msk", "Which constraints bind")
+    out = {}
+    for g, r in m.iterrows():
+        if r["initial"] > 0:
+            out[g] = (f"Eq 5.15 inactive on our data: Eq 5.22's initial set is {r['initial']:.1f} N·m stronger than "
+                      f"the demand, so Eq 5.23's regulariser keeps Γ at it (Table 5.2's set: margin "
+                      f"{r['thesis']:.1f} N·m) [{where}]")
+        else:
+            out[g] = (f"Eq 5.15 binds on our data: Eq 5.22's initial set is {-r['initial']:.1f} N·m short of the "
+                      f"demand, Table 5.2's {-r['thesis']:.1f} N·m short; ours {r['ours']:+.2f} N·m [{where}]")
+    return out
 
 
 def _ablation_causes(model: str = "MSK") -> dict:
