@@ -224,3 +224,15 @@ def test_committed_ch4_parameters_are_a_converged_feasible_identification():
         r = pc[contact.param_index(e, "mu_d")] / pc[contact.param_index(e, "mu_s")]
         assert ci.MU_RATIO[0] - 1e-6 <= r <= ci.MU_RATIO[1] + 1e-6
     assert 0.8 * 41.4 <= ChildModel().total_mass(pb) <= 1.2 * 41.4
+
+
+def test_identified_note_names_the_spec_fields_that_differ():
+    from gaitlib.problems import gait as gait_ocp
+    spec = gait_ocp.GaitSpec(model="SK", cost="Eq4.13")
+    res = SimpleNamespace(solution=SimpleNamespace(spec=spec))
+    same = {"max_rel_diff_contact": 0.0, "max_rel_diff_body": 1e-9, "provenance": {"spec": spec.to_dict()}}
+    assert ci.identified_note(same, res).startswith("The stored file is this page's (c)")
+    old = {k: v for k, v in spec.to_dict().items() if k != "jerk_ranges"}
+    other = {"max_rel_diff_contact": 0.5, "max_rel_diff_body": 0.2, "provenance": {"spec": old, "date": "2026-11-22"}}
+    text = ci.identified_note(other, res)
+    assert "not this page's (c)" in text and "0.50" in text and "jerk_ranges: 'unset' there, 'data' here" in text

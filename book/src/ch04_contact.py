@@ -50,7 +50,7 @@ import time
 import numpy as np
 import pandas as pd
 import matplotlib.pyplot as plt
-from IPython.display import display
+from IPython.display import Markdown, display
 
 from gaitlib import contact, conventions as cv, data, marks, plots
 from gaitlib.model import ChildModel
@@ -327,6 +327,7 @@ cmp = ci.identified_vs_result(c)
 print({k: v for k, v in cmp["provenance"].items() if k != "spec"})
 print(f"stored file vs this page's (c): largest difference {cmp['max_rel_diff_contact']:.1e} (contact) and "
       f"{cmp['max_rel_diff_body']:.1e} (body) of the bound widths")
+display(Markdown(ci.identified_note(cmp, c)))
 
 # %% [markdown]
 # ## What we found

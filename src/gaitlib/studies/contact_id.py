@@ -690,6 +690,23 @@ def identified_vs_result(res: ApproachResult, name: str = "ch4_child") -> dict:
             "path": str(stored["path"])}
 
 
+def identified_note(cmp: dict, res: ApproachResult, tol: float = 1e-6) -> str:
+    """One sentence on whether the stored identified set (``cmp`` =
+    :func:`identified_vs_result`) is ``res``'s: if not, which spec fields of the solve it
+    was written from differ from ``res``'s (absent fields: the spec's default of that time)."""
+    worst = max(cmp["max_rel_diff_contact"], cmp["max_rel_diff_body"])
+    if worst <= tol:
+        return f"The stored file is this page's (c) (largest difference {worst:.1e} of the bound widths)."
+    old = cmp["provenance"].get("spec") or {}
+    new = res.solution.spec.to_dict()
+    diff = {k: (old.get(k, "unset"), new.get(k, "unset")) for k in sorted(set(old) | set(new))
+            if old.get(k, "unset") != new.get(k, "unset")}
+    what = ", ".join(f"{k}: {a!r} there, {b!r} here" for k, (a, b) in diff.items()) or "no spec field (the code)"
+    return (f"**The stored file is not this page's (c)** (largest difference {worst:.2f} of the bound widths): it "
+            f"was written on {cmp['provenance'].get('date', '?')} from a (c) solved with a different problem — {what}. "
+            "Later chapters load the stored file, so they use that earlier identification.")
+
+
 # --------------------------------------------------------------------------------------
 # What the chapter found
 # --------------------------------------------------------------------------------------
