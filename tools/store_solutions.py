@@ -41,8 +41,8 @@ def notebooks(argv) -> list[Path]:
     return [REPO / "book" / f"{f}.ipynb" for f in files if (REPO / "book" / f"{f}.ipynb").exists()]
 
 
-#: nbval's per-cell limit for a refresh, s (Ch 6's sweep cell took 2,006 s on 2 workers
-#: from a partly filled cache, over nbval's default of 2,000 s).
+#: nbval's per-cell limit for a refresh, s (Ch 6's sweep cell, solving on 2 workers beside
+#: another refresh, was stopped at nbval's default of 2,000 s).
 CELL_TIMEOUT_S = 4 * 3600
 
 
