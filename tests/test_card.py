@@ -13,6 +13,8 @@ from gaitlib import cache
 from gaitlib.cli import main
 from gaitlib.studies import card
 from gaitlib.studies import msk
+from gaitlib import mtg
+from gaitlib.studies import mtg_id
 
 
 # --------------------------------------------------------------------------------------
@@ -130,3 +132,13 @@ def test_card_never_solves(tmp_path, monkeypatch):
     assert len(c) >= 30 and (c["verdict"] == "not comparable").all()
     assert (c["cause"] == "no stored solution").all()
     assert not (tmp_path / "cache").exists() or not any((tmp_path / "cache").rglob("*.json"))
+
+
+def test_mtg_causes_say_where_eq_5_15_binds_on_our_data():
+    causes = card._mtg_causes({g: mtg.MTGParams() for g in mtg.GENERATORS})
+    margins = mtg_id.margins_table({"x": None}, mtg_id.demanded_torques(mtg_id.chapter_spec())).xs(
+        "Eq 5.15", axis=1, level=1)["x"]
+    for g, m in margins.items():
+        assert causes[g].startswith("Eq 5.15 inactive" if m > 0 else "Eq 5.15 binds"), g
+        assert f"{abs(m):.1f} N·m" in causes[g] and "#which-constraints-bind" in causes[g]
+    assert any(m < 0 for m in margins) and any(m > 0 for m in margins)  # both kinds occur on our data
