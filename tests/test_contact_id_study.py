@@ -227,7 +227,7 @@ def test_committed_ch4_parameters_are_a_converged_feasible_identification():
 
 
 def test_identified_note_names_the_spec_fields_that_differ():
-    spec = gait_ocp.GaitSpec(model="SK", cost="Eq4.13")
+    spec = gait_ocp.GaitSpec(model="SK", cost="Eq4.13", jerk_ranges="data")
     res = SimpleNamespace(solution=SimpleNamespace(spec=spec))
     same = {"max_rel_diff_contact": 0.0, "max_rel_diff_body": 1e-9, "provenance": {"spec": spec.to_dict()}}
     assert ci.identified_note(same, res).startswith("The stored file is this page's (c)")
