@@ -17,6 +17,8 @@ Shell: ``gaitlib gap --data CSV --out DIR``, ``gaitlib gap-twin --effect NAME
 from __future__ import annotations
 
 import importlib
+import sys
+import types
 
 _LAZY = {
     "EFFECTS": ("gaitlib.effects", "EFFECTS"), "TWIN_EFFECTS": ("gaitlib.effects", "TWIN_EFFECTS"),
@@ -36,3 +38,17 @@ def __getattr__(name):
         mod, attr = _LAZY[name]
         return getattr(importlib.import_module(mod if "." in mod else f".{mod}", __name__ if "." not in mod else None), attr)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+class _CallableModule(types.ModuleType):
+    """A submodule that is also its namesake function: importing ``gaitlib.gap.locate`` (or
+    ``.diagnose``) makes Python bind the *module* to that package attribute, so without this
+    ``gaitlib.gap.locate(sol, data)`` would raise "module object is not callable" once anything
+    had imported the submodule."""
+
+    def __call__(self, *args, **kwargs):
+        return getattr(self, self.__name__.rsplit(".", 1)[1])(*args, **kwargs)
+
+
+def _callable(name: str) -> None:
+    sys.modules[f"{__name__}.{name}"].__class__ = _CallableModule

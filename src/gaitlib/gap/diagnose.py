@@ -772,3 +772,10 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
     settings = {"objective": objective, "candidates": names, "warm": warm is not None}
     return assemble(ds, spec0, base_sol, fits, objective=objective, resamples=resamples, seed=seed, skipped=skipped,
                     settings=settings, solution=solution)
+
+
+# ``gaitlib.gap.diagnose(...)`` calls :func:`diagnose` even after this submodule was imported
+# (gaitlib.gap._CallableModule).
+from . import _callable  # noqa: E402
+
+_callable("diagnose")

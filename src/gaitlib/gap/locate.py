@@ -319,3 +319,10 @@ def _aggregate(points: pd.DataFrame) -> pd.DataFrame:
     t = t.sort_values(["channel", "phase"], key=lambda s: s.map(order) if s.name == "channel" else s)
     t["phase"] = t["phase"].astype(str)
     return t.reset_index(drop=True)
+
+
+# ``gaitlib.gap.locate(...)`` calls :func:`locate` even after this submodule was imported
+# (gaitlib.gap._CallableModule).
+from . import _callable  # noqa: E402
+
+_callable("locate")
