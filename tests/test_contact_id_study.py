@@ -235,3 +235,45 @@ def test_identified_note_names_the_spec_fields_that_differ():
     other = {"max_rel_diff_contact": 0.5, "max_rel_diff_body": 0.2, "provenance": {"spec": old, "date": "2026-11-22"}}
     text = ci.identified_note(other, res)
     assert "not this page's (c)" in text and "0.50" in text and "jerk_ranges: 'unset' there, 'data' here" in text
+
+
+def test_readings_thesis_is_the_printed_problem_book_adds_three_fields():
+    from gaitlib.problems import contact_id as cid_ocp
+    from gaitlib import validity
+    assert ci.spec_b(4, 3, reading="thesis") == cid_ocp.spec_b(4, 3)
+    assert ci.spec_c(4, 3, reading="thesis") == cid_ocp.spec_c(4, 3)
+    b = ci.spec_b(4, 3)
+    assert (b.jerk_ranges, b.max_iter) == ("data", 3000)
+    # 1 % of body weight, half the gate's 2 %: 0.01 × 41.4 kg × g
+    assert b.swing_load_max == pytest.approx(0.01 * 41.4 * 9.81, abs=1e-3)
+    assert b.swing_load_max < validity.SWING_LOAD_BW * 41.4 * 9.81
+    gp = gait_ocp.build(ci.spec_c(4, 3))
+    assert "swing_load" in [pc.name for pc in gp.problem.phases[0].path_constraints]
+    with pytest.raises(ValueError, match="reading"):
+        ci.reading_options("printed")
+
+
+def test_start_params_and_the_multistart_keeps_the_lowest_valid(monkeypatch):
+    np.testing.assert_array_equal(ci.start_params("neutral"), ci.neutral_start())
+    th = ci.start_params("thesis (c)")
+    assert th[contact.param_index("toe", "k_v")] == ci.THESIS_CONTACT["c"]["toe"][0]
+    # the pick: lowest objective among converged and valid, else lowest of all
+    objective = {"neutral": 0.02, "thesis (c)": 0.01, "ch4_child": 0.03}
+    valid = {"neutral": True, "thesis (c)": False, "ch4_child": True}
+    made = {}
+
+    def fake_run(spec, start=None, **kw):
+        name = next(n for n in ci.B_STARTS if np.array_equal(ci.start_params(n), start))
+        made[name] = r = ci.ApproachResult("b", np.asarray(start), None, None, None, None, None, None, None,
+                                           {"status": "Solve_Succeeded", "success": True, "iterations": 10,
+                                            "objective": objective[name], "eq4_5": 0.0}, solution=name)
+        return r
+
+    monkeypatch.setattr(ci, "optimal_control", fake_run)
+    monkeypatch.setattr(ci.validity, "check", lambda sol: SimpleNamespace(passed=valid[sol], label=lambda: "x"))
+    monkeypatch.setattr(ci.params_mod, "contact_params", lambda which: 2 * ci.neutral_start())
+    best = ci.optimal_control_multistart()
+    assert best is made["neutral"] and best.stats["start"] == "neutral"
+    assert best.starts.loc["neutral", "kept"] and not best.starts.loc["thesis (c)", "kept"]
+    valid.update({"neutral": False, "ch4_child": False})
+    assert ci.optimal_control_multistart().stats["start"] == "thesis (c)"

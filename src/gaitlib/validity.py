@@ -113,12 +113,24 @@ from .problems import gait as gait_ocp
 __all__ = ["CONVERGED_STATUSES", "SWING_LOAD_BW", "SWING_MARGIN", "DOUBLE_SUPPORT_MAX", "DOUBLE_SUPPORT_WALKING",
            "RESIDUAL_FORCE_FRACTION", "RESIDUAL_MOMENT_FRACTION", "ROM_DEG", "ROM_TOL_DEG", "PERIODICITY_TOL",
            "SK_STRENGTH_PARAMS", "DATA_TERMS", "CHECKS", "Gates", "strength_limits", "data_rom", "check",
-           "check_frames", "label"]
+           "check_frames", "label", "SWING_BOUND_BW", "swing_bound"]
 
 #: IPOPT statuses counted as converged (the sweep's rule, :data:`gaitlib.sweep.ACCEPTED_STATUSES`).
 CONVERGED_STATUSES = ACCEPTED_STATUSES
 #: Vertical load a swinging foot may carry, fraction of body weight.
 SWING_LOAD_BW = 0.02
+#: The bound a problem may put on a swinging foot's vertical force
+#: (:attr:`gaitlib.problems.gait.GaitSpec.swing_load_max`): half the gate's limit, so a
+#: solution meeting it passes the gate with a margin. Fraction of body weight.
+SWING_BOUND_BW = 0.5 * SWING_LOAD_BW
+
+
+def swing_bound(bound_bw: float = SWING_BOUND_BW) -> float:
+    """A bound on a swinging foot's vertical force, N (``bound_bw`` × body weight, rounded to
+    1 mN: it is part of the spec, hence of the cache key)."""
+    return round(bound_bw * cv.BODY_MASS * cv.G, 3)
+
+
 #: Margin at each end of the data's swing window, fraction of the cycle
 #: (:data:`gaitlib.data.SWING_MARGIN`, the events' SD).
 SWING_MARGIN = data_mod.SWING_MARGIN

@@ -65,15 +65,18 @@ from .. import data as data_mod
 from .. import params as params_mod
 from ..problems import gait as gait_ocp
 from ..model import P_BODY_NAMES, P_BODY_UNITS, ChildModel
+from .. import validity
+from ..problems import contact_id as cid_ocp
 from ..problems.contact_id import (CONTINUATION, FORMULATION, GUESS_METHOD, MU_RATIO,  # noqa: F401  (API)
                                    TRAJOPT_FORMULATION, InverseDynamicsID, TrajOptSpec, solve_continued,
-                                   solve_stage, neutral_start, spec_b, spec_c)
+                                   solve_stage, neutral_start)
 
 __all__ = [
     "APPROACHES", "THESIS_RMSE", "THESIS_GEOMETRY", "THESIS_CONTACT", "THESIS_TIME",
     "TrajOptSpec", "InverseDynamicsID", "ApproachResult",
     "neutral_start", "thesis_params", "trajectory_optimization", "spec_b", "spec_c", "optimal_control",
-    "optimal_control_body", "run_all",
+    "optimal_control_body", "run_all", "READINGS", "reading_options", "B_STARTS", "start_params",
+    "optimal_control_multistart", "starts_table", "reading_table", "reading_findings",
     "rmse_table", "rmse_beside_thesis", "solver_table", "geometry_table", "contact_table",
     "body_table", "at_bounds", "friction_ratios", "residual_rms", "grf_fit", "dynamic_consistency", "grf_error_by_phase",
     "save_identified", "identified_vs_result", "THESIS_RANKING", "ranking", "findings",
@@ -144,6 +147,60 @@ _GEOM = ("a", "b", "c", "r_x", "r_y", "r_z", "gamma", "beta", "alpha")
 _GEOM_UNIT = ("mm",) * 6 + ("deg",) * 3
 _FRIC = ("k_v", "a_v", "mu_s", "mu_d")
 _FRIC_UNIT = ("N/m^3", "s/m", "-", "-")
+
+
+#: The two readings of (b)/(c) the chapter shows side by side. ``"thesis"``: Eqs 4.6–4.11 as
+#: printed — the Jrk term's denominators from the reference (the HAT's horizontal position
+#: and tilt have no jerk there, so they fall back to 1), nothing keeps a swinging foot off the
+#: ground, IPOPT's 1,000 iterations. ``"book"``: the Jrk denominators of those two
+#: coordinates from the data (:func:`gaitlib.problems.gait.data_jerk_ranges`), each foot's
+#: vertical force bounded by :func:`gaitlib.validity.swing_bound` while the data say it swings,
+#: and up to 3,000 iterations. The thesis's reading lets (b)/(c) identify contact that
+#: carries body weight in swing (the validity gate fails), so the book's headline uses "book".
+READINGS = ("book", "thesis")
+
+
+def reading_options(reading: str = "book") -> dict:
+    """The :class:`~gaitlib.problems.gait.GaitSpec` fields of a reading (:data:`READINGS`)."""
+    if reading == "thesis":
+        return {}
+    if reading == "book":
+        return {"jerk_ranges": "data", "swing_load_max": validity.swing_bound(), "max_iter": 3000}
+    raise ValueError(f"reading must be one of {READINGS}, got {reading!r}")
+
+
+def spec_b(n_intervals: int = 20, degree: int = 5, contact_bounds: str = "table4.7", reading: str = "book",
+           **kw) -> gait_ocp.GaitSpec:
+    """Approach (b) (:func:`gaitlib.problems.contact_id.spec_b`) in ``reading``
+    (:data:`READINGS`); ``kw`` overrides the reading's fields."""
+    return cid_ocp.spec_b(n_intervals, degree, contact_bounds, **{**reading_options(reading), **kw})
+
+
+def spec_c(n_intervals: int = 20, degree: int = 5, contact_bounds: str = "table4.7", reading: str = "book",
+           **kw) -> gait_ocp.GaitSpec:
+    """Approach (c) (:func:`gaitlib.problems.contact_id.spec_c`) in ``reading``
+    (:data:`READINGS`); ``kw`` overrides the reading's fields."""
+    return cid_ocp.spec_c(n_intervals, degree, contact_bounds, **{**reading_options(reading), **kw})
+
+
+#: (b)'s starting contact parameters (:func:`start_params`), tried in turn; the result kept is
+#: the converged, valid one with the lowest objective (:func:`optimal_control_multistart`).
+#: The thesis started from Brown & McPhee's published set, which we could not obtain.
+B_STARTS = ("neutral", "thesis (c)", "ch4_child")
+
+
+def start_params(name: str) -> np.ndarray:
+    """A start of :data:`B_STARTS` (39,), SI: ``"neutral"`` — :func:`neutral_start`;
+    ``"thesis (c)"`` — the thesis's identified set (Tables 4.17–4.18); ``"ch4_child"`` — the
+    set stored in ``data/identified/ch4_child.json`` (an earlier identification of ours, so
+    the start, and the key, change when that file is re-saved)."""
+    if name == "neutral":
+        return neutral_start()
+    if name == "thesis (c)":
+        return thesis_params("c")
+    if name == "ch4_child":
+        return params_mod.contact_params("ch4")
+    raise ValueError(f"start must be one of {B_STARTS}, got {name!r}")
 
 
 def thesis_params(key: str) -> np.ndarray:
@@ -358,6 +415,56 @@ def optimal_control(spec: gait_ocp.GaitSpec | None = None, start=None, stages=CO
     return _with_stages(_result_from_gait("b", final), sols)
 
 
+def optimal_control_multistart(spec: gait_ocp.GaitSpec | None = None, starts=B_STARTS, *, use_cache: bool = True,
+                               root=None, progress: bool = False) -> ApproachResult:
+    """Approach (b) from each of ``starts`` (:func:`start_params`), each through the
+    continuation (:func:`optimal_control`); returns the converged run that passes the validity
+    gates with the lowest objective (else the lowest objective of all, marked by its status
+    and gates), with every start's record in ``starts`` (:func:`starts_table`)."""
+    runs = {name: optimal_control(spec, start=start_params(name), use_cache=use_cache, root=root, progress=progress)
+            for name in starts}
+    table = starts_table(runs)
+    ok = table[table["converged"] & table["valid"]]
+    best = (ok if len(ok) else table)["objective"].idxmin()
+    res = runs[best]
+    res.starts = table.assign(kept=table.index == best)
+    res.stats["start"] = best
+    return res
+
+
+def starts_table(runs: dict[str, ApproachResult]) -> pd.DataFrame:
+    """One row per start of (b): status, converged, valid (:func:`gaitlib.validity.check`),
+    iterations (all stages), objective, the Eq 4.5 part, each ellipsoid's k_v (N/m³)."""
+    rows = {}
+    for name, r in runs.items():
+        g = validity.check(r.solution)
+        row = {"status": r.stats["status"], "converged": bool(r.success), "valid": bool(g.passed), "gates": g.label(),
+               "iterations": r.stats["iterations"], "objective": r.stats["objective"], "Eq 4.5 part": r.stats["eq4_5"]}
+        for e in cv.ELLIPSOIDS:
+            row[f"k_v {e} (N/m³)"] = float(r.p_contact[contact_mod.param_index(e, "k_v")])
+        rows[name] = row
+    return pd.DataFrame.from_dict(rows, orient="index").rename_axis("start")
+
+
+def reading_table(runs: dict[tuple[str, str], ApproachResult]) -> pd.DataFrame:
+    """(b)/(c) in each reading side by side: ``runs`` maps (approach key, reading) to its
+    result. Columns: status, gates (:func:`gaitlib.validity.check`), the largest vertical force
+    on a foot the data say swings (N), iterations, mean GRF RMSE (N), each ellipsoid's k_v
+    (N/m³)."""
+    rows = []
+    for (key, reading), r in runs.items():
+        g = validity.check(r.solution)
+        t = g.table.set_index("check")
+        rm = r.rmse.set_index("channel")["rmse"]
+        row = {"approach": APPROACHES[key], "reading": reading, "status": r.stats["status"], "gates": g.label(),
+               "swing load (N)": float(t.loc["swing_load", "value"]), "iterations": r.stats["iterations"],
+               "mean GRF RMSE (N)": float(np.mean([rm[c] for c in gait_ocp.GRF_CHANNELS]))}
+        for e in cv.ELLIPSOIDS:
+            row[f"k_v {e} (N/m³)"] = float(r.p_contact[contact_mod.param_index(e, "k_v")])
+        rows.append(row)
+    return pd.DataFrame(rows).set_index(["approach", "reading"])
+
+
 def optimal_control_body(spec: gait_ocp.GaitSpec | None = None, warm: ApproachResult | None = None, start=None, *,
                          use_cache: bool = True, root=None, progress: bool = False) -> ApproachResult:
     """Approach (c) (Sec 4.4): :func:`spec_c`, warm-started from (b)'s solution ``warm``
@@ -383,7 +490,7 @@ def run_all(n_intervals: int = 20, degree: int = 5, traj: TrajOptSpec = TrajOptS
     """The chapter's three identifications: ``{"a": …, "b": …, "c": …}`` ((c) warm-started
     from (b))."""
     a = trajectory_optimization(traj, use_cache=use_cache, root=root)
-    b = optimal_control(spec_b(n_intervals, degree), use_cache=use_cache, root=root, progress=progress)
+    b = optimal_control_multistart(spec_b(n_intervals, degree), use_cache=use_cache, root=root, progress=progress)
     c = optimal_control_body(spec_c(n_intervals, degree), warm=b, use_cache=use_cache, root=root, progress=progress)
     return {"a": a, "b": b, "c": c}
 
@@ -719,6 +826,25 @@ def ranking(fit: pd.DataFrame) -> list[str]:
     """The approaches' short labels ("(a)", "(b)", …) ordered by mean GRF RMSE, best first
     (``fit`` = :func:`grf_fit`, rows labelled as :data:`APPROACHES`)."""
     return list(fit["mean GRF RMSE (N)"].sort_values().index.str[:3])
+
+
+def reading_findings(b: ApproachResult, readings: pd.DataFrame) -> list[str]:
+    """Sentences on (b)'s multistart (``b.starts``, :func:`optimal_control_multistart`) and on
+    the two readings (:func:`reading_table`), every number from them."""
+    out = []
+    if b.starts is not None:
+        st = b.starts.sort_values("objective")
+        runs = "; ".join(f"{name}: {r.objective:.4g} ({r.iterations} iterations, "
+                         f"{'converged' if r.converged else 'NOT converged'}, {'valid' if r.valid else 'invalid'})"
+                         for name, r in st.iterrows())
+        out.append(f"(b) from {len(st)} starts, objective lowest first — {runs}. Kept: {b.stats['start']}.")
+    for lab in dict.fromkeys(readings.index.get_level_values(0)):
+        t, o = readings.loc[(lab, "thesis")], readings.loc[(lab, "book")]
+        ratios = ", ".join(f"{e} ×{o[f'k_v {e} (N/m³)'] / t[f'k_v {e} (N/m³)']:.2f}" for e in cv.ELLIPSOIDS)
+        out.append(f"{lab}: in the thesis's reading a swinging foot carries up to {t['swing load (N)']:.0f} N "
+                   f"({t['gates']}); in the book's {o['swing load (N)']:.1f} N ({o['gates']}). Mean GRF RMSE "
+                   f"{t['mean GRF RMSE (N)']:.1f} N → {o['mean GRF RMSE (N)']:.1f} N; k_v book / thesis: {ratios}.")
+    return out
 
 
 def findings(results: dict[str, ApproachResult], widened: ApproachResult, fit: pd.DataFrame,

@@ -35,10 +35,9 @@ from . import gait as gait_study
 from . import msk
 from . import predictive as pr
 
-#: The ablation's bound on a swinging foot's vertical force: half the validity gate's limit
-#: (:data:`gaitlib.validity.SWING_LOAD_BW` × body weight), so a solution meeting it passes
-#: the gate with a margin.
-SWING_BOUND_BW = 0.5 * validity.SWING_LOAD_BW
+#: The ablation's bound on a swinging foot's vertical force (:func:`gaitlib.validity.swing_bound`).
+SWING_BOUND_BW = validity.SWING_BOUND_BW
+swing_bound = validity.swing_bound
 #: A swing foot closer to the ground than this is counted as touching, m (the contact
 #: model's ellipsoids penetrate ≈ 1–2 mm under body weight).
 TOUCH = 0.002
@@ -95,12 +94,6 @@ def clearance_summary(clear: pd.DataFrame, touch: float = TOUCH, speed_class: st
                      "mean clearance in swing (mm)": 1e3 * c_all[sw].mean(),
                      f"swing within {1e3 * touch:.0f} mm of the ground (%)": 100 * float(np.mean(c_all[sw] < touch))})
     return pd.DataFrame(rows).set_index("foot")
-
-
-def swing_bound(bound_bw: float = SWING_BOUND_BW) -> float:
-    """The ablation's bound on a swinging foot's vertical force, N (rounded to 1 mN: it is
-    part of the spec, hence of the cache key)."""
-    return round(bound_bw * cv.BODY_MASS * cv.G, 3)
 
 
 def ch5_unloaded(model: str = "NMSK", bound_bw: float = SWING_BOUND_BW) -> gait_ocp.GaitSolution:

@@ -44,7 +44,7 @@ def book_solutions(chapters: Iterable[str] = CHAPTERS) -> dict[str, object]:
             out[f"ch3 {n}"] = jump.solve(n, use_cache=True)
     if "ch4" in chapters:
         a = ci.trajectory_optimization()
-        b = ci.optimal_control()
+        b = ci.optimal_control_multistart()
         c = ci.optimal_control_body(warm=b)
         cw = ci.optimal_control_body(spec=ci.spec_c(contact_bounds="widened"), warm=b)
         out.update({"ch4 (a)": a, "ch4 (b)": b, "ch4 (c)": c, "ch4 (c) widened": cw})
