@@ -95,3 +95,22 @@ def test_reload_reproduces_frames_and_cache_serves_the_same_solution(coarse):
     table = gait.rmse_beside_thesis(sol)
     assert set(table.columns) >= {"ours", "thesis, Table 4.9 (optimal control)"}
     assert table["ours"].notna().all()
+
+
+def test_readings_thesis_keeps_the_printed_spec_book_sets_two_fields():
+    """The thesis's reading is the spec every store key was made with; the book's adds the
+    data's Jrk denominators and the swing bound (1 % of body weight: 0.01 × 41.4 kg × g)."""
+    from gaitlib.problems import gait as gait_ocp
+    from gaitlib.studies import gait as sg, msk
+    import pytest
+    assert sg.natural_gait_spec("MSK") == gait_ocp.GaitSpec(model="MSK", cost="Eq5.33")
+    assert sg.natural_gait_spec("MSK", reading="thesis") == sg.natural_gait_spec("MSK")
+    b = sg.natural_gait_spec("MSK", reading="book")
+    assert b.jerk_ranges == "data" and b.swing_load_max == pytest.approx(0.01 * 41.4 * 9.81, abs=1e-3)
+    assert sg.natural_gait_spec("SK", reading="book", swing_load_max=None).swing_load_max is None  # kw wins
+    # Ch 5: MSK takes 3,000 iterations in the book's reading only; NMSK always
+    assert msk.ch5_spec("MSK").max_iter == 1000 and msk.ch5_spec("MSK", reading="book").max_iter == 3000
+    assert msk.ch5_spec("NMSK", reading="book").max_iter == 3000
+    assert msk.ch5_spec("NMSK", reading="book").jerk_ranges == "data"
+    with pytest.raises(ValueError, match="reading"):
+        sg.natural_gait_spec("SK", reading="literal")

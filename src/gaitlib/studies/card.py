@@ -487,7 +487,7 @@ def _ablation_causes(model: str = "MSK") -> dict:
 def _jerk_causes(model: str) -> dict:
     """(kind, part, side) → what the Ch 2 problem of ``model`` gives at that channel with the
     Jrk term's denominators from the data (:func:`gaitlib.studies.fidelity.jerk_study`,
-    swing foot unloaded) beside the book's reading; empty when the study is not stored."""
+    swing foot unloaded) beside the reference's (the thesis's reading); empty when the study is not stored."""
     try:
         with cache.only("the card reads stored solutions only"):
             table, sols = fidelity.jerk_study(model)
@@ -505,18 +505,20 @@ def _jerk_causes(model: str) -> dict:
     for (kind, ch), v in b.items():
         part, side = (ch[4:-2], ch[-1]) if kind == "grf" else (ch[:-2], ch[-1])
         out[(kind, part, side)] = (f"Ch 2 {model}, swing unloaded ({table.loc[runs[3], 'gates']}): Jrk denominators of "
-                                   f"the HAT from the data {v:.1f}{units[kind]} vs the book's fallback "
+                                   f"the HAT from the data {v:.1f}{units[kind]} vs the fallback 1 "
                                    f"{a[(kind, ch)]:.1f}{units[kind]} [{where}]")
     return out
 
 
-def _ch5_bases() -> dict:
-    """The Ch 5 MSK and NMSK solutions (Eq 5.33, Eq 5.55) as :class:`StoredGait`."""
+def _ch5_bases(reading: str = "thesis") -> dict:
+    """The Ch 5 MSK and NMSK solutions (Eq 5.33, Eq 5.55) in ``reading``
+    (:data:`gaitlib.studies.gait.READINGS`) as :class:`StoredGait`: the book's reading gives
+    Ch 5's rows; Chs 6–7 start from the thesis's until they are solved again."""
     out = {}
-    b = stored_gait(gait_ocp.cache_dir(msk.ch5_spec("MSK")))
+    b = stored_gait(gait_ocp.cache_dir(msk.ch5_spec("MSK", reading=reading)))
     if b is not None:
         out["MSK"] = b
-        nb = stored_gait(gait_ocp.cache_dir(msk.ch5_spec("NMSK"), guess=b.solution))
+        nb = stored_gait(gait_ocp.cache_dir(msk.ch5_spec("NMSK", reading=reading), guess=b.solution))
         if nb is not None:
             out["NMSK"] = nb
     return out
@@ -737,7 +739,7 @@ def _build(chapters) -> pd.DataFrame:
         rows += _ch4()
     bases = _ch5_bases() if {5, 6, 7} & set(chapters) else {}
     if 5 in chapters:
-        rows += _ch5(bases)
+        rows += _ch5(_ch5_bases("book"))
     ch6 = _runs(bases, "ch6") if {6, 7} & set(chapters) else {}
     valid6 = {k: gate(s, k) for k, s in ch6.items() if s is not None}
     if 6 in chapters:

@@ -66,6 +66,7 @@ from .. import params as params_mod
 from ..problems import gait as gait_ocp
 from ..model import P_BODY_NAMES, P_BODY_UNITS, ChildModel
 from .. import validity
+from . import gait as gait_study
 from ..problems import contact_id as cid_ocp
 from ..problems.contact_id import (CONTINUATION, FORMULATION, GUESS_METHOD, MU_RATIO,  # noqa: F401  (API)
                                    TRAJOPT_FORMULATION, InverseDynamicsID, TrajOptSpec, solve_continued,
@@ -149,24 +150,16 @@ _FRIC = ("k_v", "a_v", "mu_s", "mu_d")
 _FRIC_UNIT = ("N/m^3", "s/m", "-", "-")
 
 
-#: The two readings of (b)/(c) the chapter shows side by side. ``"thesis"``: Eqs 4.6–4.11 as
-#: printed — the Jrk term's denominators from the reference (the HAT's horizontal position
-#: and tilt have no jerk there, so they fall back to 1), nothing keeps a swinging foot off the
-#: ground, IPOPT's 1,000 iterations. ``"book"``: the Jrk denominators of those two
-#: coordinates from the data (:func:`gaitlib.problems.gait.data_jerk_ranges`), each foot's
-#: vertical force bounded by :func:`gaitlib.validity.swing_bound` while the data say it swings,
-#: and up to 3,000 iterations. The thesis's reading lets (b)/(c) identify contact that
-#: carries body weight in swing (the validity gate fails), so the book's headline uses "book".
-READINGS = ("book", "thesis")
+#: The readings of (b)/(c) the chapter shows side by side
+#: (:data:`gaitlib.studies.gait.READINGS`); in the book's, (b) and (c) may also take up to
+#: 3,000 iterations (the constrained swing takes (c) past 1,000).
+READINGS = gait_study.READINGS
 
 
 def reading_options(reading: str = "book") -> dict:
-    """The :class:`~gaitlib.problems.gait.GaitSpec` fields of a reading (:data:`READINGS`)."""
-    if reading == "thesis":
-        return {}
-    if reading == "book":
-        return {"jerk_ranges": "data", "swing_load_max": validity.swing_bound(), "max_iter": 3000}
-    raise ValueError(f"reading must be one of {READINGS}, got {reading!r}")
+    """The :class:`~gaitlib.problems.gait.GaitSpec` fields of a reading for (b)/(c)
+    (:func:`gaitlib.studies.gait.reading_options`, plus ``max_iter`` 3,000 in the book's)."""
+    return {**gait_study.reading_options(reading), **({"max_iter": 3000} if reading == "book" else {})}
 
 
 def spec_b(n_intervals: int = 20, degree: int = 5, contact_bounds: str = "table4.7", reading: str = "book",

@@ -340,7 +340,7 @@ def tracking_findings(tracking: pd.DataFrame, per_channel: pd.DataFrame) -> list
 
 
 def cot_findings(readings: pd.DataFrame, readings_unloaded: pd.DataFrame, sol, sol_unloaded) -> list[str]:
-    """Ch 5's sentences on the COT of the swing-unloaded NMSK solve beside the book's, the
+    """Ch 5's sentences on the COT of the swing-unloaded NMSK solve beside the thesis's reading's, the
     thesis's (reference) and the measured gross COT of children (:data:`msk.CHILD_COT_GROSS`).
     ``readings``: :func:`msk.cot_readings` of ``sol``; the same for ``sol_unloaded``."""
     g0, g1 = validity.check(sol), validity.check(sol_unloaded)
@@ -352,8 +352,8 @@ def cot_findings(readings: pd.DataFrame, readings_unloaded: pd.DataFrame, sol, s
         return out
     state = "passes every validity gate" if g1.passed else g1.label()
     out.append(f"**The swing-unloaded NMSK solve** ({sol_unloaded.stats['iterations']} iterations) {state}. "
-               f"Its COT under the NLP's reading is {c1:.2f} J kg⁻¹ m⁻¹, against {c0:.2f} for the book's Ch 5 "
-               f"solve ({g0.label()}), the thesis's {msk.THESIS_COT:g} (reference, its model and data) and the "
+               f"Its COT under the NLP's reading is {c1:.2f} J kg⁻¹ m⁻¹, against {c0:.2f} for the Ch 5 "
+               f"solve in the thesis's reading ({g0.label()}), the thesis's {msk.THESIS_COT:g} (reference, its model and data) and the "
                f"gross COT measured in 6–12-year-olds at free speed, {msk.CHILD_COT_GROSS:.1f} J kg⁻¹ m⁻¹ "
                f"(Waters et al. 1983: {msk.CHILD_COT_GROSS_ML_O2} mL O₂ kg⁻¹ m⁻¹ × {msk.J_PER_ML_O2} J/mL).")
     if g1.passed:
@@ -536,11 +536,11 @@ def com_speed_range(gait) -> float:
 
 def jerk_specs(model: str = "SK", bound_bw: float = SWING_BOUND_BW) -> dict[str, gait_ocp.GaitSpec]:
     """The chapter's tracking problem of ``model`` with the Jrk term's ranges of the
-    reference (the book) and from the data (:data:`gaitlib.problems.gait.JERK_RANGES`),
+    reference (the thesis's reading) and from the data (:data:`gaitlib.problems.gait.JERK_RANGES`),
     each with the swing foot free (the thesis) and unloaded (:func:`swing_bound`)."""
     base = gait_study.natural_gait_spec(model)
     bound = swing_bound(bound_bw)
-    return {"Jrk ranges of the reference (book)": base,
+    return {"Jrk ranges of the reference (thesis's reading)": base,
             "Jrk ranges from the data": replace(base, jerk_ranges="data"),
             "Jrk ranges of the reference, swing unloaded": replace(base, swing_load_max=bound),
             "Jrk ranges from the data, swing unloaded": replace(base, jerk_ranges="data", swing_load_max=bound)}

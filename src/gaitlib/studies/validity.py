@@ -33,12 +33,14 @@ def book_solutions(chapters: Iterable[str] = CHAPTERS) -> dict[str, object]:
     loads them (``progress=False``, ``serial=True`` for the sweeps, so cache hits stay in
     this process). Labels: ``"ch2 SK"``, ``"ch3 toe"``, ``"ch4 (b)"``, ``"ch6 NMSK FP"``,
     ``"ch7 MSK DT_Fast"``, …; ``"… [thesis guess]"`` for the runs the chapters show from
-    the thesis's partial NMSK guess."""
+    the thesis's partial NMSK guess, ``"… [thesis's reading]"`` for the problem as printed
+    beside the book's reading (:data:`gaitlib.studies.gait.READINGS`)."""
     chapters = set(chapters)
     out: dict[str, object] = {}
     if "ch2" in chapters:
-        out["ch2 SK Eq4.11"] = gait.natural_gait("SK")
-        out["ch2 MSK Eq5.33"] = gait.natural_gait("MSK")
+        for m, eq in (("SK", "Eq4.11"), ("MSK", "Eq5.33")):
+            out[f"ch2 {m} {eq}"] = gait.natural_gait(m, reading="book")
+            out[f"ch2 {m} {eq} [thesis's reading]"] = gait.natural_gait(m, reading="thesis")
     if "ch3" in chapters:
         for n in ("toeless", "toe", "ellipsoid"):
             out[f"ch3 {n}"] = jump.solve(n, use_cache=True)
@@ -47,10 +49,14 @@ def book_solutions(chapters: Iterable[str] = CHAPTERS) -> dict[str, object]:
         b = ci.optimal_control_multistart()
         c = ci.optimal_control_body(warm=b)
         cw = ci.optimal_control_body(spec=ci.spec_c(contact_bounds="widened"), warm=b)
-        out.update({"ch4 (a)": a, "ch4 (b)": b, "ch4 (c)": c, "ch4 (c) widened": cw})
+        bt = ci.optimal_control(ci.spec_b(reading="thesis"))
+        ct = ci.optimal_control_body(ci.spec_c(reading="thesis"), warm=bt)
+        out.update({"ch4 (a)": a, "ch4 (b)": b, "ch4 (c)": c, "ch4 (c) widened": cw,
+                    "ch4 (b) [thesis's reading]": bt, "ch4 (c) [thesis's reading]": ct})
     if "ch5" in chapters:
-        out["ch5 MSK Eq5.33"] = msk.solve("MSK")
-        out["ch5 NMSK Eq5.55"] = msk.solve("NMSK")
+        for m, eq in (("MSK", "Eq5.33"), ("NMSK", "Eq5.55")):
+            out[f"ch5 {m} {eq}"] = msk.solve(m, reading="book")
+            out[f"ch5 {m} {eq} [thesis's reading]"] = msk.solve(m, reading="thesis")
     if "ch6" in chapters or "ch7" in chapters:
         runs = []
         if "ch6" in chapters:
