@@ -32,7 +32,7 @@
 # | | thesis | here | why |
 # |---|---|---|---|
 # | data | Bovi 2011, 20 children, 0.98 s cycle | Schwartz 2008 *Free* class, 0.991 s | Bovi's data are not public |
-# | starting parameters | Brown & McPhee's published adult values (friction 0.40 / 0.35 for (a)) | a **neutral start**: the centre of every Table 4.7 box ($k_v$ at its geometric centre, 3.2·10⁶ N/m³), μ_s = 0.40, μ_d = 0.35 | Brown & McPhee's values could not be obtained; the thesis's own answers are not used as a start |
+# | starting parameters | Brown & McPhee's published adult values (friction 0.40 / 0.35 for (a)) | a **neutral start**: the centre of every Table 4.7 box ($k_v$ at its geometric centre, 3.2·10⁶ N/m³), μ_s = 0.40, μ_d = 0.35 | Brown & McPhee's values could not be obtained; (b) also starts from the thesis's identified set and from ours (below) |
 # | (a) search | GlobalSearch + `fmincon` | one local solve from the neutral start, then from the best-scoring points of a seeded Latin-hypercube scatter; IPOPT with exact first and second derivatives in scaled variables | same idea, reproducible, exact derivatives |
 # | (a) kinematics | measured (pelvis marker) | our reference: data angles (hip = thigh in the laboratory) and a HAT height at which the thesis's identified contact (Table 4.17), at rest, carries the data's vertical GRF | the public data have no pelvis position; this is the one place the thesis's identified geometry enters |
 # | (b), (c) bounds | Table 4.7 (the thesis's (c) values lie partly outside it, so (c) must have used unreported wider bounds) | Table 4.7 verbatim for (a), (b) and (c) | the only bounds printed |
@@ -341,10 +341,11 @@ plt.show()
 #
 # `data/identified/ch4_child.json` holds (c)'s 39 contact and 25 body parameters (SI) with
 # the spec, gaitlib version, cache fingerprint of the code, IPOPT status and iterations, the
-# date and the bounds. It was written by `contact_id.save_identified` from this chapter's
-# (c) solution; later chapters load it with `GaitSpec(contact_params="ch4",
-# body_params="ch4")`. The page only reads it, and checks that it agrees with the (c)
-# solution computed above.
+# date and the bounds. It was written by `contact_id.save_identified` from a (c) solution
+# of this chapter; later chapters load it with `GaitSpec(contact_params="ch4",
+# body_params="ch4")`. The page only reads it, and checks whether it is the (c) solution
+# computed above. Re-saving it changes the problem of every later chapter (and every key of
+# their stored solutions), so it is re-saved only together with a re-solve of Chs 5–8.
 
 # %%
 cmp = ci.identified_vs_result(c)

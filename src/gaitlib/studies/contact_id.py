@@ -25,16 +25,20 @@ Starting points (our choice; the thesis started (a) and (b) from Brown & McPhee'
 parameters, which we could not obtain — ``shared/design/model-facts.md``): the *neutral*
 start :func:`neutral_start` — the centre of each Table 4.7 box (k_v at its geometric
 centre, 3.2·10⁶ N/m³) with the thesis's friction guess μ_s = 0.40, μ_d = 0.35 (Sec 4.3.1) —
-is (a)'s first start and (b)'s guess (with the data-based guess of Sec 4.3.2 for the states
-and controls). (b) is reached through a continuation on the residual bounds
+is (a)'s first start and one of (b)'s three (:data:`B_STARTS`, with the data-based guess of
+Sec 4.3.2 for the states and controls; :func:`optimal_control_multistart` keeps the converged,
+valid run of lowest objective). (b) is reached through a continuation on the residual bounds
 (:data:`CONTINUATION`), because from the neutral start the exact problem stopped at IPOPT's
 iteration limit, infeasible. (c) is warm-started from
 (b)'s solution (states, controls and contact parameters; the body parameters start at their
 Sec 4.1.1 values).
-The thesis's identified values (Tables 4.17–4.18) are **not** used as a start; they enter
-only through the HAT-height reference of the tracked kinematics (the height at which that
+The thesis's identified values (Tables 4.17–4.18) are one of (b)'s starts; they also enter
+through the HAT-height reference of the tracked kinematics (the height at which that
 contact, at rest, carries the data's vertical GRF — the public data have no pelvis marker),
 which is also (a)'s fixed pelvis trajectory.
+
+(b) and (c) are solved in the book's reading of the problem (:data:`READINGS`: the data's Jrk
+denominators, the swinging foot unloaded) unless ``reading="thesis"``.
 
 Every solve is cached (:mod:`gaitlib.cache`; key = spec + start + code + data), so a rerun
 reloads. :func:`save_identified` writes (c)'s parameters with their provenance to
