@@ -507,8 +507,10 @@ for lab, c in (("Schwartz 2008 Free", chkS), ("gaitutils", chkU)):
 # above it, and blames the MTGs' lack of co-contraction. Co-contraction, joint stiffness and
 # activation timing are muscle-level effects: they leave angles, torques and GRFs
 # unchanged and show only in the excitations, so the test needs the NMSK model. The
-# baseline is the **Ch 5 NMSK solution** itself (Eq 5.55, the thesis's 20 × 5 mesh,
-# `gaitlib.studies.msk.solve("NMSK")`), whose gap is located with the EMG channels; each
+# baseline is the **Ch 5 NMSK solution** itself in the thesis's reading (Eq 5.55, the
+# thesis's 20 × 5 mesh, `gaitlib.studies.msk.solve("NMSK")`: Jrk denominators of the
+# reference, the swinging foot free — Ch 5 now reports the book's reading beside it; this
+# diagnosis has not been solved again on that one), whose gap is located with the EMG channels; each
 # candidate is re-solved on the same mesh with the thesis's own cost function plus the
 # effect, warm-started from it — co-contraction and joint stiffness at the magnitudes of
 # their profile grid, activation timing (a comparison-only effect: the excitation compared
@@ -554,7 +556,8 @@ if cc is not None and cc.located is not None:
 # ## 6. The gap of the book's Ch 5–7 solutions
 #
 # The same locating step applied to the solutions the chapters report, reloaded (nothing is
-# re-solved): the Ch 5 MSK and NMSK solutions, the 16 cost-function runs of Ch 6 and the
+# re-solved): the Ch 5 MSK and NMSK solutions (in the book's reading and in the thesis's,
+# from which Chs 6–7 still start), the 16 cost-function runs of Ch 6 and the
 # 8 speed runs of Ch 7. A Ch 7 run is located against **its own speed class's data** — the
 # data it never tracked (it tracks the Free data scaled in time): that gap is the
 # prediction error. RMS z over the angles, torques and GRFs of both legs (against the data

@@ -523,7 +523,8 @@ def book_gaps(root=None) -> pd.DataFrame:
     """The located gap of the book's own Ch 5–7 solutions (nothing is re-solved: every
     solution is reloaded through its study function).
 
-    Ch 5: the MSK and NMSK data-tracking solutions; Ch 6: the 16 cost-function runs; Ch 7:
+    Ch 5: the MSK and NMSK data-tracking solutions in the book's and in the thesis's reading
+    (:data:`gaitlib.studies.gait.READINGS`; Chs 6–7 start from the thesis's); Ch 6: the 16 cost-function runs; Ch 7:
     the 8 speed runs — each located against **its own speed class's data** (Schwartz 2008),
     which Ch 7 never tracked (it tracks the Free data scaled in time). One row per solution:
     chapter, model, case (cost function or class), mark (:func:`gaitlib.marks.failure_label`),
@@ -532,7 +533,8 @@ def book_gaps(root=None) -> pd.DataFrame:
     :func:`exact_left_leg`), RMS z of the EMG channels (muscle models), the number of
     significant channel × phase cells (non-EMG) and the largest such cell.
     """
-    items = [("Ch 5", m, "DT (Eq 5.33)" if m == "MSK" else "DT (Eq 5.55)", msk.solve(m, root=root)) for m in ("MSK", "NMSK")]
+    items = [("Ch 5", m, ("DT (Eq 5.33)" if m == "MSK" else "DT (Eq 5.55)") + f", {reading}'s reading",
+              msk.solve(m, root=root, reading=reading)) for reading in ("book", "thesis") for m in ("MSK", "NMSK")]
     r6 = pr.cost_function_study(("MSK", "NMSK"), pr.CH6_COSTS, progress=False, root=root)
     items += [("Ch 6", r6.specs[k].model, r6.specs[k].cost, s) for k, s in r6.solutions.items()]
     r7 = pr.speed_study(("MSK", "NMSK"), pr.CH7_CLASSES, progress=False, root=root)
