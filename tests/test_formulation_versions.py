@@ -116,7 +116,8 @@ PROBES = [
     (gait_ocp.FORMULATION, "NMSK Eq5.55", _gait(gait_ocp.GaitSpec(model="NMSK", cost="Eq5.55", n_intervals=3, degree=2))),
     (gait_ocp.FORMULATION, "SK DT + effect", _gait(gait_ocp.GaitSpec(model="SK", cost="DT", n_intervals=3, degree=2,
                                                           effects=(("body_mass", None),)))),
-    (gait_ocp.FORMULATION, "contact (b)", _gait(ci.spec_b(3, 2))),
+    # the probe of the printed problem: the book's reading only sets GaitSpec fields
+    (gait_ocp.FORMULATION, "contact (b)", _gait(ci.spec_b(3, 2, reading="thesis"))),
     (gsolve.FORMULATION, "SK fit", _gap()),
     (jump.FORMULATION, "toeless", _jump("toeless")),
     (jump.FORMULATION, "ellipsoid", _jump("ellipsoid")),
