@@ -127,3 +127,27 @@ def test_fully_predictive_fits_the_data_worse_than_data_tracking(base, root):
     assert nr["MSK DT"]["angle"] < nr["MSK FP"]["angle"]
     assert nr["MSK DT"]["torque"] < nr["MSK FP"]["torque"]
     assert set(sols["MSK FP"].solution.goals["goal"]) == {"Jrk", "Rsd", "Imp", "HAT", "Act"}
+
+
+def test_reading_of_the_ch6_ch7_runs(monkeypatch):
+    """The thesis's reading leaves every Ch 6/7 spec (hence every stored key) as it was; the
+    book's adds the data's Jrk denominators everywhere and the swing bound wherever data time
+    the swing (not FP)."""
+    from gaitlib.problems import gait as gait_ocp
+    from gaitlib.studies import predictive as pr
+    monkeypatch.setattr(gait_ocp, "hat_reference_of", lambda base: ())
+    for model in ("MSK", "NMSK"):
+        old6 = {f"{model} {c}": gait_ocp.GaitSpec(model=model, cost=c, speed_class="Free", n_intervals=3, degree=2,
+                                                  **({"excitation_guess": "emg"} if model == "NMSK" else {}))
+                for c in pr.CH6_COSTS}
+        assert pr.ch6_specs(model, None, n_intervals=3, degree=2) == old6
+        book6 = pr.ch6_specs(model, None, n_intervals=3, degree=2, reading="book")
+        for k, s in book6.items():
+            assert s.jerk_ranges == "data"
+            assert (s.swing_load_max is None) == (s.cost == "FP"), k
+        book7 = pr.ch7_specs(model, None, n_intervals=3, degree=2, reading="book")
+        assert all(s.swing_load_max > 0 and s.jerk_ranges == "data" for s in book7.values())
+        assert all(s.swing_load_max is None for s in pr.ch7_specs(model, None, n_intervals=3, degree=2).values())
+    # a field given explicitly wins over the reading's
+    assert pr.ch7_specs("MSK", None, ("Fast",), n_intervals=3, degree=2, reading="book",
+                        swing_load_max=1.0)["MSK Fast"].swing_load_max == 1.0

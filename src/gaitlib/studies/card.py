@@ -527,16 +527,17 @@ def _ch5_bases(reading: str = "thesis") -> dict:
 # ======================================================================================
 # Chapters 6 and 7: cost functions and speeds
 # ======================================================================================
-def _runs(bases: dict, which: str) -> dict:
-    """name → StoredGait (or None) of the Ch 6 (``which="ch6"``) or Ch 7 runs, found as
+def _runs(bases: dict, which: str, reading: str = "thesis") -> dict:
+    """name → StoredGait (or None) of the Ch 6 (``which="ch6"``) or Ch 7 runs in ``reading``
+    (``bases``: the Ch 5 solutions of that reading), found as
     :func:`gaitlib.studies.predictive.cost_function_study` / ``speed_study`` store them."""
     out = {}
     for m, base in bases.items():
         if which == "ch6":
-            specs = pr.ch6_specs(m, base, pr.CH6_COSTS, **pr.default_params())
+            specs = pr.ch6_specs(m, base, pr.CH6_COSTS, reading=reading, **pr.default_params())
             guesses = {k: pr.run_guess(base, pr.GUESS_POLICY[m]) for k in specs}
         else:
-            specs = pr.ch7_specs(m, base, pr.CH7_CLASSES, **pr.default_params())
+            specs = pr.ch7_specs(m, base, pr.CH7_CLASSES, reading=reading, **pr.default_params())
             guesses = {}
             for k, s in specs.items():
                 g = data_mod.load_gait_data(s.speed_class, s.source)

@@ -84,12 +84,22 @@ def _mesh(n_intervals, degree):
 
 
 def baseline(model: str, *, n_intervals: int = 20, degree: int = 5, root=None, progress: bool = False,
-             **kw) -> gait_ocp.GaitSolution:
+             reading: str = "thesis", **kw) -> gait_ocp.GaitSolution:
     """The model's Ch 5 natural-gait data-tracking solution (MSK Eq 5.33; NMSK Eq 5.55 with
-    the activation parameters identified, warm-started from the MSK one):
-    :func:`gaitlib.studies.msk.solve`, solved or reloaded from the cache; ``kw`` override
-    spec fields."""
-    return msk.solve(model, root=root, progress=progress, **_mesh(n_intervals, degree), **kw)
+    the activation parameters identified, warm-started from the MSK one) in ``reading``
+    (:data:`gaitlib.studies.gait.READINGS`): :func:`gaitlib.studies.msk.solve`, solved or
+    reloaded from the cache; ``kw`` override spec fields."""
+    return msk.solve(model, root=root, progress=progress, reading=reading, **_mesh(n_intervals, degree), **kw)
+
+
+def reading_fields(reading: str, cost: str) -> dict:
+    """The :class:`~gaitlib.problems.gait.GaitSpec` fields of a Ch 6/7 run with ``cost`` in
+    ``reading`` (:func:`gaitlib.studies.gait.reading_options`). FP tracks no data, so nothing
+    times its swing: it keeps the data's Jrk denominators but no swing bound."""
+    fields = sg.reading_options(reading)
+    if cost == "FP":
+        fields.pop("swing_load_max", None)
+    return fields
 
 
 def default_params() -> dict:
@@ -178,23 +188,26 @@ def thesis_guess(base: gait_ocp.GaitSolution, *, cycle_time: float | None = None
 
 
 def ch6_specs(model: str, base: gait_ocp.GaitSolution, costs=CH6_COSTS, *, n_intervals: int = 20, degree: int = 5,
-              **kw) -> dict[str, gait_ocp.GaitSpec]:
-    """The Ch 6 problems of ``model`` (Table 6.2 weights), HAT reference from ``base``."""
+              reading: str = "thesis", **kw) -> dict[str, gait_ocp.GaitSpec]:
+    """The Ch 6 problems of ``model`` (Table 6.2 weights), HAT reference from ``base``, in
+    ``reading`` (:func:`reading_fields`)."""
     hat = gait_ocp.hat_reference_of(base)
     extra = {"excitation_guess": "emg"} if model == "NMSK" else {}
     return {f"{model} {c}": gait_ocp.GaitSpec(model=model, cost=c, speed_class="Free", hat_reference=hat,
-                                        **_mesh(n_intervals, degree), **extra, **kw)
+                                        **_mesh(n_intervals, degree), **extra, **{**reading_fields(reading, c), **kw})
             for c in costs}
 
 
 def ch7_specs(model: str, base: gait_ocp.GaitSolution, classes=CH7_CLASSES, *, n_intervals: int = 20, degree: int = 5,
-              **kw) -> dict[str, gait_ocp.GaitSpec]:
+              reading: str = "thesis", **kw) -> dict[str, gait_ocp.GaitSpec]:
     """The Ch 7 problems of ``model``: DT (Eqs 7.1–7.2, Table 7.1) per speed class on the
-    Free data scaled in time; HAT reference = ``base``'s HAT on normalised time."""
+    Free data scaled in time; HAT reference = ``base``'s HAT on normalised time; in
+    ``reading`` (:func:`reading_fields`)."""
     hat = gait_ocp.hat_reference_of(base)
     extra = {"excitation_guess": "emg"} if model == "NMSK" else {}
     return {f"{model} {c}": gait_ocp.GaitSpec(model=model, cost="DT", speed_class=c, track_class="Free",
-                                        hat_reference=hat, **_mesh(n_intervals, degree), **extra, **kw)
+                                        hat_reference=hat, **_mesh(n_intervals, degree), **extra,
+                                        **{**reading_fields(reading, "DT"), **kw})
             for c in classes}
 
 
@@ -349,8 +362,10 @@ def _scores(sols: dict, gaits: dict, key_of) -> pd.DataFrame:
 def cost_function_study(models=("MSK", "NMSK"), costs=CH6_COSTS, *, n_intervals: int = 20, degree: int = 5,
                         root=None, scheduler: str | None = None, n_workers: int | None = None, serial: bool = False,
                         progress: bool = True, source: str = "schwartz2008", params: dict | None = None,
-                        guess: dict | None = None) -> StudyResult:
-    """Thesis Ch 6: the ``models`` × ``costs`` runs, scored against the Free data.
+                        guess: dict | None = None, reading: str = "thesis") -> StudyResult:
+    """Thesis Ch 6: the ``models`` × ``costs`` runs, scored against the Free data, in
+    ``reading`` (:data:`gaitlib.studies.gait.READINGS`: the runs, :func:`reading_fields`, and
+    the Ch 5 baselines they start from).
 
     ``guess``: model → ``"thesis"`` | ``"ch5"`` overriding :data:`GUESS_POLICY` (how each
     model's runs are started, :func:`run_guess`).
@@ -361,11 +376,13 @@ def cost_function_study(models=("MSK", "NMSK"), costs=CH6_COSTS, *, n_intervals:
     :func:`default_params`."""
     params = default_params() if params is None else dict(params)
     how = {**GUESS_POLICY, **(guess or {})}
-    bases = {m: baseline(m, n_intervals=n_intervals, degree=degree, root=root, source=source, **params)
+    bases = {m: baseline(m, n_intervals=n_intervals, degree=degree, root=root, source=source, reading=reading,
+                         **params)
              for m in models}
     specs, guesses = {}, {}
     for m in models:
-        sp = ch6_specs(m, bases[m], costs, n_intervals=n_intervals, degree=degree, source=source, **params)
+        sp = ch6_specs(m, bases[m], costs, n_intervals=n_intervals, degree=degree, source=source, reading=reading,
+                       **params)
         specs.update(sp)
         guesses.update({k: run_guess(bases[m], how[m]) for k in sp})
     recs, sols = _run(specs, guesses, root=root, scheduler=scheduler, n_workers=n_workers, serial=serial,
@@ -378,18 +395,20 @@ def cost_function_study(models=("MSK", "NMSK"), costs=CH6_COSTS, *, n_intervals:
 def speed_study(models=("MSK", "NMSK"), classes=CH7_CLASSES, *, n_intervals: int = 20, degree: int = 5,
                 root=None, scheduler: str | None = None, n_workers: int | None = None, serial: bool = False,
                 progress: bool = True, source: str = "schwartz2008", params: dict | None = None,
-                guess: dict | None = None) -> StudyResult:
+                guess: dict | None = None, reading: str = "thesis") -> StudyResult:
     """Thesis Ch 7: DT per model and speed class on time-scaled Free data, scored against
-    each class's own data (never tracked). ``params`` and ``guess`` as
+    each class's own data (never tracked). ``params``, ``guess`` and ``reading`` as
     :func:`cost_function_study`."""
     params = default_params() if params is None else dict(params)
     how = {**GUESS_POLICY, **(guess or {})}
-    bases = {m: baseline(m, n_intervals=n_intervals, degree=degree, root=root, source=source, **params)
+    bases = {m: baseline(m, n_intervals=n_intervals, degree=degree, root=root, source=source, reading=reading,
+                         **params)
              for m in models}
     gaits = {c: data_mod.load_gait_data(c, source) for c in classes}
     specs, guesses = {}, {}
     for m in models:
-        sp = ch7_specs(m, bases[m], classes, n_intervals=n_intervals, degree=degree, source=source, **params)
+        sp = ch7_specs(m, bases[m], classes, n_intervals=n_intervals, degree=degree, source=source, reading=reading,
+                       **params)
         specs.update(sp)
         for k, s in sp.items():
             g = gaits[s.speed_class]
