@@ -365,6 +365,6 @@ print("• MSK activations at their upper bound (share of nodes):",
 # speed and tilt (the jerk-term section); the planned metatarsal trajectory, which alone keeps the angles from the data
 # (the geometric floor); and the parameter sets identified on our data (the tracking
 # ablation's rows). The gap diagnosis (Ch 8) asks which unmodelled effect explains what is
-# left. This chapter and Ch 4 use the book's reading (the data's Jrk denominators, the
-# swinging foot unloaded); Chs 5–8 still solve in the thesis's reading and say so, until
-# their stores are solved again.
+# left. This chapter and Chs 4, 5 and 7 use the book's reading (the data's Jrk denominators,
+# the swinging foot unloaded); Ch 6 and Ch 8's NMSK diagnosis still solve in the thesis's
+# reading and say so, until their stores are solved again.

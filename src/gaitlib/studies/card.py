@@ -745,10 +745,13 @@ def _build(chapters) -> pd.DataFrame:
     valid6 = {k: gate(s, k) for k, s in ch6.items() if s is not None}
     if 6 in chapters:
         rows += _ch6(bases, ch6, valid6)
-    if 7 in chapters:
-        ch7 = _runs(bases, "ch7")
+    if 7 in chapters:  # Ch 7 reports the book's reading: its runs, bases and Free point (Ch 6 NMSK DT)
+        b7 = _ch5_bases("book")
+        ch7 = _runs(b7, "ch7", "book")
         valid7 = {k: gate(s, k) for k, s in ch7.items() if s is not None}
-        rows += _ch7(bases, ch7, valid7, ch6, valid6)
+        dt7 = {k: v for k, v in _runs({m: b for m, b in b7.items() if m == "NMSK"}, "ch6", "book").items()
+               if k == "NMSK DT"}
+        rows += _ch7(b7, ch7, valid7, dt7, {k: gate(s, k) for k, s in dt7.items() if s is not None})
     return pd.DataFrame([r.record() for r in rows], columns=list(COLUMNS))
 
 

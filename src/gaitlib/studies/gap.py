@@ -524,8 +524,8 @@ def book_gaps(root=None) -> pd.DataFrame:
     solution is reloaded through its study function).
 
     Ch 5: the MSK and NMSK data-tracking solutions in the book's and in the thesis's reading
-    (:data:`gaitlib.studies.gait.READINGS`; Chs 6–7 start from the thesis's); Ch 6: the 16 cost-function runs; Ch 7:
-    the 8 speed runs — each located against **its own speed class's data** (Schwartz 2008),
+    (:data:`gaitlib.studies.gait.READINGS`; Ch 6 starts from the thesis's); Ch 6: the 16 cost-function runs
+    (the thesis's reading); Ch 7: the 8 speed runs (the book's reading) — each located against **its own speed class's data** (Schwartz 2008),
     which Ch 7 never tracked (it tracks the Free data scaled in time). One row per solution:
     chapter, model, case (cost function or class), mark (:func:`gaitlib.marks.failure_label`),
     IPOPT status, RMS z of the angles, torques
@@ -537,7 +537,7 @@ def book_gaps(root=None) -> pd.DataFrame:
               msk.solve(m, root=root, reading=reading)) for reading in ("book", "thesis") for m in ("MSK", "NMSK")]
     r6 = pr.cost_function_study(("MSK", "NMSK"), pr.CH6_COSTS, progress=False, root=root)
     items += [("Ch 6", r6.specs[k].model, r6.specs[k].cost, s) for k, s in r6.solutions.items()]
-    r7 = pr.speed_study(("MSK", "NMSK"), pr.CH7_CLASSES, progress=False, root=root)
+    r7 = pr.speed_study(("MSK", "NMSK"), pr.CH7_CLASSES, progress=False, root=root, reading="book")
     items += [("Ch 7", r7.specs[k].model, r7.specs[k].speed_class, s) for k, s in r7.solutions.items()]
     data, rows = {}, []
     for chapter, model, case, sol in items:
