@@ -151,3 +151,14 @@ def test_reading_of_the_ch6_ch7_runs(monkeypatch):
     # a field given explicitly wins over the reading's
     assert pr.ch7_specs("MSK", None, ("Fast",), n_intervals=3, degree=2, reading="book",
                         swing_load_max=1.0)["MSK Fast"].swing_load_max == 1.0
+
+
+def test_cot_minimum_text_needs_every_speed():
+    import pandas as pd
+    from gaitlib.studies import predictive as pr
+    full = pd.DataFrame({"mark": ["", "", ""]}, index=["Slow", "Free", "Fast"])
+    assert "a U-curve as the thesis reports" in pr._cot_minimum_text("Free", full)
+    gap = pd.DataFrame({"mark": ["NOT CONVERGED: x", "", ""]}, index=["Slow", "Free", "Fast"])
+    t = pr._cot_minimum_text("Free", gap)
+    assert "not tested" in t and "Slow" in t and "as the thesis reports" not in t
+    assert pr._cot_minimum_text("Fast", full).startswith("not at the natural speed")

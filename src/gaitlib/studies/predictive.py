@@ -573,6 +573,18 @@ def ch6_findings(res: StudyResult, thesis_guess_stats: pd.DataFrame, reruns: dic
     return lines
 
 
+def _cot_minimum_text(imin: str, curve: pd.DataFrame) -> str:
+    """What the COT minimum ``imin`` of the unmarked points says; with a speed left out
+    (marked: not converged or invalid) the U-curve claim is not tested."""
+    left = [c for c, m in curve["mark"].items() if m]
+    if imin != "Free":
+        return "not at the natural speed — no U-curve with the minimum at Free"
+    if left:
+        return (f"the natural speed among these points, but the U-curve claim is not tested: {', '.join(left)} "
+                "left out (not converged or invalid)")
+    return "the natural speed — a U-curve as the thesis reports"
+
+
 def ch7_findings(res: StudyResult, classes, control: pd.DataFrame, cot: pd.DataFrame, reruns: dict,
                  ch5_row: str | None = None) -> list[str]:
     """Ch 7's findings as Markdown list items, every number from the runs: convergence and
@@ -610,7 +622,7 @@ def ch7_findings(res: StudyResult, classes, control: pd.DataFrame, cot: pd.DataF
         thesis_classes = ", ".join(k for k, _, _ in THESIS_COT_FIG_7_5)
         lines.append(f"- COT (NMSK DT, converged runs; Free = the Ch 6 NMSK DT run): "
                      f"{', '.join(f'{i} {v:.2f}' for i, v in cc['COT (J/kg/m)'].items())} J/(kg·m); minimum at {imin} "
-                     f"({'the natural speed — a U-curve as the thesis reports' if imin == 'Free' else 'not at the natural speed — no U-curve with the minimum at Free'}). "
+                     f"({_cot_minimum_text(imin, curve)}). "
                      f"Thesis (Fig 7.5): {thesis} at {thesis_classes}."
                      + (f" The Ch 5 NMSK solution (Eq 5.55, its own activation parameters) has {r5['COT (J/kg/m)']:.2f}"
                         + (f" ({r5['mark']})" if r5["mark"] else "") + "; it is not on the curve." if r5 is not None else ""))
