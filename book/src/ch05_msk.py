@@ -489,9 +489,12 @@ print(f"• This page's solves and identifications took {time.perf_counter() - T
 #   e.g. the same λ^P for five generators, s^V above 1 everywhere — look like what IPOPT
 #   returns when stopped at tolerance 1e-5 on this tiny objective (compare our tol-1e-5
 #   column): drift from the barrier, not information from the data.
-# * *MSK and NMSK tracking.* Our RMSEs are several times Tables 5.4 and 5.11's, as in Ch 2:
-#   different data, contact parameters identified on other data (unless Ch 4's are used),
-#   and the right leg landing with a flexed knee. The NMSK fit is close to the MSK fit,
+# * *MSK and NMSK tracking.* Row by row against Tables 5.4 and 5.11: the RMSE tables above
+#   and the report card (computed, with a verdict per row). The causes measured so far are
+#   Ch 2's — the Jrk term's denominators, the load on a swinging foot (together: the
+#   difference between the two readings in the table of the section on valid gaits) and
+#   the geometric floor of the angle error; "different data" is a hypothesis we have not
+#   measured. The NMSK fit is close to the MSK fit,
 #   as in the thesis, largely because it starts from it; from the thesis's data-based
 #   guess the same NLP ends in a worse local optimum (`msk.solve` docstring).
 # * *Activation parameters.* Eq 5.55 has no EMG term, so τ_act, c3, s1, s2 are not
