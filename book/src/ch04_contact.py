@@ -24,8 +24,9 @@
 #
 # The thesis found (b) far better than (a) and (c) better than (b) (Sec 4.5: tangential /
 # normal GRF RMSEs 36.5 / 234.6 N, 14.1 / 26.4 N and 3.0 / 10.3 N), and used (c)'s values in
-# every later chapter. We do the same on our data: (c)'s parameters are stored in
-# `data/identified/ch4_child.json` with their provenance.
+# every later chapter. Later chapters here load the parameters stored in
+# `data/identified/ch4_child.json`, with their provenance; whether that file is this page's
+# (c) is checked in the last section.
 #
 # **Where we depart from the thesis, and why**
 #
