@@ -95,6 +95,10 @@ def test_cli_writes_card(cli_card):
     assert strong["cause"].str.contains("MTG strength envelope").all()
     assert strong["cause"].str.contains("human standing jumps").all()
     assert (card.counts(c).sum() == len(c))
+    # every Ch 5 tracking row carries its channel's located gap (Ch 8's first step); other rows none
+    track = c["item"].str.contains(r"^N?MSK RMSE ")
+    assert c.loc[track, "gap"].str.match(r"RMS z \d+\.\d\d").all()
+    assert c.loc[~track, "gap"].isna().all()
 
 
 def test_card_reads_the_stored_numbers(tmp_path, monkeypatch):

@@ -81,5 +81,5 @@ for ch, part in c.groupby("chapter"):
     sty = (t.style.hide(axis="index")
            .apply(lambda col: [f"background-color: {COLOURS.get(v, '')}" for v in col], subset=["verdict"])
            .set_properties(**{"text-align": "left", "vertical-align": "top", "font-size": "0.85em"})
-           .set_properties(subset=["cause", "valid"], **{"min-width": "18em"}))
+           .set_properties(subset=["cause", "valid", "gap"], **{"min-width": "18em"}))
     display(HTML(sty.to_html(escape=False)))

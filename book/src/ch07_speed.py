@@ -55,8 +55,8 @@ stats[["mark", "status", "converged", "iterations", "solve (s)", "ms/iteration",
 
 # %%
 res_thesis = pr.speed_study(("MSK", "NMSK"), classes, progress=False, reading="thesis")
-pd.concat({"book's reading": stats[["mark", "status", "iterations", "COT (J/kg/m)"]],
-           "thesis's reading": res_thesis.stats()[["mark", "status", "iterations", "COT (J/kg/m)"]]}, axis=1)
+pr.readings_table({"book's reading": res, "thesis's reading": res_thesis},
+                  columns=("mark", "status", "iterations", "COT (J/kg/m)"))
 
 # %% [markdown]
 # **Initial guesses.** MSK: the thesis's (Sec 7.1) — the time-scaled *Free* data with the

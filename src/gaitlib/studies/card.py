@@ -14,6 +14,9 @@ stored gives a "not comparable" row) and returns a DataFrame with the columns :d
 ``solution``  the stored solution (cache kind/key and what it is)
 ``valid``     its physical validity gates (:func:`gaitlib.validity.check`): ``"valid"``,
               ``"not converged (…)"`` and/or ``"invalid: …"``
+``gap``       tracking rows (Ch 5): the located gap of that channel (:func:`gaitlib.gap.locate`,
+              Ch 8's first step) — its RMS z against the data's SD, whether it is significant,
+              and its largest gait phase; empty elsewhere
 
 Verdict rule (:func:`verdict`)
 ------------------------------
@@ -58,11 +61,14 @@ from . import mtg_id
 from .. import activation
 from . import predictive as pr
 from . import fidelity
+from . import ch6_claims
+from ..gap import io as gap_io
+from ..gap import locate as gap_locate
 
 __all__ = ["COLUMNS", "VERDICTS", "REL_TOL", "ABS_TOL", "RULE", "verdict", "Row", "StoredGait", "stored_gait",
            "gate", "build", "counts", "write", "PHYSIOLOGICAL_JUMP_RISE_M"]
 
-COLUMNS = ("chapter", "item", "thesis", "ours", "unit", "verdict", "cause", "solution", "valid")
+COLUMNS = ("chapter", "item", "thesis", "ours", "unit", "verdict", "cause", "solution", "valid", "gap")
 VERDICTS = ("reproduced", "within data SD", "qualitatively reproduced", "not reproduced", "not comparable",
             "invalid")
 #: Relative tolerance of "reproduced": 10 % of the thesis's value.
@@ -140,6 +146,7 @@ class Row:
     valid: str = ""
     sd: float | None = None
     holds: bool | None = None
+    gap: str = ""
 
     def record(self) -> dict:
         v = verdict(self.thesis, self.ours, unit=self.unit, sd=self.sd, holds=self.holds, valid=self.valid)
@@ -156,7 +163,7 @@ class Row:
 
         return {"chapter": self.chapter, "item": self.item, "thesis": g6(self.thesis), "ours": g6(self.ours),
                 "unit": self.unit,
-                "verdict": v, "cause": cause, "solution": self.solution, "valid": self.valid}
+                "verdict": v, "cause": cause, "solution": self.solution, "valid": self.valid, "gap": self.gap}
 
 
 def _anchor(page: str, heading: str) -> str:
@@ -387,6 +394,8 @@ def _ch5(bases: dict) -> list[Row]:
     # Tables 5.4 and 5.11: tracking RMSEs
     ablation = {"MSK": _ablation_causes("MSK")}
     jerk = _jerk_causes("MSK")
+    floor = _floor_causes()
+    gaps = {m: _located_gaps(s) for m, s in bases.items() if s is not None}
     for model, table in (("MSK", "Table 5.4"), ("NMSK", "Table 5.11")):
         s = bases.get(model)
         valid = gate(s, model) if s is not None else ""
@@ -397,12 +406,16 @@ def _ch5(bases: dict) -> list[Row]:
             unit = {"angle": "deg", "torque": "N*m", "grf": "N"}[kind]
             sd = _rms_sd(gait, col, 1 / cv.DEG if kind == "angle" else 1.0)
             ours = float(r.get((kind, ch), np.nan)) if r is not None else np.nan
-            cause = ablation.get(model, {}).get((kind, part, side))
-            if cause is None and (kind, part, side) in jerk:  # the MSK measurement, named as such
-                cause = jerk[(kind, part, side)]
+            # angles: the geometric floor (no dynamics); torques and forces: the Ch 2 measurements,
+            # made from the thesis's reading and labelled so
+            cause = floor.get((part, side)) if kind == "angle" else None
+            if cause is None:
+                cause = ablation.get(model, {}).get((kind, part, side)) or jerk.get((kind, part, side))
+                cause = f"measured from the thesis's reading: {cause}" if cause else None
             rows.append(Row(5, f"{model} RMSE {kind} {part} {side.upper()} ({table})", tv, ours, unit,
                             cause or "unknown",
-                            s.name if s is not None else "", valid, sd=sd))
+                            s.name if s is not None else "", valid, sd=sd,
+                            gap=gaps.get(model, {}).get(f"{kind}:{'grf_' if kind == 'grf' else ''}{part}_{side}", "")))
     # Table 5.10 and COT: the NMSK solution
     s = bases.get("NMSK")
     valid = gate(s, "NMSK") if s is not None else ""
@@ -481,6 +494,38 @@ def _ablation_causes(model: str = "MSK") -> dict:
     for (kind, part, side, unit), r in fidelity.channel_table(picked, model).iterrows():
         out[(kind, part, side)] = (f"tracking ablation: lowest {r[r['best change']]:.1f} {unit} "
                                    f"({r['best change']}), target {r['target']:.1f} {unit} met by: {r['met by']} [{where}]")
+    return out
+
+
+def _located_gaps(sol) -> dict:
+    """Channel (``"angle:knee_r"`` …) → the located gap of ``sol`` against the Free data
+    (:func:`gaitlib.gap.locate.locate`): RMS z, significance, and the phase with the largest
+    RMS z."""
+    loc = gap_locate.locate(sol, gap_io.load_real("Free", "schwartz2008"))
+    where = _anchor("ch08_gap", "1. Locate: SD-standardised residuals by channel and phase")
+    out = {}
+    for _, c in loc.channels.iterrows():
+        ph = loc.table[loc.table["channel"] == c["channel"]].sort_values("rms_z").iloc[-1]
+        out[c["channel"]] = (f"RMS z {c['rms_z']:.2f}{' (significant)' if c['significant'] else ''}; largest in "
+                             f"{ph['phase']} (z {ph['rms_z']:.2f}{', significant' if ph['significant'] else ''}) [{where}]")
+    return out
+
+
+def _floor_causes(clearance_mm: float = 1e3 * fidelity.TOUCH) -> dict:
+    """(joint, side) → the geometric angle floor of that joint (Ch 2,
+    :func:`gaitlib.studies.fidelity.kinematic_floor_table`: the poses closest to the data whose
+    feet agree with its phases, no dynamics), with the planned metatarsal angles tracked and
+    free, at ``clearance_mm`` of swing clearance."""
+    t = fidelity.kinematic_floor_table((clearance_mm / 1e3,))
+    where = _anchor("ch02_gait", "The jerk term's denominators: a HAT pinned to a constant speed")
+    at = t.set_index("metatarsal")
+    out = {}
+    for col in t.columns:
+        if col.endswith(" (deg)") and col != "worst (deg)":
+            j, side = col[:-len(" (deg)")].rsplit("_", 1)
+            out[(j, side)] = (f"geometric floor (no dynamics, {clearance_mm:g} mm swing clearance): "
+                              f"{at[col].iloc[0]:.1f}° with the planned metatarsal angles tracked, "
+                              f"{at[col].iloc[1]:.1f}° with them free [{where}]")
     return out
 
 
@@ -584,19 +629,7 @@ def _ch6(bases: dict, runs: dict, valid: dict) -> list[Row]:
                             s.name if s else "", valid.get(f"{model} {c}", ""), holds=bool(s and s.success)))
     free = data_mod.load_gait_data("Free")
     sc = {k: pr.score(s, free) for k, s in runs.items() if s is not None}
-    # which model tracks better, per cost function (Sec 6.2.3; mean NRMSE of angles, torques, GRFs)
-    for c, better in (("SDT2", "MSK"), ("SP3", "MSK"), ("SDT1", "NMSK"), ("SP2", "NMSK"), ("FP", "NMSK")):
-        a, b = f"MSK {c}", f"NMSK {c}"
-        if a in sc and b in sc:
-            ma, mb = _mean(sc[a]), _mean(sc[b])
-            holds = (ma < mb) if better == "MSK" else (mb < ma)
-            ours = f"mean NRMSE MSK {ma:.3f}, NMSK {mb:.3f}"
-        else:
-            holds, ours = None, np.nan
-        worse = "NMSK" if better == "MSK" else "MSK"
-        rows.append(Row(6, f"{c}: {better} more accurate than {worse} (Sec 6.2.3)", f"{better} < {worse}", ours, "",
-                        "unknown", f"Ch 6 {a}, {b}",
-                        _joint({a: valid.get(a, ""), b: valid.get(b, "")}), holds=holds))
+    rows += _ch6_claims(bases, runs, valid, free)
     # the fully predictive NMSK vs MSK: % lower RMSE (Sec 6.3)
     for kind, tv in pr.THESIS_FP_GAIN_PCT.items():
         a, b = "MSK FP", "NMSK FP"
@@ -611,14 +644,8 @@ def _ch6(bases: dict, runs: dict, valid: dict) -> list[Row]:
                     "Ch 6 MSK FP, NMSK FP", _joint({k: valid.get(k, "") for k in ("MSK FP", "NMSK FP")})))
     rows.append(_time_ratio_row(6, "all 8 MSK runs' compute time ÷ all 8 NMSK runs' (Sec 6.3, Table 6.3)", th, runs,
                                 pr.CH6_COSTS, "Ch 6, 16 runs", valid))
-    # excitations: SDT3 the most accurate NMSK run; FP vs the Ch 5 tracking (Secs 6.2.3–6.2.4)
     ex = {c: float(pr.excitation_score(runs[f"NMSK {c}"], free)["rmse"].mean())
           for c in pr.CH6_COSTS if runs.get(f"NMSK {c}") is not None}
-    best = min(ex, key=ex.get) if ex else None
-    rows.append(Row(6, "NMSK SDT3 predicts the most accurate excitations (Sec 6.2.3)", "SDT3",
-                    f"{best} (mean RMSE {ex[best]:.3f}; SDT3 {ex.get('SDT3', np.nan):.3f})" if best else np.nan, "",
-                    "unknown", "Ch 6 NMSK, 8 runs", _joint({f"NMSK {c}": valid.get(f"NMSK {c}", "") for c in pr.CH6_COSTS}),
-                    holds=(best == "SDT3") if best else None))
     n5 = bases.get("NMSK")
     ours = np.nan
     if n5 is not None and "FP" in ex:
@@ -627,6 +654,32 @@ def _ch6(bases: dict, runs: dict, valid: dict) -> list[Row]:
     rows.append(Row(6, "NMSK FP excitation RMSE lower than the Ch 5 data tracking's by (Sec 6.2.4)",
                     pr.THESIS_FP_EXCITATION_GAIN_PCT, ours, "%", "unknown", "Ch 6 NMSK FP, Ch 5 NMSK",
                     _joint({"NMSK FP": valid.get("NMSK FP", ""), "Ch 5 NMSK": gate(n5, "NMSK") if n5 is not None else ""})))
+    return rows
+
+
+def _ch6_claims(bases: dict, runs: dict, valid: dict, free) -> list[Row]:
+    """The Ch 6 conclusions (:func:`gaitlib.studies.ch6_claims.conclusions`) that the thesis
+    states without a number, one row each, on the runs that converged and pass the gates;
+    the verdict is the NRMSE one, and a claim whose verdict changes with the metric says so in
+    its cause."""
+    where = _anchor("ch06_costfun", "The thesis's conclusions, re-derived from valid runs (Secs 6.2–6.3)")
+    usable = {k: s for k, s in runs.items() if s is not None and not _blocked(valid.get(k, ""))}
+    n5 = bases.get("NMSK")
+    table = ch6_claims.conclusions(usable, free, excluded={k: valid.get(k, "") for k in runs if k not in usable},
+                                   ch5_nmsk=n5)
+    valid = {**valid, ch6_claims.CH5_NMSK: gate(n5, "NMSK") if n5 is not None else ""}
+    rows = []
+    for _, r in table[~table["numeric"].astype(bool)].iterrows():
+        names = r["runs"].split(", ")
+        exc = isinstance(r["RMSE: verdict"], str)  # an excitation claim: RMSE (the thesis's), else NRMSE
+        metric, other = ("RMSE", "NRMSE") if exc else ("NRMSE", "SD units")
+        ours = r[metric] if r["verdict"] != "not tested" else np.nan
+        cause = "unknown"
+        if r["depends on metric"]:
+            cause = f"depends on the metric: {other} says {r[f'{other}: verdict']} ({r[other]}) [{where}]"
+        rows.append(Row(6, f"{r['claim']} (Sec {r['thesis']})", "holds", ours, "", cause,
+                        f"Ch 6 {', '.join(names)}", _joint({n: valid.get(n, "") for n in names}),
+                        holds=None if r["verdict"] == "not tested" else r[f"{metric}: verdict"] == "holds"))
     return rows
 
 
@@ -738,20 +791,19 @@ def _build(chapters) -> pd.DataFrame:
         rows += _ch3()
     if 4 in chapters:
         rows += _ch4()
-    bases = _ch5_bases() if {5, 6, 7} & set(chapters) else {}
+    # Chs 5–7 report the book's reading (the Ch 5 solutions, the Ch 6 runs and the Ch 7 runs)
+    bases = _ch5_bases("book") if {5, 6, 7} & set(chapters) else {}
     if 5 in chapters:
-        rows += _ch5(_ch5_bases("book"))
-    ch6 = _runs(bases, "ch6") if {6, 7} & set(chapters) else {}
+        rows += _ch5(bases)
+    ch6 = _runs(bases, "ch6", "book") if {6, 7} & set(chapters) else {}
     valid6 = {k: gate(s, k) for k, s in ch6.items() if s is not None}
     if 6 in chapters:
         rows += _ch6(bases, ch6, valid6)
-    if 7 in chapters:  # Ch 7 reports the book's reading: its runs, bases and Free point (Ch 6 NMSK DT)
-        b7 = _ch5_bases("book")
-        ch7 = _runs(b7, "ch7", "book")
+    if 7 in chapters:  # the Free point is the Ch 6 NMSK DT run
+        ch7 = _runs(bases, "ch7", "book")
         valid7 = {k: gate(s, k) for k, s in ch7.items() if s is not None}
-        dt7 = {k: v for k, v in _runs({m: b for m, b in b7.items() if m == "NMSK"}, "ch6", "book").items()
-               if k == "NMSK DT"}
-        rows += _ch7(b7, ch7, valid7, dt7, {k: gate(s, k) for k, s in dt7.items() if s is not None})
+        dt7 = {k: v for k, v in ch6.items() if k == "NMSK DT"}
+        rows += _ch7(bases, ch7, valid7, dt7, {k: v for k, v in valid6.items() if k == "NMSK DT"})
     return pd.DataFrame([r.record() for r in rows], columns=list(COLUMNS))
 
 

@@ -490,6 +490,17 @@ def mean_nrmse(scores: pd.DataFrame) -> pd.Series:
     return kind_nrmse(scores).mean(axis=1)
 
 
+def readings_table(results: dict, columns=("mark", "status", "iterations")) -> pd.DataFrame:
+    """The same study in several readings side by side: label → :class:`StudyResult`; per
+    reading ``columns`` of :meth:`StudyResult.stats` and the run's :func:`mean_nrmse`."""
+    parts = {}
+    for label, r in results.items():
+        nr = mean_nrmse(r.scores)
+        nr.index = [" ".join(i) for i in nr.index]
+        parts[label] = r.stats()[list(columns)].assign(**{"mean NRMSE": nr})
+    return pd.concat(parts, axis=1)
+
+
 def _converged_line(stats: pd.DataFrame, extra: str = "") -> str:
     ok = stats["converged"]
     return (f"- {int(ok.sum())} of {len(ok)} runs converged{extra}"
