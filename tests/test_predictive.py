@@ -162,3 +162,29 @@ def test_cot_minimum_text_needs_every_speed():
     t = pr._cot_minimum_text("Free", gap)
     assert "not tested" in t and "Slow" in t and "as the thesis reports" not in t
     assert pr._cot_minimum_text("Fast", full).startswith("not at the natural speed")
+
+
+def test_input_vs_class_control_by_hand():
+    """The Ch 7 control (time-scaled Free data against a class's data): zero against itself;
+    a constant c added to one torque channel of the class gives c / (that channel's range)
+    / 6 (the mean over the six torque channels), computed here without the code under test."""
+    from dataclasses import replace as _replace
+    from gaitlib import data as data_mod
+    free = data_mod.load_gait_data("Free")
+    same = data_mod.time_scaled(free, free)
+    for kind in ("angle", "torque", "grf"):
+        assert pr._input_vs_class(same, free, kind) == pytest.approx(0.0, abs=1e-12)
+    c = 3.0  # N·m on the right knee
+    mean = free.mean.copy()
+    mean["tau_knee_r"] = mean["tau_knee_r"] + c
+    shifted = _replace(free, mean=mean)
+    hand = c / float(mean["tau_knee_r"].max() - mean["tau_knee_r"].min()) / 6
+    assert pr._input_vs_class(same, shifted, "torque") == pytest.approx(hand, rel=1e-9)
+    assert pr._input_vs_class(same, shifted, "angle") == pytest.approx(0.0, abs=1e-12)
+
+
+def test_loose_tracking_divides_the_three_data_terms_by_ten():
+    dt = gait_ocp.COST_FUNCTIONS["NMSK"]["DT"]
+    loose = dict(pr.LOOSE_TRACKING)
+    assert set(loose) == {"Trq", "Ang", "GRF"}
+    assert all(loose[k] == pytest.approx(dt[k] / 10) for k in loose)

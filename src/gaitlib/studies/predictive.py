@@ -395,14 +395,18 @@ def cost_function_study(models=("MSK", "NMSK"), costs=CH6_COSTS, *, n_intervals:
 def speed_study(models=("MSK", "NMSK"), classes=CH7_CLASSES, *, n_intervals: int = 20, degree: int = 5,
                 root=None, scheduler: str | None = None, n_workers: int | None = None, serial: bool = False,
                 progress: bool = True, source: str = "schwartz2008", params: dict | None = None,
-                guess: dict | None = None, reading: str = "thesis") -> StudyResult:
+                guess: dict | None = None, reading: str = "thesis", weights: tuple = ()) -> StudyResult:
     """Thesis Ch 7: DT per model and speed class on time-scaled Free data, scored against
     each class's own data (never tracked). ``params``, ``guess`` and ``reading`` as
-    :func:`cost_function_study`."""
+    :func:`cost_function_study`; ``weights``: ``(term, weight)`` overrides of Table 7.1's
+    (:attr:`gaitlib.problems.gait.GaitSpec.weights`; e.g. :data:`LOOSE_TRACKING`)."""
+    if weights:
+        params = {**(default_params() if params is None else params), "weights": tuple(weights)}
     params = default_params() if params is None else dict(params)
     how = {**GUESS_POLICY, **(guess or {})}
+    base_params = {k: v for k, v in params.items() if k != "weights"}
     bases = {m: baseline(m, n_intervals=n_intervals, degree=degree, root=root, source=source, reading=reading,
-                         **params)
+                         **base_params)
              for m in models}
     gaits = {c: data_mod.load_gait_data(c, source) for c in classes}
     specs, guesses = {}, {}
@@ -417,6 +421,52 @@ def speed_study(models=("MSK", "NMSK"), classes=CH7_CLASSES, *, n_intervals: int
                       progress=progress)
     return StudyResult(specs, recs, sols, bases, _scores(sols, gaits, lambda s: s.spec.speed_class),
                        guess=how, guesses=guesses)
+
+
+#: The Ch 7 pin experiment: Table 7.1's three data-tracking weights (Trq, Ang, GRF; 1/4
+#: each) divided by 10, every other term unchanged — does a prediction held less tightly to
+#: the time-scaled Free data move towards the untracked class data?
+LOOSE_TRACKING = (("Trq", 1 / 40), ("Ang", 1 / 40), ("GRF", 1 / 40))
+
+
+def input_pull(res: StudyResult, gaits: dict) -> pd.DataFrame:
+    """Where each Ch 7 prediction sits between what it tracked and what it should predict:
+    per run and kind (angles, torques, GRFs; mean NRMSE over the kind's channels), its NRMSE
+    against the class's own data (untracked), against the time-scaled *Free* data it tracked,
+    and the control (that scaled data against the class data). ``gaits``: class → GaitData
+    (the *Free* class included). A prediction pinned to its input has a small NRMSE against
+    the input and about the control's against the class."""
+    rows = []
+    for name, sol in res.solutions.items():
+        c = sol.spec.speed_class
+        scaled = data_mod.time_scaled(gaits["Free"], gaits[c])
+        vs_class, vs_input = score(sol, gaits[c]), score(sol, scaled)
+        for kind in _KINDS:
+            rows.append({"run": name, "kind": kind, "mark": marks.failure_label(sol) or "",
+                         "vs class data": float(vs_class.loc[vs_class["kind"] == kind, "nrmse"].mean()),
+                         "vs tracked input": float(vs_input.loc[vs_input["kind"] == kind, "nrmse"].mean()),
+                         "control: input vs class": _input_vs_class(scaled, gaits[c], kind)})
+    return pd.DataFrame(rows).set_index(["run", "kind"])
+
+
+def _input_vs_class(scaled: data_mod.GaitData, cls: data_mod.GaitData, kind: str) -> float:
+    """Mean NRMSE over ``kind``'s channels of the time-scaled Free data against the class's
+    data (each channel's RMSE over the class's range; the channels :func:`score` scores)."""
+    f, g = sg.tracking_data(scaled), sg.tracking_data(cls)
+    chans = {"angle": list(gait_ocp.LEG_JOINTS), "torque": [f"tau_{j}" for j in gait_ocp.LEG_JOINTS],
+             "grf": list(gait_ocp.GRF_CHANNELS)}[kind]
+    out = []
+    for ch in chans:
+        d = np.interp(f.time / f.cycle_time, g.time / g.cycle_time, g.mean[ch].to_numpy())
+        out.append(np.sqrt(np.mean((f.mean[ch].to_numpy() - d) ** 2)) / float(np.ptp(g.mean[ch])))
+    return float(np.mean(out))
+
+
+def closer_cells(pull: pd.DataFrame) -> tuple[int, int]:
+    """(cells, of) — the unmarked run × kind cells of :func:`input_pull` whose prediction is
+    closer to the class data than the control (the scaled input)."""
+    ok = pull[pull["mark"] == ""]
+    return int((ok["vs class data"] < ok["control: input vs class"]).sum()), len(ok)
 
 
 def cot_table(ch7: StudyResult, natural=None) -> pd.DataFrame:
