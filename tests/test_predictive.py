@@ -188,3 +188,15 @@ def test_loose_tracking_divides_the_three_data_terms_by_ten():
     loose = dict(pr.LOOSE_TRACKING)
     assert set(loose) == {"Trq", "Ang", "GRF"}
     assert all(loose[k] == pytest.approx(dt[k] / 10) for k in loose)
+
+
+def test_fp_may_be_timed_by_the_data_swing_but_not_with_a_free_final_time():
+    """The FP-timed experiment: an FP spec accepts the swing bound (the data's event times,
+    no curve tracked); a free final time has no data swing windows and is refused."""
+    from gaitlib import validity
+    b = validity.swing_bound()
+    assert b == pytest.approx(0.01 * 41.4 * 9.81, abs=1e-3)
+    s = gait_ocp.GaitSpec(model="MSK", cost="FP", swing_load_max=b)
+    assert s.swing_load_max == b and "Ang" not in s.term_weights and "Trq" not in s.term_weights
+    with pytest.raises(ValueError, match="fixed final time"):
+        gait_ocp.GaitSpec(model="MSK", cost="FP", swing_load_max=b, tf_bounds=(0.8, 1.2))

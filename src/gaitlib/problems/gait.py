@@ -301,7 +301,9 @@ class GaitSpec:
         vertical GRF while the *data* say that foot swings (the validity gate's window:
         foot off + margin to the next foot contact − margin, :func:`swing_windows`). An
         ablation of the Fidelity II study (:mod:`gaitlib.studies.fidelity`): it measures what
-        an unloaded swing foot costs in tracking. Tracking runs with fixed final time only.
+        an unloaded swing foot costs in tracking. Runs with a fixed final time only (FP
+        included: then the data's event times — foot off, foot contact, the left leg's
+        shift — time the bound, and no data curve is tracked).
     jerk_ranges : ``None`` / ``"reference"`` (the book so far) or ``"data"``: the
         denominators of the Jrk term (Eq 4.11: "the minimum and maximum values of … jerks
         … were obtained from the experimental data"). ``"reference"``: the range of each
@@ -388,8 +390,8 @@ class GaitSpec:
         if self.swing_load_max is not None:
             if not float(self.swing_load_max) >= 0.0:
                 raise ValueError(f"swing_load_max must be None or >= 0 N, got {self.swing_load_max!r}")
-            if self.tf_bounds or self.cost == "FP":
-                raise ValueError("swing_load_max needs the data's swing (a tracking run with fixed final time)")
+            if self.tf_bounds:
+                raise ValueError("swing_load_max needs the data's swing windows (a run with fixed final time)")
 
     @property
     def term_weights(self) -> dict[str, float]:

@@ -102,6 +102,32 @@ def reading_fields(reading: str, cost: str) -> dict:
     return fields
 
 
+def fp_timed_study(models=("MSK", "NMSK"), *, n_intervals: int = 20, degree: int = 5, root=None,
+                   scheduler: str | None = None, n_workers: int | None = None, serial: bool = False,
+                   progress: bool = False) -> StudyResult:
+    """The FP runs of Ch 6 in the book's reading with the swing bound timed by the data's
+    events (:func:`gaitlib.validity.swing_bound` while the data say a foot swings): the
+    book's FP has no swing bound (:func:`reading_fields`) and can end as a shuffle with both
+    feet loaded; this experiment gives it the gait's phase timing — two event times and the
+    left leg's shift, no data curve — and nothing else. Scored against the Free data like
+    every Ch 6 run."""
+    from .. import validity
+    params = default_params()
+    how = dict(GUESS_POLICY)
+    bases = {m: baseline(m, n_intervals=n_intervals, degree=degree, root=root, reading="book", **params) for m in models}
+    specs, guesses = {}, {}
+    for m in models:
+        sp = ch6_specs(m, bases[m], ("FP",), n_intervals=n_intervals, degree=degree, reading="book",
+                       swing_load_max=validity.swing_bound(), **params)
+        specs.update(sp)
+        guesses.update({k: run_guess(bases[m], how[m]) for k in sp})
+    recs, sols = _run(specs, guesses, root=root, scheduler=scheduler, n_workers=n_workers, serial=serial,
+                      progress=progress)
+    free = data_mod.load_gait_data("Free")
+    return StudyResult(specs, recs, sols, bases, _scores(sols, {"Free": free}, lambda s: "Free"), guess=how,
+                       guesses=guesses)
+
+
 def default_params() -> dict:
     """The parameter sets the thesis carries into Chs 6–7: those of the Ch 5 solves
     (:func:`gaitlib.studies.msk.parameter_sets`). The NMSK runs use the activation
@@ -467,6 +493,37 @@ def closer_cells(pull: pd.DataFrame) -> tuple[int, int]:
     closer to the class data than the control (the scaled input)."""
     ok = pull[pull["mark"] == ""]
     return int((ok["vs class data"] < ok["control: input vs class"]).sum()), len(ok)
+
+
+def pin_findings(pull: pd.DataFrame, loose: pd.DataFrame | None = None) -> list[str]:
+    """What holds the Ch 7 predictions to their input, from :func:`input_pull` of the study
+    (``pull``) and of the loosened-tracking runs (``loose``, :data:`LOOSE_TRACKING`); unmarked
+    cells only (converged and valid), per model."""
+    out = []
+    for model in ("MSK", "NMSK"):
+        p = pull[(pull["mark"] == "") & pull.index.get_level_values("run").str.startswith(f"{model} ")]
+        if p.empty:
+            continue
+        n = len(p)
+        near_input = int((p["vs tracked input"] < p["vs class data"]).sum())
+        own = int((p["vs tracked input"] >= p["control: input vs class"]).sum())
+        closer, _ = closer_cells(p)
+        line = (f"- {model}, Table 7.1's weights: closer to the class data than the scaled input in {closer} of {n} "
+                f"cells; closer to its tracked input than to the class data in {near_input} of {n}; its own error "
+                f"against the input it tracked (median NRMSE {p['vs tracked input'].median():.3f}) is at least the "
+                f"class–input distance it would have to beat (median {p['control: input vs class'].median():.3f}) in "
+                f"{own} of {n} cells.")
+        if loose is not None:
+            q = loose[(loose["mark"] == "") & loose.index.get_level_values("run").str.startswith(f"{model} ")]
+            lq, nq = closer_cells(q)
+            dropped = sorted({r for r, _ in loose.index} - {r for r, _ in q.index})
+            dropped = [r for r in dropped if r.startswith(f"{model} ")]
+            line += (f" With the three data-tracking weights ÷ 10: closer in {lq} of {nq} cells"
+                     + (f" (left out, marked: {', '.join(dropped)})" if dropped else "")
+                     + (f"; median NRMSE against the class data {q['vs class data'].median():.3f} "
+                        f"(Table 7.1's weights: {p['vs class data'].median():.3f})." if nq else "."))
+        out.append(line)
+    return out
 
 
 def cot_table(ch7: StudyResult, natural=None) -> pd.DataFrame:
