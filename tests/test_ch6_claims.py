@@ -95,3 +95,18 @@ def test_similar_threshold_is_relative(metric):
     t = cc.table_conclusions(_table(acc, exc), times)
     assert _row(t, "DT: MSK and NMSK similar")[f"{metric}: verdict"] == "does not hold"
     assert np.isfinite(tol)
+
+
+def test_an_extremum_claim_fails_on_the_usable_runs_or_stays_untested():
+    """'SDT3 has the most accurate excitations' with NMSK FP left out: decided only when it
+    fails among the usable runs (a left-out run can only add a rival)."""
+    acc, exc, times = _case()
+    del acc["NMSK FP"], exc["NMSK FP"]
+    t = cc.table_conclusions(_table(acc, exc), times, excluded={"NMSK FP": "INVALID: double support"})
+    r = _row(t, "NMSK SDT3 predicts the most")  # 0.10 is the best of the 7 left: holds there, untested
+    assert r["verdict"] == "not tested" and "left out: NMSK FP (invalid)" in r["ours"]
+    exc["NMSK SDT2"] = (0.05, 0.1)  # now SDT2 beats SDT3 among the usable runs
+    t = cc.table_conclusions(_table(acc, exc), times, excluded={"NMSK FP": "INVALID: double support"})
+    assert _row(t, "NMSK SDT3 predicts the most")["verdict"] == "does not hold"
+    # "worse half" is no extremum: it needs all eight
+    assert _row(t, "NMSK DT is among")["verdict"] == "not tested"

@@ -104,6 +104,14 @@ def _sdt3_enough(acc, metric):
     return s <= pr.SDT3_ENOUGH_FACTOR * d, f"NMSK SDT3 {_fmt(s)}, DT {_fmt(d)} (ratio {s / d:.2f})"
 
 
+def _extremum(test, required):
+    """Mark ``test`` as a claim about the most / least accurate run: only ``required`` must be
+    usable; with comparators left out, a claim that fails on the usable runs fails (more
+    runs can only add rivals), and one that holds on them stays untested."""
+    test.required = list(required)
+    return test
+
+
 def _worst_of(model_case_sets, kinds):
     """``label`` run least accurate (on ``kinds``) among the others, per model."""
     def test(acc, metric):
@@ -115,7 +123,7 @@ def _worst_of(model_case_sets, kinds):
             ok &= vw > vo[worst_other]
             parts.append(f"{model} {worst} {_fmt(vw)} vs worst other {worst_other} {_fmt(vo[worst_other])}")
         return ok, "; ".join(parts)
-    return test
+    return _extremum(test, [f"{model} {worst}" for model, worst, _ in model_case_sets])
 
 
 def _fp_gain_claim(kind: str) -> str:
@@ -148,7 +156,7 @@ def _exc_rank(case, where):
         ok = {"best": rank == 1, "worst": rank == len(order), "worse half": rank > len(order) / 2}[where]
         return ok, (f"NMSK {case} {_fmt(ex[case])}, rank {rank} of {len(order)} "
                     f"(best {order[0]} {_fmt(ex[order[0]])}, worst {order[-1]} {_fmt(ex[order[-1]])})")
-    return test
+    return _extremum(test, [f"NMSK {case}"]) if where in ("best", "worst") else test
 
 
 def _claims(ch5_nmsk: str | None) -> list:
@@ -260,8 +268,10 @@ def table_conclusions(scores: pd.DataFrame, times: dict, *, excluded: dict | Non
     for claim, sec, test_text, need, test, metrics in _claims(c5):
         row = {"claim": claim, "thesis": sec, "test": test_text, "runs": ", ".join(need),
                "numeric": claim in _NUMERIC}
-        miss = acc.missing(need)
-        used = [n for n in need if n in notes]
+        required = getattr(test, "required", need)
+        miss = acc.missing(required)
+        rivals_out = acc.missing([n for n in need if n not in required])
+        used = [n for n in need if n in notes and acc.has(n)]
         verdicts = []
         for label in metrics:
             col = label
@@ -269,15 +279,21 @@ def table_conclusions(scores: pd.DataFrame, times: dict, *, excluded: dict | Non
                 row[col], v = "—", "not tested"
             else:
                 ok, txt = test(acc, label)
-                row[col], v = txt, ("holds" if ok else "does not hold")
+                # an extremum that holds without all its rivals is not established
+                v = "does not hold" if not ok else ("not tested" if rivals_out else "holds")
+                row[col] = txt
             row[f"{col}: verdict"] = v
             verdicts.append(v)
         if miss:
             verdict = "not tested"
-            row["ours"] = "not usable: " + ", ".join(miss)
+            row["ours"] = "not usable: " + ", ".join(miss + rivals_out)
         else:
             verdict = verdicts[0] if len(set(verdicts)) == 1 else "depends on the metric"
-            row["ours"] = "; ".join(f"{n}: {notes[n]}" for n in used)
+            if "not tested" in verdicts and verdict == "depends on the metric":
+                verdict = "not tested"  # fails on one metric, undecided on the other
+            row["ours"] = "; ".join([f"{n}: {notes[n]}" for n in used]
+                                    + ([f"left out: {', '.join(rivals_out)} (compared among the usable runs)"]
+                                       if rivals_out else []))
         row["verdict"] = verdict
         row["depends on metric"] = verdict == "depends on the metric"
         rows.append(row)

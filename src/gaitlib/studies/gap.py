@@ -138,7 +138,7 @@ def own_data(gait):
 
 
 def nmsk_attribution(candidates=NMSK_CANDIDATES, resamples: int = 200, serial: bool = True,
-                     root=None) -> diagnose.Diagnosis:
+                     root=None, reading: str = "thesis") -> diagnose.Diagnosis:
     """Muscle-level candidates on the Ch 5 NMSK solution (thesis Sec 5.3.5's question: does
     co-contraction close the TA/GAM gap?).
 
@@ -147,15 +147,17 @@ def nmsk_attribution(candidates=NMSK_CANDIDATES, resamples: int = 200, serial: b
     spec's own cost function (``objective="cost"``: the thesis's problem plus the effect),
     warm-started from it, on the same mesh; profiled effects on their grid
     (:data:`gaitlib.gap.diagnose.PROFILE_GRID`), activation timing on the comparison only.
-    Ranked as :func:`gaitlib.gap.diagnose.assemble` does."""
-    base_sol = msk.solve("NMSK", root=root)
+    Ranked as :func:`gaitlib.gap.diagnose.assemble` does. ``reading``: the Ch 5 solution's
+    (:data:`gaitlib.studies.gait.READINGS`)."""
+    base_sol = msk.solve("NMSK", root=root, reading=reading)
     spec0 = base_sol.spec
     ds = gio.load_real(spec0.speed_class, spec0.source)
     names, skipped = diagnose.candidates(spec0, ds.gait, candidates)
     fits = diagnose.candidate_fits(spec0, {"data": ds}, {"data": base_sol}, names, objective="cost", root=root,
                             serial=serial, progress=False)["data"]
     return diagnose.assemble(ds, spec0, base_sol, fits, objective="cost", resamples=resamples, skipped=skipped,
-                      settings={"objective": "cost", "candidates": names, "baseline": "Ch 5 NMSK solution"})
+                      settings={"objective": "cost", "candidates": names,
+                                "baseline": f"Ch 5 NMSK solution, {reading}'s reading"})
 
 
 def _emg_rss(loc: locate.Located, stems) -> dict:
@@ -524,8 +526,8 @@ def book_gaps(root=None) -> pd.DataFrame:
     solution is reloaded through its study function).
 
     Ch 5: the MSK and NMSK data-tracking solutions in the book's and in the thesis's reading
-    (:data:`gaitlib.studies.gait.READINGS`; Ch 6 starts from the thesis's); Ch 6: the 16 cost-function runs
-    (the thesis's reading); Ch 7: the 8 speed runs (the book's reading) — each located against **its own speed class's data** (Schwartz 2008),
+    (:data:`gaitlib.studies.gait.READINGS`); Ch 6: the 16 cost-function runs and Ch 7: the 8
+    speed runs (both in the book's reading) — each located against **its own speed class's data** (Schwartz 2008),
     which Ch 7 never tracked (it tracks the Free data scaled in time). One row per solution:
     chapter, model, case (cost function or class), mark (:func:`gaitlib.marks.failure_label`),
     IPOPT status, RMS z of the angles, torques
@@ -535,7 +537,7 @@ def book_gaps(root=None) -> pd.DataFrame:
     """
     items = [("Ch 5", m, ("DT (Eq 5.33)" if m == "MSK" else "DT (Eq 5.55)") + f", {reading}'s reading",
               msk.solve(m, root=root, reading=reading)) for reading in ("book", "thesis") for m in ("MSK", "NMSK")]
-    r6 = pr.cost_function_study(("MSK", "NMSK"), pr.CH6_COSTS, progress=False, root=root)
+    r6 = pr.cost_function_study(("MSK", "NMSK"), pr.CH6_COSTS, progress=False, root=root, reading="book")
     items += [("Ch 6", r6.specs[k].model, r6.specs[k].cost, s) for k, s in r6.solutions.items()]
     r7 = pr.speed_study(("MSK", "NMSK"), pr.CH7_CLASSES, progress=False, root=root, reading="book")
     items += [("Ch 7", r7.specs[k].model, r7.specs[k].speed_class, s) for k, s in r7.solutions.items()]
@@ -719,12 +721,12 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
                    + " " + visibility_text(val))
     if valv is not None:
         out.append(" ".join(validation_lines(valv)[:-1]))
-    conv = gaps[gaps["status"] == "Solve_Succeeded"]
+    conv = gaps[gaps["mark"] == ""]  # converged and valid (a marked solution carries no sentence)
     left_top = conv["largest cell"].str.contains("_l ").mean() * 100
     c = conv.sort_values("RMS z, angles/torques/GRFs")
     lo, hi = c.iloc[0], c.iloc[-1]
     out.append(
-        f"**The book's Ch 5–7 solutions.** {len(conv)} of {len(gaps)} converged. Their RMS z over angles, torques and "
+        f"**The book's Ch 5–7 solutions.** {len(conv)} of {len(gaps)} converged and pass the validity gates. Their RMS z over angles, torques and "
         f"GRFs runs from {lo['RMS z, angles/torques/GRFs']:.1f} ({lo['chapter']} {lo['model']} {lo['case']}) to "
         f"{hi['RMS z, angles/torques/GRFs']:.1f} ({hi['chapter']} {hi['model']} {hi['case']}), against "
         f"{sS['rms_z']:.2f} for the SK model fitted by the diagnosis's SD-standardised objective: the thesis's cost "

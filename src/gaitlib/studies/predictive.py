@@ -683,8 +683,8 @@ def ch6_findings(res: StudyResult, thesis_guess_stats: pd.DataFrame, reruns: dic
     exc = csc[csc["kind"] == "excitation"].groupby("case")["rmse"].mean()
     not_conv = [c for c in CH6_COSTS if run_marks.get(f"NMSK {c}")]
     if len(exc):
-        lines.append("- Excitation RMSE vs EMG (mean over mapped muscles, converged NMSK runs"
-                     + (f"; {', '.join(not_conv)} left out: not converged" if not_conv else "") + "): "
+        lines.append("- Excitation RMSE vs EMG (mean over mapped muscles, converged and valid NMSK runs"
+                     + (f"; {', '.join(not_conv)} left out: not converged or invalid" if not_conv else "") + "): "
                      f"best {exc.idxmin()} {exc.min():.3f}, worst {exc.idxmax()} {exc.max():.3f}; "
                      f"FP {exc.get('FP', np.nan):.3f} vs DT {exc.get('DT', np.nan):.3f} (thesis: FP "
                      f"{THESIS_FP_EXCITATION_GAIN_PCT:.0f} % better than DT).")
