@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import json
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -572,10 +572,12 @@ def _ch5_bases(reading: str = "thesis") -> dict:
 # ======================================================================================
 # Chapters 6 and 7: cost functions and speeds
 # ======================================================================================
-def _runs(bases: dict, which: str, reading: str = "thesis") -> dict:
+def _runs(bases: dict, which: str, reading: str = "thesis", max_iter: int | None = None) -> dict:
     """name → StoredGait (or None) of the Ch 6 (``which="ch6"``) or Ch 7 runs in ``reading``
     (``bases``: the Ch 5 solutions of that reading), found as
-    :func:`gaitlib.studies.predictive.cost_function_study` / ``speed_study`` store them."""
+    :func:`gaitlib.studies.predictive.cost_function_study` / ``speed_study`` store them;
+    ``max_iter``: their reruns with that iteration limit instead
+    (:meth:`gaitlib.studies.predictive.StudyResult.rerun_failed`)."""
     out = {}
     for m, base in bases.items():
         if which == "ch6":
@@ -589,6 +591,7 @@ def _runs(bases: dict, which: str, reading: str = "thesis") -> dict:
                 guesses[k] = pr.run_guess(base, pr.GUESS_POLICY[m], cycle_time=g.cycle_time,
                                           stride=g.speed * g.cycle_time)
         for k, s in specs.items():
+            s = replace(s, max_iter=max_iter) if max_iter else s
             out[k] = stored_gait(gait_ocp.cache_dir(s, guess=guesses[k]))
     return out
 
@@ -616,7 +619,8 @@ def _short(label: str) -> str:
     return ", ".join(dict.fromkeys(n for n in names if n))
 
 
-def _ch6(bases: dict, runs: dict, valid: dict) -> list[Row]:
+def _ch6(bases: dict, runs: dict, valid: dict, reruns: dict | None = None) -> list[Row]:
+    reruns = reruns or {}
     rows = []
     status = _anchor("ch06_costfun", "Did every run converge? Solver statistics and Table 6.3")
     for model, hours in pr.THESIS_HOURS_TABLE_6_3.items():
@@ -629,7 +633,7 @@ def _ch6(bases: dict, runs: dict, valid: dict) -> list[Row]:
                             s.name if s else "", valid.get(f"{model} {c}", ""), holds=bool(s and s.success)))
     free = data_mod.load_gait_data("Free")
     sc = {k: pr.score(s, free) for k, s in runs.items() if s is not None}
-    rows += _ch6_claims(bases, runs, valid, free)
+    rows += _ch6_claims(bases, runs, valid, free, reruns)
     # the fully predictive NMSK vs MSK: % lower RMSE (Sec 6.3)
     for kind, tv in pr.THESIS_FP_GAIN_PCT.items():
         a, b = "MSK FP", "NMSK FP"
@@ -657,24 +661,34 @@ def _ch6(bases: dict, runs: dict, valid: dict) -> list[Row]:
     return rows
 
 
-def _ch6_claims(bases: dict, runs: dict, valid: dict, free) -> list[Row]:
+def _ch6_claims(bases: dict, runs: dict, valid: dict, free, reruns: dict) -> list[Row]:
     """The Ch 6 conclusions (:func:`gaitlib.studies.ch6_claims.conclusions`) that the thesis
     states without a number, one row each, on the runs that converged and pass the gates;
     the verdict is the NRMSE one, and a claim whose verdict changes with the metric says so in
     its cause."""
     where = _anchor("ch06_costfun", "The thesis's conclusions, re-derived from valid runs (Secs 6.2–6.3)")
-    usable = {k: s for k, s in runs.items() if s is not None and not _blocked(valid.get(k, ""))}
+    usable, notes = {}, {}
+    for k, s in runs.items():
+        if s is not None and not _blocked(valid.get(k, "")):
+            usable[k] = s
+        elif reruns.get(k) is not None and not _blocked(gate(reruns[k], k)):  # the page's rule
+            usable[k] = reruns[k]
+            notes[k] = f"its {reruns[k].spec.max_iter}-iteration rerun ({reruns[k].stats['iterations']} iterations)"
     n5 = bases.get("NMSK")
     table = ch6_claims.conclusions(usable, free, excluded={k: valid.get(k, "") for k in runs if k not in usable},
-                                   ch5_nmsk=n5)
-    valid = {**valid, ch6_claims.CH5_NMSK: gate(n5, "NMSK") if n5 is not None else ""}
+                                   ch5_nmsk=n5, notes=notes)
+    valid = {**valid, **{k: gate(s, k) for k, s in usable.items()},
+             ch6_claims.CH5_NMSK: gate(n5, "NMSK") if n5 is not None else ""}
     rows = []
     for _, r in table[~table["numeric"].astype(bool)].iterrows():
-        names = r["runs"].split(", ")
+        # a decided claim is computed from the usable runs alone; an untested one names all
+        names = (r["used"] if r["verdict"] != "not tested" else r["runs"]).split(", ")
         exc = isinstance(r["RMSE: verdict"], str)  # an excitation claim: RMSE (the thesis's), else NRMSE
         metric, other = ("RMSE", "NRMSE") if exc else ("NRMSE", "SD units")
         ours = r[metric] if r["verdict"] != "not tested" else np.nan
         cause = "unknown"
+        if r["verdict"] == "not tested":
+            cause = f"not tested: {r['ours']} [{where}]"
         if r["depends on metric"]:
             cause = f"depends on the metric: {other} says {r[f'{other}: verdict']} ({r[other]}) [{where}]"
         rows.append(Row(6, f"{r['claim']} (Sec {r['thesis']})", "holds", ours, "", cause,
@@ -798,7 +812,7 @@ def _build(chapters) -> pd.DataFrame:
     ch6 = _runs(bases, "ch6", "book") if {6, 7} & set(chapters) else {}
     valid6 = {k: gate(s, k) for k, s in ch6.items() if s is not None}
     if 6 in chapters:
-        rows += _ch6(bases, ch6, valid6)
+        rows += _ch6(bases, ch6, valid6, _runs(bases, "ch6", "book", max_iter=3000))
     if 7 in chapters:  # the Free point is the Ch 6 NMSK DT run
         ch7 = _runs(bases, "ch7", "book")
         valid7 = {k: gate(s, k) for k, s in ch7.items() if s is not None}

@@ -246,7 +246,8 @@ def conclusions(runs: dict, gait: data_mod.GaitData, *, excluded: dict | None = 
 
     Columns: ``claim, thesis`` (section), ``test``, one text and one verdict column per metric,
     ``ours`` (reruns used, or the runs not usable), ``verdict``, ``depends on metric``,
-    ``runs`` (the runs the claim needs, comma-separated) and ``numeric`` (the thesis states a
+    ``runs`` (the runs the claim needs, comma-separated), ``used`` (those usable, which the
+    verdict is computed from) and ``numeric`` (the thesis states a
     number: a per-cent gain or a time). Compute-time rows have no metric."""
     all_runs = dict(runs)
     if ch5_nmsk is not None:
@@ -267,7 +268,7 @@ def table_conclusions(scores: pd.DataFrame, times: dict, *, excluded: dict | Non
     rows = []
     for claim, sec, test_text, need, test, metrics in _claims(c5):
         row = {"claim": claim, "thesis": sec, "test": test_text, "runs": ", ".join(need),
-               "numeric": claim in _NUMERIC}
+               "used": ", ".join(n for n in need if acc.has(n)), "numeric": claim in _NUMERIC}
         required = getattr(test, "required", need)
         miss = acc.missing(required)
         rivals_out = acc.missing([n for n in need if n not in required])
@@ -299,7 +300,7 @@ def table_conclusions(scores: pd.DataFrame, times: dict, *, excluded: dict | Non
         rows.append(row)
     rows += _time_claims(times, acc)
     cols = ["claim", "thesis", "test", "NRMSE", "NRMSE: verdict", "SD units", "SD units: verdict", "RMSE",
-            "RMSE: verdict", "ours", "verdict", "depends on metric", "runs", "numeric"]
+            "RMSE: verdict", "ours", "verdict", "depends on metric", "runs", "used", "numeric"]
     return pd.DataFrame(rows).reindex(columns=cols)
 
 
