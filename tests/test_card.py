@@ -95,6 +95,9 @@ def test_cli_writes_card(cli_card):
     assert strong["cause"].str.contains("MTG strength envelope").all()
     assert strong["cause"].str.contains("human standing jumps").all()
     assert (card.counts(c).sum() == len(c))
+    # a reproduced row (of any kind) needs no cause, so none says "unknown"
+    ok = c["verdict"].isin(["reproduced", "within data SD", "qualitatively reproduced"])
+    assert not c.loc[ok, "cause"].fillna("").str.startswith("unknown").any()
     # every Ch 5 tracking row carries its channel's located gap (Ch 8's first step); other rows none
     track = c["item"].str.contains(r"^N?MSK RMSE ")
     assert c.loc[track, "gap"].str.match(r"RMS z \d+\.\d\d").all()

@@ -20,8 +20,9 @@
 # * the **initial guess** is the data-based one with the HAT coordinates, the metatarsal
 #   angles and torques (and, MSK, the 12 MTG activations) taken from that Ch 5 solution;
 #   NMSK excitations start from the EMG where our data have the muscle. **We depart from
-#   this for NMSK:** from the thesis's partial guess, 3 of these 8 NMSK runs and all 4
-#   NMSK runs of Ch 7 stopped at IPOPT's 1000-iteration limit (statuses shown below), so the NMSK runs reported here
+#   this for NMSK:** from the thesis's partial guess, several of these NMSK runs and of the
+#   NMSK runs of Ch 7 stopped at IPOPT's 1000-iteration limit (their statuses are shown below
+#   and in Ch 7), so the NMSK runs reported here
 #   start from the *whole* Ch 5 NMSK solution (states, excitations, residuals);
 # * nothing is identified: contact, MTG and activation parameters are fixed.
 #

@@ -10,7 +10,8 @@ stored gives a "not comparable" row) and returns a DataFrame with the columns :d
 ``unit``      SI-ish display unit of both (deg, N*m, N, cm, J/kg/m, %, 1 …)
 ``verdict``   :func:`verdict` (the rule below, stated once)
 ``cause``     a one-line measured reason with the book page/section that measures it,
-              ``"unknown"``, or empty for a reproduced row (it needs none)
+              ``"unknown"``, or empty for a reproduced row, qualitatively reproduced
+              included (it needs none)
 ``solution``  the stored solution (cache kind/key and what it is)
 ``valid``     its physical validity gates (:func:`gaitlib.validity.check`): ``"valid"``,
               ``"not converged (…)"`` and/or ``"invalid: …"``
@@ -156,7 +157,7 @@ class Row:
             cause = f"{'gates fail (valid column)' if cause == 'unknown' else cause}; the number alone: {alone}"
         if _missing(self.ours) and cause == "unknown":
             cause = "no stored solution"
-        if v in ("reproduced", "within data SD") and cause == "unknown":
+        if v in ("reproduced", "within data SD", "qualitatively reproduced") and cause == "unknown":
             cause = ""  # a reproduced row needs no cause
         def g6(x):  # 6 significant digits for numbers (text kept)
             return float(f"{float(x):.6g}") if _numeric(x) else x

@@ -102,23 +102,19 @@ def reading_fields(reading: str, cost: str) -> dict:
     return fields
 
 
-def fp_timed_study(models=("MSK", "NMSK"), *, n_intervals: int = 20, degree: int = 5, root=None,
-                   scheduler: str | None = None, n_workers: int | None = None, serial: bool = False,
-                   progress: bool = False) -> StudyResult:
-    """The FP runs of Ch 6 in the book's reading with the swing bound timed by the data's
-    events (:func:`gaitlib.validity.swing_bound` while the data say a foot swings): the
-    book's FP has no swing bound (:func:`reading_fields`) and can end as a shuffle with both
-    feet loaded; this experiment gives it the gait's phase timing — two event times and the
-    left leg's shift, no data curve — and nothing else. Scored against the Free data like
-    every Ch 6 run."""
-    from .. import validity
+def variant_study(models=("MSK", "NMSK"), costs=CH6_COSTS, *, n_intervals: int = 20, degree: int = 5, root=None,
+                  scheduler: str | None = None, n_workers: int | None = None, serial: bool = False,
+                  progress: bool = False, **changes) -> StudyResult:
+    """Ch 6 runs in the book's reading with GaitSpec fields ``changes`` on top (one experiment
+    of the Fidelity II work: everything else — weights, guesses, HAT reference, parameter
+    sets — as :func:`cost_function_study`). Scored against the Free data."""
     params = default_params()
     how = dict(GUESS_POLICY)
     bases = {m: baseline(m, n_intervals=n_intervals, degree=degree, root=root, reading="book", **params) for m in models}
     specs, guesses = {}, {}
     for m in models:
-        sp = ch6_specs(m, bases[m], ("FP",), n_intervals=n_intervals, degree=degree, reading="book",
-                       swing_load_max=validity.swing_bound(), **params)
+        sp = ch6_specs(m, bases[m], costs, n_intervals=n_intervals, degree=degree, reading="book",
+                       **{**params, **changes})
         specs.update(sp)
         guesses.update({k: run_guess(bases[m], how[m]) for k in sp})
     recs, sols = _run(specs, guesses, root=root, scheduler=scheduler, n_workers=n_workers, serial=serial,
@@ -126,6 +122,24 @@ def fp_timed_study(models=("MSK", "NMSK"), *, n_intervals: int = 20, degree: int
     free = data_mod.load_gait_data("Free")
     return StudyResult(specs, recs, sols, bases, _scores(sols, {"Free": free}, lambda s: "Free"), guess=how,
                        guesses=guesses)
+
+
+def fp_timed_study(models=("MSK", "NMSK"), **kw) -> StudyResult:
+    """The FP runs of Ch 6 in the book's reading with the swing bound timed by the data's
+    events (:func:`gaitlib.validity.swing_bound` while the data say a foot swings): the
+    book's FP has no swing bound (:func:`reading_fields`) and can end as a shuffle with both
+    feet loaded; this experiment gives it the gait's phase timing — two event times and the
+    left leg's shift, no data curve — and nothing else (:func:`variant_study`)."""
+    from .. import validity
+    return variant_study(models, ("FP",), swing_load_max=validity.swing_bound(), **kw)
+
+
+def activation_study(costs=("DT",), **kw) -> StudyResult:
+    """The NMSK Ch 6 runs in the book's reading with the activation parameters (τ_act, c3, s1,
+    s2) identified with the run (``free_activation``, as Ch 5's Eq 5.55 does) instead of fixed
+    to the thesis's Table 5.10 (:func:`variant_study`): how much of the NMSK runs' misfit the
+    thesis's activation parameters cause on our data."""
+    return variant_study(("NMSK",), costs, free_activation=True, **kw)
 
 
 def default_params() -> dict:
