@@ -99,6 +99,17 @@ def test_each_ablation_change_is_one_change_on_the_swing_unloaded_spec():
     assert "GRF weight ×4" in fidelity.tracking_changes("MSK")
 
 
+def test_each_ch5_ablation_change_is_one_change_on_the_book_reading_spec():
+    from gaitlib.studies import msk
+    base = msk.ch5_spec("MSK", reading="book")
+    assert base.jerk_ranges == "data" and base.swing_load_max == pytest.approx(0.01 * 41.4 * 9.81, abs=1e-3)
+    for name, change in fidelity.ch5_changes("MSK").items():
+        spec = replace(base, **change)
+        differs = {k for k, v in spec.to_dict().items() if base.to_dict().get(k) != v}
+        assert differs <= set(change) and differs, name
+    assert {"coordinate weight ×4", "torque weight ×4", "GRF weight ×4"} <= set(fidelity.ch5_changes("MSK"))
+
+
 def _row(status="Solve_Succeeded", obj=0.3, gates="valid", angle=10.0, torque=12.0, grf=60.0, swing=4.0, ds=27.0):
     return {"status": status, "iterations": 300, "objective": obj, "swing load (N)": swing,
             "double support (%)": ds, "worst angle RMSE (deg)": angle, "worst torque RMSE (N·m)": torque,

@@ -277,6 +277,43 @@ def tracking_ablation(model: str = "MSK", *, bound_bw: float = SWING_BOUND_BW, u
 TARGET_FACTOR = 1.5
 
 
+def ch5_changes(model: str = "MSK") -> dict[str, dict]:
+    """The changes of the Ch 5 ablation, each a set of :class:`GaitSpec` fields applied alone
+    to the Ch 5 problem in the book's reading (:func:`gaitlib.studies.msk.ch5_spec`): each
+    data-tracking weight of Table 5.3 (¼ → 1), the mesh (40 × 5), and the thesis's parameter
+    sets instead of ours (body Tables 4.15–4.16, contact Tables 4.17–4.18, MTGs Table 5.2)."""
+    w = dict(gait_ocp.COST_FUNCTIONS[model][msk.ch5_spec(model).cost])
+    return {
+        f"coordinate weight ×{1 / w['Q']:g}": {"weights": (("Q", 1.0),)},
+        f"torque weight ×{1 / w['Trq']:g}": {"weights": (("Trq", 1.0),)},
+        f"GRF weight ×{1 / w['GRF']:g}": {"weights": (("GRF", 1.0),)},
+        "mesh 40 × 5": {"n_intervals": 40},
+        "the thesis's parameter sets": {"body_params": "thesis", "contact_params": "default",
+                                        "mtg_params": "default"},
+    }
+
+
+#: The row of the Ch 5 ablation that is the book's own Ch 5 solution.
+CH5_BASE_ROW = "Ch 5, book's reading"
+
+
+def ch5_ablation(model: str = "MSK", *, use_cache: bool = True, serial: bool = True) -> tuple[pd.DataFrame, dict]:
+    """Each :func:`ch5_changes` entry applied alone to the Ch 5 problem in the book's reading
+    (the base row: the book's Ch 5 solution), every run solved from the data like the book's
+    Ch 5 solve. Returns (one :func:`ablation_row` per run, the solutions by row)."""
+    base = msk.ch5_spec(model, reading="book")
+    specs = {k: replace(base, **ch) for k, ch in ch5_changes(model).items()}
+    recs = gait_ocp.solve_specs(specs, use_cache=use_cache, serial=serial)
+    sols = {CH5_BASE_ROW: msk.solve(model, reading="book"), **{k: r.value for k, r in recs.items()}}
+    return pd.DataFrame([ablation_row(k, v) for k, v in sols.items() if v is not None]).set_index("run"), sols
+
+
+def usable_solutions(sols: dict) -> dict:
+    """The converged solutions that pass the validity gates (what a conclusion may use)."""
+    return {k: v for k, v in sols.items() if v is not None and v.stats["status"] in validity.CONVERGED_STATUSES
+            and validity.check(v).passed}
+
+
 def channel_table(picked: dict, model: str = "MSK") -> pd.DataFrame:
     """RMSE per channel (rows ``kind, channel, side, unit``) of every ablation row's
     solution (columns, in ``picked``'s order), beside the thesis's table for ``model`` (a
