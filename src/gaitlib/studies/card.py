@@ -396,6 +396,7 @@ def _ch5(bases: dict) -> list[Row]:
     ablation = {"MSK": _ablation_causes("MSK")}
     jerk = _jerk_causes("MSK")
     floor = _floor_causes()
+    ch5abl = {"MSK": _ch5_ablation_causes("MSK")}
     gaps = {m: _located_gaps(s) for m, s in bases.items() if s is not None}
     for model, table in (("MSK", "Table 5.4"), ("NMSK", "Table 5.11")):
         s = bases.get(model)
@@ -407,9 +408,11 @@ def _ch5(bases: dict) -> list[Row]:
             unit = {"angle": "deg", "torque": "N*m", "grf": "N"}[kind]
             sd = _rms_sd(gait, col, 1 / cv.DEG if kind == "angle" else 1.0)
             ours = float(r.get((kind, ch), np.nan)) if r is not None else np.nan
-            # angles: the geometric floor (no dynamics); torques and forces: the Ch 2 measurements,
-            # made from the thesis's reading and labelled so
-            cause = floor.get((part, side)) if kind == "angle" else None
+            # MSK: the Ch 5 ablation on the book's reading itself; angles: the geometric floor
+            # (no dynamics); otherwise the Ch 2 measurements, made from the thesis's reading
+            # and labelled so
+            parts = [ch5abl.get(model, {}).get((kind, part, side)), floor.get((part, side)) if kind == "angle" else None]
+            cause = "; ".join(p for p in parts if p) or None
             if cause is None:
                 cause = ablation.get(model, {}).get((kind, part, side)) or jerk.get((kind, part, side))
                 cause = f"measured from the thesis's reading: {cause}" if cause else None
@@ -509,6 +512,28 @@ def _located_gaps(sol) -> dict:
         ph = loc.table[loc.table["channel"] == c["channel"]].sort_values("rms_z").iloc[-1]
         out[c["channel"]] = (f"RMS z {c['rms_z']:.2f}{' (significant)' if c['significant'] else ''}; largest in "
                              f"{ph['phase']} (z {ph['rms_z']:.2f}{', significant' if ph['significant'] else ''}) [{where}]")
+    return out
+
+
+def _ch5_ablation_causes(model: str = "MSK") -> dict:
+    """(kind, part, side) → the Ch 5 ablation's answer for that channel (:func:`gaitlib.
+    studies.fidelity.ch5_ablation`: one change at a time on the book's reading; the lowest
+    RMSE a converged, valid run reaches and which changes meet the target); empty when it is
+    not stored or the book's own Ch 5 solution is not usable."""
+    try:
+        with cache.only("the card reads stored solutions only"):
+            _, sols = fidelity.ch5_ablation(model)
+    except cache.NotCached:
+        return {}
+    ok = fidelity.usable_solutions(sols)
+    if fidelity.CH5_BASE_ROW not in ok or len(ok) < 2:
+        return {}
+    where = _anchor("ch05_msk", "Where the misfit comes from: one change at a time")
+    out = {}
+    for (kind, part, side, unit), r in fidelity.channel_table(ok, model).iterrows():
+        out[(kind, part, side)] = (f"Ch 5 ablation (book's reading, {len(ok) - 1} usable changes): lowest "
+                                   f"{r[r['best change']]:.1f} {unit} ({r['best change']}), target {r['target']:.1f} "
+                                   f"{unit} met by: {r['met by']} [{where}]")
     return out
 
 

@@ -308,6 +308,29 @@ def ch5_ablation(model: str = "MSK", *, use_cache: bool = True, serial: bool = T
     return pd.DataFrame([ablation_row(k, v) for k, v in sols.items() if v is not None]).set_index("run"), sols
 
 
+def ch5_ablation_findings(table: pd.DataFrame, per_channel: pd.DataFrame, floor: pd.DataFrame,
+                          clearance_mm: float = 1e3 * TOUCH) -> list[str]:
+    """Sentences on the Ch 5 ablation (:func:`ch5_ablation`; ``per_channel``: its
+    :func:`channel_table` over the usable runs; ``floor``: :func:`kinematic_floor_table`):
+    which runs count, and for each angle channel the lowest RMSE any change reaches, the
+    target, and the geometric floor (no dynamics) at ``clearance_mm``."""
+    left = [f"{k} ({r['gates'] if r['gates'] != 'valid' else r['status']})" for k, r in table.iterrows()
+            if r["status"] not in validity.CONVERGED_STATUSES or r["gates"] != "valid"]
+    out = [f"- {len(table) - len(left)} of {len(table)} runs converged and pass the validity gates"
+           + (f"; left out: {', '.join(left)}" if left else "") + "."]
+    at = floor[np.isclose(floor["swing clearance (mm)"], clearance_mm)].set_index("metatarsal")
+    ang = per_channel.xs("angle", level="kind")
+    cols = [c for c in per_channel.columns if c not in ("target", "best change", "met by")
+            and not c.startswith("thesis")]
+    for (ch, side, unit), r in ang.iterrows():
+        fcol = f"{ch}_{side} (deg)"
+        fl = (f"; geometric floor {at[fcol].iloc[0]:.1f}° (metatarsal tracked), {at[fcol].iloc[1]:.1f}° (free)"
+              if fcol in at.columns else "")
+        out.append(f"- {ch} {side.upper()}: {r[cols[0]]:.1f}° in the book's Ch 5; lowest {r[r['best change']]:.1f}° "
+                   f"({r['best change']}); target {r['target']:.1f}° met by: {r['met by']}{fl}.")
+    return out
+
+
 def usable_solutions(sols: dict) -> dict:
     """The converged solutions that pass the validity gates (what a conclusion may use)."""
     return {k: v for k, v in sols.items() if v is not None and v.stats["status"] in validity.CONVERGED_STATUSES

@@ -142,6 +142,29 @@ def activation_study(costs=("DT",), **kw) -> StudyResult:
     return variant_study(("NMSK",), costs, free_activation=True, **kw)
 
 
+def activation_table(res: StudyResult, res_act: StudyResult, costs=("DT",)) -> pd.DataFrame:
+    """The NMSK runs of ``costs`` with the thesis's activation parameters (``res``, the Ch 6
+    study) beside the same runs with them identified (``res_act``, :func:`activation_study`),
+    and the MSK run of the same cost: mark, mean NRMSE per kind and overall, and the
+    activation parameters each NMSK run used (τ_act s; c3, s1, s2 dimensionless)."""
+    rows = {}
+    for c in costs:
+        items = [(f"MSK {c}", res.solutions.get(f"MSK {c}"), "—"),
+                 (f"NMSK {c}, Table 5.10's activation parameters", res.solutions.get(f"NMSK {c}"), "Table 5.10"),
+                 (f"NMSK {c}, activation parameters identified", res_act.solutions.get(f"NMSK {c}"), "identified")]
+        for label, sol, how in items:
+            if sol is None:
+                continue
+            sc = score(sol, data_mod.load_gait_data("Free"))
+            k = sc[sc["kind"].isin(_KINDS)].groupby("kind")["nrmse"].mean()
+            ap = sol.stats.get("activation_parameters") or {}
+            rows[label] = {"mark": marks.failure_label(sol) or "", "iterations": sol.stats["iterations"],
+                           **{f"NRMSE {kk}": float(v) for kk, v in k.items()}, "mean NRMSE": float(k.mean()),
+                           "activation parameters": how,
+                           **{p: float(v) for p, v in ap.items()}}
+    return pd.DataFrame(rows).T
+
+
 def default_params() -> dict:
     """The parameter sets the thesis carries into Chs 6–7: those of the Ch 5 solves
     (:func:`gaitlib.studies.msk.parameter_sets`). The NMSK runs use the activation
