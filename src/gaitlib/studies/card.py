@@ -769,9 +769,15 @@ def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict) -> list[
         v = valid6.get("NMSK DT", "") if c == "Free" else valid.get(f"NMSK {c}", "")
         cot = float(s.stats.get("COT", np.nan)) if s is not None else np.nan
         cause = "unknown"
+        if s is not None and getattr(s, "muscle_activations", None) is not None:
+            br = msk.cot_breakdown(s).iloc[:, 0]
+            cause = (f"shortening heat {br['shortening']:.2f} of {br['total']:.2f} J/kg/m (Eq 5.47 as printed); the "
+                     f"thesis's value is {tv / msk.CHILD_COT_GROSS:.2f}× the gross COT children aged 6–12 were measured "
+                     f"at free speed ({msk.CHILD_COT_GROSS:.1f} J/kg/m, Waters et al. 1983) [{cot_page}]")
         if c == "Free" and n5 is not None:
             cause = (f"ours: Ch 6 NMSK DT (the cost of the other points); the Ch 5 NMSK (Eq 5.55, its own "
-                     f"activation parameters) gives {n5.stats.get('COT', np.nan):.2f} [{cot_page}]")
+                     f"activation parameters) gives {n5.stats.get('COT', np.nan):.2f}; "
+                     + (cause if cause != "unknown" else f"[{cot_page}]"))
         g = data_mod.load_gait_data(c)
         pts[c] = (g.speed, cot)
         vals[f"NMSK {c}"] = v
