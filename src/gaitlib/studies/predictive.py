@@ -559,6 +559,11 @@ def pin_findings(pull: pd.DataFrame, loose: pd.DataFrame | None = None) -> list[
                      + (f" (left out, marked: {', '.join(dropped)})" if dropped else "")
                      + (f"; median NRMSE against the class data {q['vs class data'].median():.3f} "
                         f"(Table 7.1's weights: {p['vs class data'].median():.3f})." if nq else "."))
+            if nq:
+                away = q["vs class data"].median() > p["vs class data"].median()
+                line += (" Loosened, the predictions moved " + ("away from" if away else "towards")
+                         + " the class data: " + ("the data terms are not what holds them from it." if away else
+                                                  "the data terms hold them to their input."))
         out.append(line)
     return out
 
