@@ -63,6 +63,7 @@ from .. import activation
 from . import predictive as pr
 from . import fidelity
 from . import ch6_claims
+from .. import marks as marks_mod
 from ..gap import io as gap_io
 from ..gap import locate as gap_locate
 
@@ -598,12 +599,13 @@ def _ch5_bases(reading: str = "thesis") -> dict:
 # ======================================================================================
 # Chapters 6 and 7: cost functions and speeds
 # ======================================================================================
-def _runs(bases: dict, which: str, reading: str = "thesis", max_iter: int | None = None) -> dict:
+def _runs(bases: dict, which: str, reading: str = "thesis", **changes) -> dict:
     """name → StoredGait (or None) of the Ch 6 (``which="ch6"``) or Ch 7 runs in ``reading``
     (``bases``: the Ch 5 solutions of that reading), found as
     :func:`gaitlib.studies.predictive.cost_function_study` / ``speed_study`` store them;
-    ``max_iter``: their reruns with that iteration limit instead
-    (:meth:`gaitlib.studies.predictive.StudyResult.rerun_failed`)."""
+    ``changes``: GaitSpec fields of a variant of those runs (e.g. ``max_iter=3000``: the
+    reruns of :meth:`gaitlib.studies.predictive.StudyResult.rerun_failed`; ``weights=``: the
+    Ch 7 pin experiment)."""
     out = {}
     for m, base in bases.items():
         if which == "ch6":
@@ -617,7 +619,7 @@ def _runs(bases: dict, which: str, reading: str = "thesis", max_iter: int | None
                 guesses[k] = pr.run_guess(base, pr.GUESS_POLICY[m], cycle_time=g.cycle_time,
                                           stride=g.speed * g.cycle_time)
         for k, s in specs.items():
-            s = replace(s, max_iter=max_iter) if max_iter else s
+            s = replace(s, **changes) if changes else s
             out[k] = stored_gait(gait_ocp.cache_dir(s, guess=guesses[k]))
     return out
 
@@ -794,8 +796,40 @@ def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict) -> list[
     rows.append(Row(7, "COT against speed is U-shaped with its minimum at the natural speed (Sec 7.2, Fig 7.5)",
                     "U, minimum at natural speed", ours, "", "unknown",
                     "Ch 6 NMSK DT, Ch 7 NMSK", _joint(vals), holds=holds))
+    rows.append(_ch7_pin(bases, runs))
     rows += _ch7_consistent()
     return rows
+
+
+class _Runs:
+    """The ``solutions`` of a study, as :func:`gaitlib.studies.predictive.input_pull` reads them."""
+
+    def __init__(self, runs: dict):
+        self.solutions = {k: s for k, s in runs.items() if s is not None}
+
+
+def _ch7_pin(bases: dict, runs: dict) -> Row:
+    """Thesis Secs 7.2–7.3: the predictions approach the speed classes' own (untracked) data.
+    Ours: the NMSK cells (class × kind) closer to the class data than the time-scaled Free
+    data they tracked; the cause: the pin experiment (:func:`gaitlib.studies.predictive.
+    pin_findings`, Table 7.1's data weights ÷ 10)."""
+    item = "NMSK predictions closer to each class's own data than the scaled Free data they tracked (Secs 7.2–7.3)"
+    gaits = {c: data_mod.load_gait_data(c) for c in cv.SPEED_CLASSES}
+    nm = {k: s for k, s in runs.items() if k.startswith("NMSK ")}
+    if not all(s is not None for s in nm.values()):
+        return Row(7, item, "closer", np.nan, "", "unknown", "", "")
+    pull = pr.input_pull(_Runs(nm), gaits)
+    closer, n = pr.closer_cells(pull)
+    loose = _runs({m: b for m, b in bases.items() if m == "NMSK"}, "ch7", "book", weights=pr.LOOSE_TRACKING)
+    cause = "unknown"
+    if all(s is not None for s in loose.values()):
+        lines = pr.pin_findings(pull, pr.input_pull(_Runs(loose), gaits))
+        where = _anchor("ch07_speed", "Accuracy against each class's own (untracked) data — thesis Figs 7.1–7.4")
+        if lines:
+            cause = lines[-1].lstrip("- ") + f" [{where}]"
+    valid = _joint({k: gate(s, k) for k, s in nm.items() if s is not None and not marks_mod.failure_label(s)})
+    return Row(7, item, "closer", f"{closer} of {n} unmarked cells", "", cause, "Ch 7 NMSK, 4 runs",
+               valid or "valid", holds=closer > n / 2)
 
 
 def _ch7_consistent() -> list[Row]:
