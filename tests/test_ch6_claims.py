@@ -56,7 +56,7 @@ def test_verdicts_by_hand():
     assert _row(t, "SP1 (GRF only)")["verdict"] == "holds"     # 0.3 > every Ang/Trq run, both models
     assert _row(t, "FP: less accurate")["verdict"] == "holds"
     r = _row(t, "FP: NMSK angles")  # SD units 1 − 3.2/4 = 20 %; NRMSE 1 − 0.35/0.4 = 12.5 %
-    assert "lower by 12 %" in r["NRMSE"] or "lower by 13 %" in r["NRMSE"]
+    assert "NMSK lower by 12 %" in r["NRMSE"] or "NMSK lower by 13 %" in r["NRMSE"]
     assert "lower by 20 %" in r["SD units"]
     assert _row(t, "NMSK SDT3 predicts the most")["verdict"] == "holds"
     assert _row(t, "NMSK SP1 predicts the least")["verdict"] == "holds"

@@ -707,6 +707,12 @@ def _ch6_claims(bases: dict, runs: dict, valid: dict, free, reruns: dict) -> lis
                                    ch5_nmsk=n5, notes=notes)
     valid = {**valid, **{k: gate(s, k) for k, s in usable.items()},
              ch6_claims.CH5_NMSK: gate(n5, "NMSK") if n5 is not None else ""}
+    # the FP claims again on the FP runs with the gait's phase timing (Ch 6, our reading)
+    timed = {k: v for k, v in _runs(bases, "ch6", "book", swing_load_max=validity.swing_bound()).items()
+             if k.endswith(" FP") and v is not None and not _blocked(gate(v, k))}
+    table_t = (ch6_claims.conclusions({**usable, **timed}, free, ch5_nmsk=n5, notes=notes).set_index("claim")
+               if timed else None)
+    fp_where = _anchor("ch06_costfun", "FP with the gait's phase timing")
     rows = []
     for _, r in table[~table["numeric"].astype(bool)].iterrows():
         # a decided claim is computed from the usable runs alone; an untested one names all
@@ -717,6 +723,10 @@ def _ch6_claims(bases: dict, runs: dict, valid: dict, free, reruns: dict) -> lis
         cause = "unknown"
         if r["verdict"] == "not tested":
             cause = f"not tested: {r['ours']} [{where}]"
+            if table_t is not None and r["claim"] in table_t.index and table_t.loc[r["claim"], "verdict"] != "not tested":
+                t = table_t.loc[r["claim"]]
+                cause += (f"; with the gait's phase timing (FP, our reading): {t['verdict']} "
+                          f"({t['RMSE' if exc else 'NRMSE']}) [{fp_where}]")
         if r["depends on metric"]:
             cause = f"depends on the metric: {other} says {r[f'{other}: verdict']} ({r[other]}) [{where}]"
         rows.append(Row(6, f"{r['claim']} (Sec {r['thesis']})", "holds", ours, "", cause,

@@ -80,6 +80,11 @@ def _short(mark: str | None) -> str:
     return ", ".join(p.split(":")[0].strip().lower() for p in mark.split("; "))
 
 
+def _by(pct: float, down: str, up: str) -> str:
+    """``"lower by 12 %"`` for a positive gain, ``"higher by 4 %"`` for a negative one."""
+    return f"{down if pct >= 0 else up} by {abs(pct):.0f} %"
+
+
 def _fmt(v: float) -> str:
     return f"{v:.3f}" if np.isfinite(v) else "—"
 
@@ -143,7 +148,7 @@ def _fp_gain(kind, thesis_pct):
     def test(acc, metric):
         m, n = acc("MSK FP", metric, (kind,)), acc("NMSK FP", metric, (kind,))
         g = 100 * (1 - n / m)
-        return g > 0, f"MSK {_fmt(m)}, NMSK {_fmt(n)}: NMSK lower by {g:.0f} % (thesis {thesis_pct:.0f} %)"
+        return g > 0, f"MSK {_fmt(m)}, NMSK {_fmt(n)}: NMSK {_by(g, 'lower', 'higher')} (thesis {thesis_pct:.0f} % lower)"
     return (_fp_gain_claim(kind), "6.2.4, 6.3", "NMSK FP score < MSK FP's",
             ["MSK FP", "NMSK FP"], test)
 
@@ -189,8 +194,8 @@ def _claims(ch5_nmsk: str | None) -> list:
     if ch5_nmsk is not None:
         def fp_vs_ch5(acc, metric):
             f, c5 = acc("NMSK FP", metric, ("excitation",)), acc(ch5_nmsk, metric, ("excitation",))
-            return f < c5, (f"FP {_fmt(f)}, Ch 5 {_fmt(c5)}: FP lower by {100 * (1 - f / c5):.0f} % "
-                            f"(thesis {pr.THESIS_FP_EXCITATION_GAIN_PCT:.0f} %)")
+            return f < c5, (f"FP {_fmt(f)}, Ch 5 {_fmt(c5)}: FP {_by(100 * (1 - f / c5), 'lower', 'higher')} "
+                            f"(thesis {pr.THESIS_FP_EXCITATION_GAIN_PCT:.0f} % lower)")
         exc_claims.append((_FP_CH5_CLAIM, "6.2.4, 6.3",
                            "FP excitation score < Ch 5 NMSK's", ["NMSK FP", ch5_nmsk], fp_vs_ch5))
     return [(*c, METRICS) for c in acc_claims] + [(*c, EXC_METRICS) for c in exc_claims]
@@ -226,8 +231,8 @@ def _time_claims(times: dict, acc: _Acc) -> list[dict]:
     else:
         g = 100 * (1 - times["NMSK FP"] / times["MSK FP"])
         verdict = "holds" if g > 0 else "does not hold"
-        ours = (f"MSK {times['MSK FP']:.0f} s, NMSK {times['NMSK FP']:.0f} s: NMSK faster by {g:.0f} % "
-                f"(thesis {100 * (1 - th['NMSK']['FP'] / th['MSK']['FP']):.0f} %)")
+        ours = (f"MSK {times['MSK FP']:.0f} s, NMSK {times['NMSK FP']:.0f} s: NMSK {_by(g, 'faster', 'slower')} "
+                f"(thesis {100 * (1 - th['NMSK']['FP'] / th['MSK']['FP']):.0f} % faster)")
     rows.append({"claim": _TIME_FP_CLAIM, "thesis": "6.2.4, 6.3", "test": "solve time NMSK FP < MSK FP",
                  "runs": "MSK FP, NMSK FP", "numeric": True,
                  "ours": ours, "verdict": verdict})
