@@ -713,6 +713,7 @@ def _ch6_claims(bases: dict, runs: dict, valid: dict, free, reruns: dict) -> lis
     table_t = (ch6_claims.conclusions({**usable, **timed}, free, ch5_nmsk=n5, notes=notes).set_index("claim")
                if timed else None)
     fp_where = _anchor("ch06_costfun", "FP with the gait's phase timing")
+    act_cause = _ch6_activation_cause(bases, runs)
     rows = []
     for _, r in table[~table["numeric"].astype(bool)].iterrows():
         # a decided claim is computed from the usable runs alone; an untested one names all
@@ -727,12 +728,33 @@ def _ch6_claims(bases: dict, runs: dict, valid: dict, free, reruns: dict) -> lis
                 t = table_t.loc[r["claim"]]
                 cause += (f"; with the gait's phase timing (FP, our reading): {t['verdict']} "
                           f"({t['RMSE' if exc else 'NRMSE']}) [{fp_where}]")
+        model_pair = r["claim"].split(":")[0] in pr.CH6_COSTS and ("MSK" in r["claim"] and "NMSK" in r["claim"])
+        if cause == "unknown" and model_pair and act_cause:
+            cause = act_cause
         if r["depends on metric"]:
             cause = f"depends on the metric: {other} says {r[f'{other}: verdict']} ({r[other]}) [{where}]"
         rows.append(Row(6, f"{r['claim']} (Sec {r['thesis']})", "holds", ours, "", cause,
                         f"Ch 6 {', '.join(names)}", _joint({n: valid.get(n, "") for n in names}),
                         holds=None if r["verdict"] == "not tested" else r[f"{metric}: verdict"] == "holds"))
     return rows
+
+
+def _ch6_activation_cause(bases: dict, runs: dict) -> str:
+    """The activation experiment of Ch 6 (:func:`gaitlib.studies.predictive.activation_study`:
+    NMSK DT with its activation parameters identified instead of Table 5.10's), as a cause of
+    the NMSK-vs-MSK accuracy rows; empty when it is not stored or a run is not usable."""
+    m, n = runs.get("MSK DT"), runs.get("NMSK DT")
+    if m is None or n is None or bases.get("NMSK") is None:
+        return ""
+    a = _runs({"NMSK": bases["NMSK"]}, "ch6", "book", free_activation=True).get("NMSK DT")
+    if a is None or _blocked(gate(a, "NMSK DT")):
+        return ""
+    free = data_mod.load_gait_data("Free")
+    nr = {k: float(pr.mean_nrmse(pr.score(v, free).assign(model="x", case="y")).iloc[0]) for k, v in
+          (("MSK", m), ("NMSK", n), ("identified", a))}
+    where = _anchor("ch06_costfun", "A measured cause: the NMSK runs' activation parameters")
+    return (f"the NMSK runs use Table 5.10's activation parameters: NMSK DT mean NRMSE {nr['NMSK']:.3f} with them, "
+            f"{nr['identified']:.3f} with them identified on our data (MSK DT {nr['MSK']:.3f}) — measured on DT [{where}]")
 
 
 def _time_ratio_row(chapter: int, item: str, th: dict, runs: dict, names, solution: str, valid: dict) -> Row:
