@@ -275,7 +275,8 @@ def test_ch6_findings_verdicts():
     # SDT3 0.27 ≤ 1.1 × 0.25 = 0.275: holds
     assert f[4] == "- Thesis claim *SDT3 (Trq + Ang) is enough for NMSK*: NMSK SDT3 mean NRMSE 0.270 vs DT 0.250 — " \
                    "holds (within 10 %)."
-    assert f[5].startswith("- Excitation RMSE vs EMG (mean over mapped muscles, converged NMSK runs): best FP 0.300, "
+    assert f[5].startswith("- Excitation RMSE vs EMG (mean over mapped muscles, converged and valid NMSK runs): best FP "
+                           "0.300, "
                            "worst DT 0.500; FP 0.300 vs DT 0.500 (thesis: FP 12 % better than DT).")
 
 

@@ -43,6 +43,7 @@ from ..problems import gait as gait_ocp
 from . import gait as sg
 from . import msk
 from .. import marks
+from .. import validity
 from ..marks import failure_label
 
 __all__ = ["CH6_COSTS", "CH7_CLASSES", "THESIS_CLASS", "THESIS_HOURS_TABLE_6_3", "THESIS_HOURS_TABLE_7_2",
@@ -130,7 +131,6 @@ def fp_timed_study(models=("MSK", "NMSK"), **kw) -> StudyResult:
     book's FP has no swing bound (:func:`reading_fields`) and can end as a shuffle with both
     feet loaded; this experiment gives it the gait's phase timing — two event times and the
     left leg's shift, no data curve — and nothing else (:func:`variant_study`)."""
-    from .. import validity
     return variant_study(models, ("FP",), swing_load_max=validity.swing_bound(), **kw)
 
 
