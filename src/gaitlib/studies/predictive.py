@@ -11,7 +11,8 @@ problems. As in the thesis:
   (:func:`thesis_guess`); NMSK excitations would start from the EMG where the data have
   the muscle (``excitation_guess="emg"``, Sec 5.3.4). **Departure:** the NMSK runs start
   from the whole Ch 5 NMSK solution (:data:`GUESS_POLICY`, :func:`run_guess`), because
-  from the thesis's partial guess 7 of the 12 stopped at the iteration limit;
+  from the thesis's partial guess several stop at the iteration limit (the chapters show
+  those runs' statuses);
 - no parameter is identified (contact, MTG and activation parameters fixed).
 
 Ch 7 (thesis Sec 7.1) — semi-predictive slow and fast gaits: the DT cost function (Table
@@ -175,8 +176,8 @@ def default_params() -> dict:
 #: How the runs of each model are started (see :func:`run_guess`): ``"thesis"`` — the
 #: thesis's partial guess of Sec 6.1 (:func:`thesis_guess`); ``"ch5"`` — the whole Ch 5
 #: solution (every state and control, time-scaled for Ch 7). MSK runs use the thesis's guess.
-#: NMSK runs use ``"ch5"``: from the thesis's partial guess, most NMSK runs at the full mesh
-#: stopped at IPOPT's 1000-iteration limit (environment.md, "Measured choices") — the
+#: NMSK runs use ``"ch5"``: from the thesis's partial guess, several NMSK runs at the full
+#: mesh stop at IPOPT's 1000-iteration limit (environment.md, "Measured choices") — the
 #: chapters show those statuses beside the runs they report.
 GUESS_POLICY = {"MSK": "thesis", "NMSK": "ch5"}
 GUESSES = ("thesis", "ch5")
