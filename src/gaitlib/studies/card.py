@@ -17,7 +17,8 @@ stored gives a "not comparable" row) and returns a DataFrame with the columns :d
               ``"not converged (…)"`` and/or ``"invalid: …"``
 ``gap``       tracking rows (Ch 5): the located gap of that channel (:func:`gaitlib.gap.locate`,
               Ch 8's first step) — its RMS z against the data's SD, whether it is significant,
-              and its largest gait phase; empty elsewhere
+              and its largest gait phase — and the diagnosis's verdict on that solution where
+              one was run (NMSK: Ch 8's muscle-level attribution); empty elsewhere
 
 Verdict rule (:func:`verdict`)
 ------------------------------
@@ -66,6 +67,7 @@ from . import ch6_claims
 from .. import marks as marks_mod
 from ..gap import io as gap_io
 from ..gap import locate as gap_locate
+from . import gap as gap_study
 
 __all__ = ["COLUMNS", "VERDICTS", "REL_TOL", "ABS_TOL", "RULE", "verdict", "Row", "StoredGait", "stored_gait",
            "gate", "build", "counts", "write", "PHYSIOLOGICAL_JUMP_RISE_M"]
@@ -399,6 +401,7 @@ def _ch5(bases: dict) -> list[Row]:
     floor = _floor_causes()
     ch5abl = {"MSK": _ch5_ablation_causes("MSK")}
     gaps = {m: _located_gaps(s) for m, s in bases.items() if s is not None}
+    verdicts = {"NMSK": _nmsk_diagnosis_text(), "MSK": "no diagnosis run on this solution"}
     for model, table in (("MSK", "Table 5.4"), ("NMSK", "Table 5.11")):
         s = bases.get(model)
         valid = gate(s, model) if s is not None else ""
@@ -420,7 +423,8 @@ def _ch5(bases: dict) -> list[Row]:
             rows.append(Row(5, f"{model} RMSE {kind} {part} {side.upper()} ({table})", tv, ours, unit,
                             cause or "unknown",
                             s.name if s is not None else "", valid, sd=sd,
-                            gap=gaps.get(model, {}).get(f"{kind}:{'grf_' if kind == 'grf' else ''}{part}_{side}", "")))
+                            gap=_gap_text(gaps.get(model, {}).get(f"{kind}:{'grf_' if kind == 'grf' else ''}{part}_{side}", ""),
+                                          verdicts.get(model, ""))))
     # Table 5.10 and COT: the NMSK solution
     s = bases.get("NMSK")
     valid = gate(s, "NMSK") if s is not None else ""
@@ -500,6 +504,24 @@ def _ablation_causes(model: str = "MSK") -> dict:
         out[(kind, part, side)] = (f"tracking ablation: lowest {r[r['best change']]:.1f} {unit} "
                                    f"({r['best change']}), target {r['target']:.1f} {unit} met by: {r['met by']} [{where}]")
     return out
+
+
+def _gap_text(located: str, verdict: str) -> str:
+    return f"{located}; {verdict}" if located and verdict else located
+
+
+def _nmsk_diagnosis_text() -> str:
+    """The diagnosis of the book's Ch 5 NMSK solution (Ch 8 section 5: muscle-level
+    candidates, :func:`gaitlib.studies.gap.nmsk_attribution`): its verdict and top effect;
+    says so when it is not stored."""
+    try:
+        with cache.only("the card reads stored solutions only"):
+            d = gap_study.nmsk_attribution(reading="book", resamples=0)
+    except cache.NotCached:
+        return "diagnosis not stored"
+    where = _anchor("ch08_gap", "5. Does co-contraction close the TA/GAM gap? (thesis Sec 5.3.5)")
+    return (f"diagnosis (co-contraction, joint stiffness, activation timing on this solution): {d.verdict}"
+            + (f", top {d.top_effect}" if d.top_effect != "unexplained" else "") + f" [{where}]")
 
 
 def _located_gaps(sol) -> dict:
