@@ -332,7 +332,7 @@ def usable(res: pr.StudyResult, reruns: dict | None = None) -> tuple[dict, dict,
 def summary(table: pd.DataFrame) -> str:
     """One sentence: how many claims hold, do not hold, depend on the metric, are not tested."""
     n = table["verdict"].value_counts().reindex(list(VERDICTS), fill_value=0)
-    return (f"Of the thesis's {len(table)} Ch 6 claims tested here: {n['holds']} hold, {n['does not hold']} do not, "
+    return (f"Of the thesis's {len(table)} Ch 6 claims tested here: {n['holds']} hold{'s' if n['holds'] == 1 else ''}, {n['does not hold']} do{'es' if n['does not hold'] == 1 else ''} not, "
             f"{n['depends on the metric']} depend{'s' if n['depends on the metric'] == 1 else ''} on the metric (NRMSE "
             f"vs SD units), {n['not tested']} {'is' if n['not tested'] == 1 else 'are'} not "
             "tested (a run they need did not converge or fails a validity gate).")
