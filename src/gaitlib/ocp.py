@@ -44,6 +44,7 @@ from __future__ import annotations
 import inspect
 import json
 import math
+import os
 import time
 import warnings
 from collections.abc import Callable, Mapping, Sequence
@@ -57,6 +58,7 @@ import numpy as np
 import pandas as pd
 import scipy.sparse as sp
 
+from gaitlib import compiled
 from gaitlib.collocation import Mesh
 
 __all__ = [
@@ -390,6 +392,16 @@ class Problem:
 #: re-solving the store (tools/store_solutions.py) for a from-scratch run to reproduce it.
 DEFAULT_DERIVATIVES = "graph"
 
+#: ``GAITLIB_COMPILE=1``: the default of :attr:`SolverOptions.compiled` (an environment
+#: variable, so sweep workers inherit it; the CLI's ``--compiled`` sets it). It changes how
+#: fast the per-node functions are evaluated, not what they compute (the same bits), so it is
+#: no part of any cache key.
+COMPILE_ENV = "GAITLIB_COMPILE"
+
+
+def _default_compiled() -> bool:
+    return os.environ.get(COMPILE_ENV, "0") not in ("", "0")
+
 
 @dataclass(frozen=True)
 class SolverOptions:
@@ -427,6 +439,14 @@ class SolverOptions:
         round-off (tests/test_node_derivatives.py), built in a fraction of the time
         (benchmarks/bench_build.py). IPOPT's path can still differ at round-off level, and
         on the non-convex gait problems that can mean another local optimum.
+    compiled : bool
+        With ``derivatives="nodes"``: evaluate the per-node functions (values, Jacobians,
+        Hessians) as compiled C (:func:`gaitlib.compiled.compiled`, cached on disk: the first
+        use on a machine compiles, later ones load). The same operations in the same order
+        as CasADi's SX virtual machine, compiled without fast-math or FMA contraction: the
+        same numbers to the last bit, so IPOPT takes the same path
+        (tests/test_compiled.py). Ignored with ``derivatives="graph"`` (one whole-NLP graph
+        is too large to compile).
     ipopt : mapping
         Further IPOPT options, applied last (e.g. ``{"nlp_scaling_method": "none"}``).
 
@@ -444,6 +464,7 @@ class SolverOptions:
     graph: str = "sx"
     expand: bool = True
     derivatives: str = field(default_factory=lambda: DEFAULT_DERIVATIVES)
+    compiled: bool = field(default_factory=_default_compiled)
     ipopt: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self):
@@ -845,6 +866,18 @@ class _PhaseLayout:
         self.t0_bounds, self.tf_bounds = t0, tf
 
 
+class _Lazy(dict):
+    """A dict whose missing entries are made by ``make(key)`` when first looked up."""
+
+    def __init__(self, make):
+        super().__init__()
+        self._make = make
+
+    def __missing__(self, key):
+        self[key] = value = self._make(key)
+        return value
+
+
 @dataclass
 class _NodePhase:
     """One phase's per-node functions for :meth:`Transcription._node_derivatives`: the
@@ -1119,6 +1152,7 @@ class Transcription:
         Terms whose pattern is empty are left out (for fixed phase times every term but the
         last and g_Y·J is zero)."""
         S = ca.SX
+        native = compiled.compiled if self.options.compiled else (lambda fun, reverse=False: fun)
         w_sx, p_sx = self.w, self.nlp["p"]
         W, Pm = ca.MX.sym("x", self._n_w), ca.MX.sym("p", p_sx.shape[0])
         sig, lam = ca.MX.sym("lam_f"), ca.MX.sym("lam_g", self.n_constraints)
@@ -1134,15 +1168,19 @@ class Transcription:
             n_fg = node.size1_out(0) + node.size1_out(1)
             nd = _NodePhase(nc=nc, nz=z.numel(), ny=y.numel(), y_off=y_off, z_off=z_off,
                             inputs=ca.Function(f"{ph.name}_node_inputs", [w_sx, p_sx], [Xc, U, P, Tc, D]),
-                            hess=ca.Function(f"{ph.name}_node_hess", [x, u, p, t, d, m],
-                                             [ca.hessian(ca.dot(m, y), z)[0]]).map(nc))
+                            hess=native(ca.Function(f"{ph.name}_node_hess", [x, u, p, t, d, m],
+                                                    [ca.hessian(ca.dot(m, y), z)[0]])).map(nc))
             # the constraints' rows (ẋ, path) and the objective's (integrands) separately, so
             # that IPOPT's f and g (and their derivatives) evaluate only what each uses
-            for part, rows_ in (("all", slice(0, nd.ny)), ("fg", slice(0, n_fg)), ("l", slice(n_fg, nd.ny))):
-                nd.rows[part] = rows_
-                nd.values[part] = ca.Function(f"{ph.name}_node_{part}", [x, u, p, t, d], [y[rows_]]).map(nc)
-                nd.jacobians[part] = ca.Function(f"{ph.name}_node_jac_{part}", [x, u, p, t, d],
-                                                 [y[rows_], ca.jacobian(y[rows_], z)]).map(nc)
+            nd.rows.update({"all": slice(0, nd.ny), "fg": slice(0, n_fg), "l": slice(n_fg, nd.ny)})
+            # made when first used (a compiled function is compiled only if the NLP uses it);
+            # nlpsol differentiates f and g once at set-up (its nlp_grad), so the values
+            # carry their reverse derivative
+            nd.values = _Lazy(lambda part, ph=ph, y=y, nd=nd, args=(x, u, p, t, d): native(
+                ca.Function(f"{ph.name}_node_{part}", list(args), [y[nd.rows[part]]]), reverse=True).map(nd.nc))
+            nd.jacobians = _Lazy(lambda part, ph=ph, y=y, z=z, nd=nd, args=(x, u, p, t, d): native(
+                ca.Function(f"{ph.name}_node_jac_{part}", list(args),
+                            [y[nd.rows[part]], ca.jacobian(y[nd.rows[part]], z)])).map(nd.nc))
             Zw = ca.jacobian(ca.vec(ca.vertcat(Xc, U, ca.repmat(P, 1, nc), Tc)), w_sx)
             if ca.depends_on(Zw, ca.vertcat(w_sx, p_sx)):
                 raise AssertionError(f"phase {ph.name!r}: node inputs are not affine in the variables")
@@ -1517,6 +1555,7 @@ class Transcription:
             "options": {k: v for k, v in self.options.nlpsol_options()["ipopt"].items()},
             "graph": self.options.graph,
             "derivatives": "nodes" if self._by_nodes else "graph",
+            "compiled": bool(self._by_nodes and self.options.compiled),
             "symbolic_time": self.symbolic_time,
             "ipopt_t_wall": {k: float(v) for k, v in stats.items()
                              if k.startswith("t_wall_") and isinstance(v, (int, float))},

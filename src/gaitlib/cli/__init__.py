@@ -50,11 +50,16 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import sys
 from pathlib import Path
 
 from .. import blas
 from .common import EXIT_FAILED, CLIError, Output, _add_output_options, _int_options, _Parser, check_cache, int_at_least
+
+#: gaitlib.ocp.COMPILE_ENV (tests/test_compiled.py checks they agree)
+COMPILE_ENV = "GAITLIB_COMPILE"
+
 
 def _listed_files(summary: Path) -> set:
     """The ``files`` a previous run's ``summary.json`` lists (none if unreadable)."""
@@ -284,6 +289,11 @@ def _expected() -> tuple:
 def main(argv: list[str] | None = None) -> int:
     blas.pin()  # the Makefile's BLAS settings unless set; numpy is not imported yet
     args = build_parser().parse_args(argv)
+    if getattr(args, "compiled", False):
+        if args.derivatives != "nodes":  # the whole-graph derivatives are too large to compile
+            print(f"gaitlib {args.command}: --compiled needs --derivatives nodes", file=sys.stderr)
+            return EXIT_FAILED
+        os.environ[COMPILE_ENV] = "1"  # the environment, so sweep workers inherit it
     if args.debug:
         return args.func(args)
     try:
