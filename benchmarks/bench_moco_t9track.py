@@ -10,7 +10,12 @@ first use, then for each scheme runs, each in its own process with one BLAS thre
 1. Moco (``moco/moco_side.py`` with the Moco venv's python), as MocoTrack configures it;
 2. gaitlib (``t9track.py``), the benchmark configuration (μ_init = 1e-3);
 3. gaitlib with IPOPT's default options (μ_init = 0.1), for reference;
-4. gaitlib with an unexpanded MX graph (builds in a fraction of a second, evaluates slower).
+4. gaitlib with per-node derivatives (``--derivatives nodes``), and the same with the
+   per-node functions compiled to C (``--compiled``, :mod:`gaitlib.compiled`: the same
+   numbers, so the same iterations). The libraries are compiled once per machine: a first,
+   untimed run of the compiled variant per scheme compiles them (its setup time, compile
+   included, is recorded as ``compile_first_use_setup_s``), so the timed repeats load them;
+5. gaitlib with an unexpanded MX graph (builds in a fraction of a second, evaluates slower).
 
 It prints one table (setup time, solve time, iterations, time per iteration, objective,
 max constraint violation, RMS per coordinate), writes ``results/moco_t9track.json`` and
@@ -131,6 +136,12 @@ def main(argv=None):
     load_start = os.getloadavg()
     _, spline = t9.reference()
 
+    first_use = {}
+    for scheme in args.schemes:  # compile the per-node functions once (not a timed repeat)
+        stem = f"gaitlib_{scheme}_nodes_compiled"
+        run([sys.executable, str(HERE / "t9track.py"), "--scheme", scheme, "--derivatives", "nodes",
+             "--compiled", "--out", str(RAW)], "gaitlib (per-node derivatives, compiled): first use, compiles")
+        first_use[scheme] = json.loads((RAW / f"{stem}.json").read_text())["setup_time"]
     runs = []
     for rep in range(args.repeats):
         for scheme in args.schemes:
@@ -148,6 +159,10 @@ def main(argv=None):
                              [sys.executable, str(HERE / "t9track.py"), "--scheme", scheme,
                               "--derivatives", "nodes", "--out", str(RAW)],
                              f"gaitlib_{scheme}_nodes"))
+            variants.append(("gaitlib (per-node derivatives, compiled)",
+                             [sys.executable, str(HERE / "t9track.py"), "--scheme", scheme,
+                              "--derivatives", "nodes", "--compiled", "--out", str(RAW)],
+                             f"gaitlib_{scheme}_nodes_compiled"))
             if not args.no_mx_variant:
                 variants.append(("gaitlib (MX, not expanded)",
                                  [sys.executable, str(HERE / "t9track.py"), "--scheme", scheme,
@@ -194,7 +209,8 @@ def main(argv=None):
 
     # ------------------------------------------------------------------ summary
     tools = ["moco", "gaitlib"] + ([] if args.no_defaults_variant else
-                                   ["gaitlib (IPOPT defaults)"]) + ["gaitlib (per-node derivatives)"] + (
+                                   ["gaitlib (IPOPT defaults)"]) + ["gaitlib (per-node derivatives)",
+                                                                     "gaitlib (per-node derivatives, compiled)"] + (
         [] if args.no_mx_variant else ["gaitlib (MX, not expanded)"])
     speedups, lines = {}, []
     head = ("| scheme | tool | rep | status | setup s | solve s | it | ms/it | objective | "
@@ -222,6 +238,7 @@ def main(argv=None):
                             "all_succeeded": ok}
         for tool, key in (("gaitlib (IPOPT defaults)", "speedup_ipopt_defaults"),
                           ("gaitlib (per-node derivatives)", "speedup_nodes"),
+                          ("gaitlib (per-node derivatives, compiled)", "speedup_nodes_compiled"),
                           ("gaitlib (MX, not expanded)", "speedup_mx_noexpand")):
             if tool in med:
                 speedups[scheme][key] = med["moco"] / med[tool]
@@ -244,6 +261,7 @@ def main(argv=None):
             "opensim": next((r["raw"].get("opensim_version") for r in runs
                              if r["tool"] == "moco"), None),
             "load_average_start": load_start, "load_average_end": os.getloadavg(),
+            "compile_first_use_setup_s": first_use,
             "note": "other processes may share this 2-core machine: absolute times can be "
                     "inflated; ratios are measured within one run",
             "units": {"time": "s", "rms": "rad (angles), m (pelvis_tx, pelvis_ty)",
@@ -275,6 +293,8 @@ def main(argv=None):
                      if "speedup_ipopt_defaults" in s else "")
                   + (f"; gaitlib with per-node derivatives {s['speedup_nodes']:.1f}×"
                      if "speedup_nodes" in s else "")
+                  + (f"; gaitlib with per-node derivatives, compiled {s['speedup_nodes_compiled']:.1f}×"
+                     if "speedup_nodes_compiled" in s else "")
                   + (f"; gaitlib MX not expanded {s['speedup_mx_noexpand']:.1f}×"
                      if "speedup_mx_noexpand" in s else "")
                   + "; setup + solve: " + ", ".join(

@@ -280,7 +280,8 @@ def run(args) -> dict:
     tag = args.tag or (args.scheme + ("" if args.dynamics == "explicit" else "_implicit")
                        + ("_ipoptdefaults" if args.ipopt_defaults else "")
                        + ("" if args.graph == "sx" else "_" + args.graph)
-                       + ("_nodes" if args.graph == "sx" and args.derivatives == "nodes" else ""))
+                       + ("_nodes" if args.graph == "sx" and args.derivatives == "nodes" else "")
+                       + ("_compiled" if args.compiled else ""))
     log_path = out / f"gaitlib_{tag}_ipopt.log"
     t0 = time.perf_counter()
     problem, mesh, guess, model, (filt, spline) = build(
@@ -294,7 +295,7 @@ def run(args) -> dict:
     opts = ipopt_options(args.tol, args.max_iter, extra)
     if args.graph == "mx-noexpand":
         opts = dataclasses.replace(opts, graph="mx", expand=False)
-    opts = dataclasses.replace(opts, derivatives=args.derivatives)
+    opts = dataclasses.replace(opts, derivatives=args.derivatives, compiled=args.compiled)
     tr = ocp.transcribe(problem, mesh, opts)
     setup_time = time.perf_counter() - t0
     w0 = tr.initial_point(guess)
@@ -390,6 +391,9 @@ def main(argv=None):
     ap.add_argument("--derivatives", choices=("graph", "nodes"), default=ocp.DEFAULT_DERIVATIVES,
                     help="with --graph sx: CasADi's derivatives of the whole NLP graph, or per-node "
                          "derivative functions assembled by the chain rule (fast to build)")
+    ap.add_argument("--compiled", action="store_true",
+                    help="with --derivatives nodes: per-node functions as compiled C (gaitlib.compiled; "
+                         "the same numbers as the SX virtual machine)")
     ap.add_argument("--tag", default=None, help="output file stem (default from options)")
     ap.add_argument("--out", default=str(HERE / "results" / "moco_raw"))
     args = ap.parse_args(argv)
