@@ -187,3 +187,26 @@ def test_scaling_figure_draws_every_model(tmp_path):
     fig = perf.scaling_figure(_scaling())
     labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
     assert "SK: b = 0.93" in labels and "MSK: b = 1.50" in labels and "linear (b = 1)" in labels
+
+
+def test_e2e_findings_against_the_targets_and_the_same_iterates():
+    def row(variant, e2e, build, solve, its, evals, objective=0.1094):
+        return {"variant": variant, "status": "Solve_Succeeded", "iterations": its, "e2e_s": e2e, "build_s": build,
+                "solve_s": solve, "ms_per_iteration": 1e3 * solve / its, "evals_s": evals,
+                "ipopt_rest_s": solve - evals, "objective": objective}
+
+    res = {"gait": [row("graph", 89.0, 30.0, 55.0, 340, 27.0, 0.1067), row("nodes", 63.0, 1.0, 59.0, 467, 30.5),
+                    row("nodes, compiled (first use)", 95.0, 55.0, 36.0, 467, 7.0),
+                    row("nodes, compiled", 40.0, 1.3, 36.0, 467, 7.0)],
+           "gap": [{"variant": "graph", "status": "ok", "verdict": "knee_offset", "e2e_s": 150.0},
+                   {"variant": "nodes, compiled", "status": "ok", "verdict": "knee_offset", "e2e_s": 50.0}]}
+    msk, comp, first, rest, gap = perf.e2e_findings(res)
+    assert "Fastest: nodes, compiled, 40 s against the target of 20 s — not met (2.0× over)." in msk
+    # evaluations 30.5 → 7.0 s = 4.4×; the same iterations and objective
+    assert "from 30.5 to 7.0 s (4.4×) and the solve from 59.0 to 36.0 s; the same iterations" in comp
+    assert first.startswith("• The first use on a machine compiles: build 55 s instead of 1.3 s")
+    # IPOPT's own 29.0 s of 36.0 s = 62 ms per iteration; 20 s at 77.1 ms per iteration = 259 iterations
+    assert "29.0 of 36.0 s (62 ms per iteration" in rest and "allows 259 iterations; this path took 467" in rest
+    assert gap.endswith("Fastest 50 s against the target of 60 s — met.")
+    res["gait"][3]["objective"] = 0.2
+    assert "the iterates differ" in perf.e2e_findings(res)[1]

@@ -203,9 +203,9 @@ def linear_solver_table(res: dict | None = None) -> tuple[pd.DataFrame, pd.DataF
 
 def moco_table(res: dict | None = None) -> pd.DataFrame:
     """T9-track, gaitlib vs OpenSim Moco: per scheme the medians of solve time and the
-    speed-up (Moco / gaitlib), also with IPOPT's default options, and end to end (setup +
-    solve; the per-node-derivatives variant and the speed-up against the fastest gaitlib
-    variant that converged in every repeat)."""
+    speed-up (Moco / gaitlib), also with IPOPT's default options, with per-node derivatives
+    compiled, and against the fastest gaitlib variant that converged in every repeat; end to
+    end (setup + solve) likewise. Columns of variants a results file lacks are NaN."""
     res = load("moco_t9track") if res is None else res
     rows = []
     for scheme, s in res["speedups"].items():
@@ -213,10 +213,14 @@ def moco_table(res: dict | None = None) -> pd.DataFrame:
         rows.append({"scheme": scheme, "Moco solve (s)": s["moco_solve_median"],
                      "gaitlib solve (s)": s["gaitlib_solve_median"], "speed-up": s["speedup"],
                      "speed-up, gaitlib with IPOPT defaults": s.get("speedup_ipopt_defaults", np.nan),
+                     "speed-up, gaitlib per-node compiled": s.get("speedup_nodes_compiled", np.nan),
+                     "speed-up, solve (best converged gaitlib variant)": s.get("speedup_best", {}).get("speedup", np.nan),
                      "Moco setup + solve (s)": e2e.get("moco", np.nan),
                      "gaitlib setup + solve (s)": e2e.get("gaitlib", np.nan),
                      "gaitlib per-node derivatives, setup + solve (s)":
                          e2e.get("gaitlib (per-node derivatives)", np.nan),
+                     "gaitlib per-node compiled, setup + solve (s)":
+                         e2e.get("gaitlib (per-node derivatives, compiled)", np.nan),
                      "speed-up, setup + solve (best converged gaitlib variant)":
                          s.get("speedup_e2e", {}).get("speedup", np.nan),
                      "all converged": s.get("all_succeeded")})
@@ -263,6 +267,72 @@ def build_findings(res: dict) -> list[str]:
                      f"{b.iterations} iterations ({a.status} / {b.status}, objectives {a.objective:.4g} vs "
                      f"{b.objective:.4g}): build + solve {a.e2e_s:.0f} s vs {b.e2e_s:.0f} s")
         out.append(line + ".")
+    return out
+
+
+#: Issue 22's end-to-end targets (s, this 2-core machine): ``gaitlib run gait --model MSK --cost
+#: DT --speed Free`` (20 × 5) from an empty cache, build included; ``gaitlib gap`` on a new CSV at
+#: its default mesh.
+E2E_TARGETS = {"gait": 20.0, "gap": 60.0}
+
+
+def e2e_tables(res: dict) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """``bench_e2e.py``: (the MSK DT Free command, ``gaitlib gap`` on a new CSV), one row per
+    derivative path (graph; nodes; nodes compiled, first use and with the libraries cached):
+    process wall time from an empty solution cache beside build, solve, iterations, ms per
+    iteration and the split of the IPOPT call (evaluations / IPOPT's own work)."""
+    cols = {"variant": "variant", "status": "status", "iterations": "iterations", "e2e_s": "end to end (s)",
+            "build_s": "build (s)", "solve_s": "solve (s)", "ms_per_iteration": "ms / iteration",
+            "evals_s": "evaluations (s)", "ipopt_rest_s": "IPOPT rest (s)", "objective": "objective",
+            "same_as_nodes": "same iterates as nodes", "verdict": "verdict", "solves": "solves",
+            "load_at_start": "load at start"}
+    out = []
+    for key in ("gait", "gap"):
+        df = pd.DataFrame(res.get(key, []))
+        out.append(df[[c for c in cols if c in df.columns]].rename(columns=cols) if len(df) else df)
+    return out[0], out[1]
+
+
+def e2e_findings(res: dict) -> list[str]:
+    """What ``bench_e2e.py`` measured, in sentences computed from its rows: each path's end
+    to end time against :data:`E2E_TARGETS`, what compiling changed (and whether the
+    iterates stayed the same), and where the remaining time goes."""
+    out = []
+    rows = {r["variant"]: r for r in res.get("gait", []) if "iterations" in r}
+    tgt = E2E_TARGETS["gait"]
+    if rows:
+        best = min(rows.values(), key=lambda r: r["e2e_s"])
+        out.append(f"• MSK DT Free, 20 × 5, from an empty cache: "
+                   + "; ".join(f"{name} {r['e2e_s']:.0f} s ({r['iterations']} iterations, {r['ms_per_iteration']:.0f} ms "
+                               f"each)" for name, r in rows.items())
+                   + f". Fastest: {best['variant']}, {best['e2e_s']:.0f} s against the target of {tgt:.0f} s — "
+                   + ("met." if best["e2e_s"] <= tgt else f"not met ({best['e2e_s'] / tgt:.1f}× over)."))
+        nodes, comp = rows.get("nodes"), rows.get("nodes, compiled")
+        first = rows.get("nodes, compiled (first use)")
+        if nodes and comp:
+            same = comp["iterations"] == nodes["iterations"] and comp["objective"] == nodes["objective"]
+            out.append(f"• Compiling the per-node functions cut the evaluations from {nodes['evals_s']:.1f} to "
+                       f"{comp['evals_s']:.1f} s ({nodes['evals_s'] / comp['evals_s']:.1f}×) and the solve from "
+                       f"{nodes['solve_s']:.1f} to {comp['solve_s']:.1f} s; "
+                       + ("the same iterations and the same objective to the last digit (the same numbers)."
+                          if same else "the iterates differ (not the same numbers: a defect to investigate)."))
+            if first:
+                out.append(f"• The first use on a machine compiles: build {first['build_s']:.0f} s instead of "
+                           f"{comp['build_s']:.1f} s (end to end {first['e2e_s']:.0f} s); later processes load the "
+                           f"libraries.")
+            out.append(f"• What is left of the compiled solve is IPOPT's own work, {comp['ipopt_rest_s']:.1f} of "
+                       f"{comp['solve_s']:.1f} s ({1e3 * comp['ipopt_rest_s'] / max(comp['iterations'], 1):.0f} ms per "
+                       f"iteration, mostly MUMPS factorising the KKT matrix — more than once in an iteration that needs "
+                       f"an inertia correction). At that rate the {tgt:.0f}-s target allows "
+                       f"{tgt / (comp['ms_per_iteration'] / 1e3):.0f} iterations; this path took {comp['iterations']}.")
+    gap = [r for r in res.get("gap", []) if r.get("status") == "ok"]
+    if gap:
+        best = min(gap, key=lambda r: r["e2e_s"])
+        out.append("• `gaitlib gap` on a new CSV, default mesh: "
+                   + "; ".join(f"{r['variant']} {r['e2e_s']:.0f} s ({r.get('verdict', '?')})" for r in gap)
+                   + f". Fastest {best['e2e_s']:.0f} s against the target of {E2E_TARGETS['gap']:.0f} s — "
+                   + ("met." if best["e2e_s"] <= E2E_TARGETS["gap"] else
+                      f"not met ({best['e2e_s'] / E2E_TARGETS['gap']:.1f}× over)."))
     return out
 
 
