@@ -284,7 +284,8 @@ def e2e_tables(res: dict) -> tuple[pd.DataFrame, pd.DataFrame]:
     cols = {"variant": "variant", "status": "status", "iterations": "iterations", "e2e_s": "end to end (s)",
             "build_s": "build (s)", "solve_s": "solve (s)", "ms_per_iteration": "ms / iteration",
             "evals_s": "evaluations (s)", "ipopt_rest_s": "IPOPT rest (s)", "objective": "objective",
-            "same_as_nodes": "same iterates as nodes", "verdict": "verdict", "solves": "solves",
+            "same_as_nodes": "same iterates as nodes", "verdict": "verdict", "candidates": "candidates",
+            "baseline_iterations": "baseline iterations",
             "load_at_start": "load at start"}
     out = []
     for key in ("gait", "gap"):
