@@ -110,6 +110,30 @@ def test_each_ch5_ablation_change_is_one_change_on_the_book_reading_spec():
     assert {"coordinate weight ×4", "torque weight ×4", "GRF weight ×4"} <= set(fidelity.ch5_changes("MSK"))
 
 
+def test_nmsk_ch5_ablation_starts_each_change_from_the_msk_run_of_that_change(monkeypatch):
+    """As the book's NMSK solve starts from the book's MSK solution, each NMSK change starts
+    from the MSK ablation's solution with the same change."""
+    from gaitlib.problems import gait as gait_ocp
+    from gaitlib.studies import msk
+
+    seen = {}
+
+    def fake_solve_specs(specs, guesses=None, **kw):
+        model = next(iter(specs.values())).model
+        seen[model] = (dict(specs), guesses)
+        return {k: type("R", (), {"value": f"{model}:{k}"})() for k in specs}
+
+    monkeypatch.setattr(gait_ocp, "solve_specs", fake_solve_specs)
+    monkeypatch.setattr(msk, "solve", lambda model, **kw: f"{model}:base")
+    monkeypatch.setattr(fidelity, "ablation_row", lambda k, v: {"run": k, "solution": v})
+    table, sols = fidelity.ch5_ablation("NMSK")
+    assert seen["MSK"][1] is None  # MSK from the data
+    specs, guesses = seen["NMSK"]
+    assert set(guesses) == set(specs) == set(fidelity.ch5_changes("NMSK"))
+    assert all(g == f"MSK:{k}" for k, g in guesses.items())
+    assert sols[fidelity.CH5_BASE_ROW] == "NMSK:base"
+
+
 def _row(status="Solve_Succeeded", obj=0.3, gates="valid", angle=10.0, torque=12.0, grf=60.0, swing=4.0, ds=27.0):
     return {"status": status, "iterations": 300, "objective": obj, "swing load (N)": swing,
             "double support (%)": ds, "worst angle RMSE (deg)": angle, "worst torque RMSE (N·m)": torque,

@@ -399,7 +399,7 @@ def _ch5(bases: dict) -> list[Row]:
     ablation = {"MSK": _ablation_causes("MSK")}
     jerk = _jerk_causes("MSK")
     floor = _floor_causes()
-    ch5abl = {"MSK": _ch5_ablation_causes("MSK")}
+    ch5abl = {m: _ch5_ablation_causes(m) for m in ("MSK", "NMSK")}
     gaps = {m: _located_gaps(s) for m, s in bases.items() if s is not None}
     verdicts = {"NMSK": _nmsk_diagnosis_text(), "MSK": "no diagnosis run on this solution"}
     for model, table in (("MSK", "Table 5.4"), ("NMSK", "Table 5.11")):
@@ -412,7 +412,7 @@ def _ch5(bases: dict) -> list[Row]:
             unit = {"angle": "deg", "torque": "N*m", "grf": "N"}[kind]
             sd = _rms_sd(gait, col, 1 / cv.DEG if kind == "angle" else 1.0)
             ours = float(r.get((kind, ch), np.nan)) if r is not None else np.nan
-            # MSK: the Ch 5 ablation on the book's reading itself; angles: the geometric floor
+            # the Ch 5 ablation on the book's reading itself; angles: the geometric floor
             # (no dynamics); otherwise the Ch 2 measurements, made from the thesis's reading
             # and labelled so
             parts = [ch5abl.get(model, {}).get((kind, part, side)), floor.get((part, side)) if kind == "angle" else None]
@@ -538,6 +538,11 @@ def _located_gaps(sol) -> dict:
     return out
 
 
+#: The Ch 5 page's section of each model's ablation (the card links to it).
+CH5_ABLATION_HEADINGS = {"MSK": "Where the misfit comes from: one change at a time",
+                         "NMSK": "Where the NMSK misfit comes from: one change at a time"}
+
+
 def _ch5_ablation_causes(model: str = "MSK") -> dict:
     """(kind, part, side) → the Ch 5 ablation's answer for that channel (:func:`gaitlib.
     studies.fidelity.ch5_ablation`: one change at a time on the book's reading; the lowest
@@ -551,7 +556,7 @@ def _ch5_ablation_causes(model: str = "MSK") -> dict:
     ok = fidelity.usable_solutions(sols)
     if fidelity.CH5_BASE_ROW not in ok or len(ok) < 2:
         return {}
-    where = _anchor("ch05_msk", "Where the misfit comes from: one change at a time")
+    where = _anchor("ch05_msk", CH5_ABLATION_HEADINGS[model])
     out = {}
     for (kind, part, side, unit), r in fidelity.channel_table(ok, model).iterrows():
         out[(kind, part, side)] = (f"Ch 5 ablation (book's reading, {len(ok) - 1} usable changes): lowest "

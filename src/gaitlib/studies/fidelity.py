@@ -299,11 +299,17 @@ CH5_BASE_ROW = "Ch 5, book's reading"
 
 def ch5_ablation(model: str = "MSK", *, use_cache: bool = True, serial: bool = True) -> tuple[pd.DataFrame, dict]:
     """Each :func:`ch5_changes` entry applied alone to the Ch 5 problem in the book's reading
-    (the base row: the book's Ch 5 solution), every run solved from the data like the book's
-    Ch 5 solve. Returns (one :func:`ablation_row` per run, the solutions by row)."""
+    (the base row: the book's Ch 5 solution), every run started as the book's Ch 5 solve of
+    ``model`` starts (:func:`gaitlib.studies.msk.solve`): MSK from the data; NMSK from the MSK
+    solution of the same change (the MSK ablation's run, solved or reloaded first). Returns
+    (one :func:`ablation_row` per run, the solutions by row)."""
     base = msk.ch5_spec(model, reading="book")
     specs = {k: replace(base, **ch) for k, ch in ch5_changes(model).items()}
-    recs = gait_ocp.solve_specs(specs, use_cache=use_cache, serial=serial)
+    guesses = None
+    if model == "NMSK":
+        _, msk_sols = ch5_ablation("MSK", use_cache=use_cache, serial=serial)
+        guesses = {k: msk_sols[k] for k in specs}
+    recs = gait_ocp.solve_specs(specs, guesses=guesses, use_cache=use_cache, serial=serial)
     sols = {CH5_BASE_ROW: msk.solve(model, reading="book"), **{k: r.value for k, r in recs.items()}}
     return pd.DataFrame([ablation_row(k, v) for k, v in sols.items() if v is not None]).set_index("run"), sols
 
