@@ -35,7 +35,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from gaitlib import gap, marks
+from gaitlib import cache, gap, marks
 from gaitlib.gap import diagnose, locate, twin
 from gaitlib.gap import figures as gap_figures
 from gaitlib.studies import gap as gap_study
@@ -596,6 +596,29 @@ if len(best6):
 if len(ch7):
     print("Ch 7, against each class's own data: " + "; ".join(
         f"{r['model']} {r['case']}: RMS z {r['RMS z, angles/torques/GRFs']:.2f}" for _, r in ch7.iterrows()))
+
+# %% [markdown]
+# ## 6b. The library's candidates on the Ch 5 MSK solution
+#
+# The attribution of section 5, on the Ch 5 **MSK** solution in the book's reading, with every
+# effect of the library that applies to the MSK model (model effects and laboratory effects;
+# `gaitlib.studies.gap.ch5_attribution("MSK", reading="book")`): each candidate re-solved
+# with Eq 5.33 plus the effect, warm-started from the Ch 5 solution, on its 20 × 5 mesh.
+# The report card's MSK tracking rows carry this verdict.
+
+# %%
+try:
+    with cache.only("the MSK diagnosis is read from the store (gap_study.ch5_attribution('MSK') solves it)"):
+        dM = gap_study.ch5_attribution("MSK", reading="book")
+except cache.NotCached as e:
+    dM = None
+    print(f"Not stored yet: {e}")
+if dM is not None:
+    sM = gap_study.summary(dM)
+    print(f"Ch 5 MSK solution: {dM.baseline.stats['status']}, {dM.baseline.stats['iterations']} iterations; "
+          f"RSS = {sM['rss']:.1f} (RMS z = {sM['rms_z']:.2f}) over {dM.located.n_points} points; "
+          f"verdict {dM.verdict}, top effect {dM.top_effect}")
+    display(gap_study.ranking_table(dM))
 
 # %% [markdown]
 # ## Findings

@@ -401,7 +401,7 @@ def _ch5(bases: dict) -> list[Row]:
     floor = _floor_causes()
     ch5abl = {m: _ch5_ablation_causes(m) for m in ("MSK", "NMSK")}
     gaps = {m: _located_gaps(s) for m, s in bases.items() if s is not None}
-    verdicts = {"NMSK": _nmsk_diagnosis_text(), "MSK": "no diagnosis run on this solution"}
+    verdicts = {"NMSK": _nmsk_diagnosis_text(), "MSK": _msk_diagnosis_text()}
     for model, table in (("MSK", "Table 5.4"), ("NMSK", "Table 5.11")):
         s = bases.get(model)
         valid = gate(s, model) if s is not None else ""
@@ -522,6 +522,24 @@ def _nmsk_diagnosis_text() -> str:
     where = _anchor("ch08_gap", "5. Does co-contraction close the TA/GAM gap? (thesis Sec 5.3.5)")
     return (f"diagnosis (co-contraction, joint stiffness, activation timing on this solution): {d.verdict}"
             + (f", top {d.top_effect}" if d.top_effect != "unexplained" else "") + f" [{where}]")
+
+
+#: Ch 8's section holding the library diagnosis of the book's Ch 5 MSK solution.
+MSK_DIAGNOSIS_HEADING = "6b. The library's candidates on the Ch 5 MSK solution"
+
+
+def _msk_diagnosis_text() -> str:
+    """The diagnosis of the book's Ch 5 MSK solution with every applicable library effect
+    (:func:`gaitlib.studies.gap.ch5_attribution`): its verdict and top effect; "no diagnosis
+    run on this solution" when it is not stored."""
+    try:
+        with cache.only("the card reads stored solutions only"):
+            d = gap_study.ch5_attribution("MSK", reading="book", resamples=0)
+    except cache.NotCached:
+        return "no diagnosis run on this solution"
+    where = _anchor("ch08_gap", MSK_DIAGNOSIS_HEADING)
+    return (f"diagnosis (the library's {len(d.settings.get('candidates', []))} candidates on this solution): "
+            f"{d.verdict}" + (f", top {d.top_effect}" if d.top_effect != "unexplained" else "") + f" [{where}]")
 
 
 def _located_gaps(sol) -> dict:

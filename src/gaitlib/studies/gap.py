@@ -49,7 +49,7 @@ from ..marks import failure_label
 from . import predictive as pr
 
 __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "NMSK_CANDIDATES", "effect_table", "twin_validation",
-           "sk_diagnosis", "nmsk_attribution", "emg_gap_table", "exact_left_leg", "left_leg_check",
+           "sk_diagnosis", "nmsk_attribution", "ch5_attribution", "emg_gap_table", "exact_left_leg", "left_leg_check",
            "book_gaps", "twin_validation_full_mesh", "twin_full_mesh_lines", "twin_full_mesh_verdict",
            "left_leg_flips", "co_contraction_text", "findings",
            "validation_cases", "validation_lines", "visibility_text",
@@ -140,16 +140,23 @@ def own_data(gait):
 def nmsk_attribution(candidates=NMSK_CANDIDATES, resamples: int = 200, serial: bool = True,
                      root=None, reading: str = "thesis") -> diagnose.Diagnosis:
     """Muscle-level candidates on the Ch 5 NMSK solution (thesis Sec 5.3.5's question: does
-    co-contraction close the TA/GAM gap?).
+    co-contraction close the TA/GAM gap?): :func:`ch5_attribution` of ``"NMSK"``."""
+    return ch5_attribution("NMSK", candidates, resamples=resamples, serial=serial, root=root, reading=reading)
 
-    Baseline: the Ch 5 NMSK data-tracking solution (:func:`gaitlib.studies.msk.solve`,
-    Eq 5.55 on the full 20 × 5 mesh) — not re-fitted. Candidates are re-solved with the
+
+def ch5_attribution(model: str, candidates=None, resamples: int = 200, serial: bool = True,
+                    root=None, reading: str = "thesis") -> diagnose.Diagnosis:
+    """Candidate effects on the Ch 5 solution of ``model`` ("MSK" or "NMSK").
+
+    Baseline: the Ch 5 data-tracking solution (:func:`gaitlib.studies.msk.solve`, Eq 5.33 /
+    5.55 on the full 20 × 5 mesh) — not re-fitted. Candidates (``None``: every library effect
+    that applies to the model, :func:`gaitlib.gap.diagnose.candidates`) are re-solved with the
     spec's own cost function (``objective="cost"``: the thesis's problem plus the effect),
     warm-started from it, on the same mesh; profiled effects on their grid
     (:data:`gaitlib.gap.diagnose.PROFILE_GRID`), activation timing on the comparison only.
     Ranked as :func:`gaitlib.gap.diagnose.assemble` does. ``reading``: the Ch 5 solution's
     (:data:`gaitlib.studies.gait.READINGS`)."""
-    base_sol = msk.solve("NMSK", root=root, reading=reading)
+    base_sol = msk.solve(model, root=root, reading=reading)
     spec0 = base_sol.spec
     ds = gio.load_real(spec0.speed_class, spec0.source)
     names, skipped = diagnose.candidates(spec0, ds.gait, candidates)
@@ -157,7 +164,7 @@ def nmsk_attribution(candidates=NMSK_CANDIDATES, resamples: int = 200, serial: b
                             serial=serial, progress=False)["data"]
     return diagnose.assemble(ds, spec0, base_sol, fits, objective="cost", resamples=resamples, skipped=skipped,
                       settings={"objective": "cost", "candidates": names,
-                                "baseline": f"Ch 5 NMSK solution, {reading}'s reading"})
+                                "baseline": f"Ch 5 {model} solution, {reading}'s reading"})
 
 
 def _emg_rss(loc: locate.Located, stems) -> dict:
