@@ -540,8 +540,9 @@ print(f"• This page's solves and identifications took {time.perf_counter() - T
 #   and the report card (computed, with a verdict per row). The causes measured so far are
 #   Ch 2's — the Jrk term's denominators, the load on a swinging foot (together: the
 #   difference between the two readings in the table of the section on valid gaits) and
-#   the geometric floor of the angle error; "different data" is a hypothesis we have not
-#   measured. The NMSK fit is close to the MSK fit,
+#   the geometric floor of the angle error — and this page's two ablations (MSK and NMSK:
+#   which single change of weight, mesh or parameter set lowers each channel, and which
+#   meet the target); "different data" is a hypothesis we have not measured. The NMSK fit is close to the MSK fit,
 #   as in the thesis, largely because it starts from it; from the thesis's data-based
 #   guess the same NLP ends in a worse local optimum (`msk.solve` docstring).
 # * *Activation parameters.* Eq 5.55 has no EMG term, so τ_act, c3, s1, s2 are not
