@@ -23,7 +23,7 @@ LAYERS = (
     ("data", ("gaitlib.tidy", "gaitlib.plausibility", "gaitlib.data")),
     ("physics", ("gaitlib.model", "gaitlib.contact", "gaitlib.mtg", "gaitlib.activation", "gaitlib.metabolics",
                  "gaitlib.kinematics", "gaitlib.jump", "gaitlib.params")),
-    ("engine", ("gaitlib.collocation", "gaitlib.ocp", "gaitlib.cache", "gaitlib.sweep")),
+    ("engine", ("gaitlib.collocation", "gaitlib.compiled", "gaitlib.ocp", "gaitlib.cache", "gaitlib.sweep")),
     ("effects", ("gaitlib.effects",)),
     ("problems", ("gaitlib.problems",)),
     ("checks", ("gaitlib.validity", "gaitlib.marks", "gaitlib.plots")),
