@@ -178,6 +178,23 @@ def test_co_contraction_text():
     assert G.co_contraction_text(diag, emg) is None
 
 
+def test_msk_diagnosis_text():
+    rk = pd.DataFrame({"rank": [1, 2, 3, 4, np.nan], "effect": ["joint_stiffness", "activation_timing", "arm_swing",
+                                                                 "co_contraction", "friction"],
+                       "pct_closed": [33.6, 31.5, 4.6, -12.1, np.nan], "dBIC": [-143.7, -132.5, -11.4, 47.6, np.nan],
+                       "status": ["Solve_Succeeded", "Solve_Succeeded (comparison only)", "Solve_Succeeded",
+                                  "Solve_Succeeded", "located gap above the baseline's (Solve_Succeeded)"]})
+    fit = SimpleNamespace(profile=[(-0.5, 1614.7, "ok"), (1.0, 3880.2, "ok"), (2.0, 4564.0, "ok")])
+    diag = SimpleNamespace(ranking=rk, verdict="partial", top_effect="joint_stiffness", fits={"joint_stiffness": fit})
+    t = G.msk_diagnosis_text(diag)
+    assert t.startswith("**The Ch 5 MSK solution, the library's 5 candidates.** Verdict **partial**, top effect "
+                        "joint_stiffness (its best magnitude, -0.5, is the lowest point of its profile grid -0.5, 1, 2")
+    assert ("closing the most: joint_stiffness 33.6 % (ΔBIC -144), activation_timing 31.5 % (ΔBIC -132, comparison "
+            "only), arm_swing 4.6 % (ΔBIC -11). 1 ranked candidate(s) widen the gap; 1 end above") in t
+    fit.profile = [(-0.5, 3000.0, "ok"), (1.0, 1000.0, "ok"), (2.0, 4564.0, "ok")]  # interior best: no caveat
+    assert "profile grid" not in G.msk_diagnosis_text(diag)
+
+
 # ------------------------------------------------------------------------------ Ch 3
 
 def _jump_sol(label, rise, mu, knee_min_deg, tau_knee, success=True):

@@ -624,5 +624,6 @@ if dM is not None:
 # ## Findings
 
 # %%
-display(Markdown("\n\n".join(gap_study.findings(tv, tvf, dS, dU, dN, chkS, chkU, bg, emg, val=val, valv=valv))))
+display(Markdown("\n\n".join(gap_study.findings(tv, tvf, dS, dU, dN, chkS, chkU, bg, emg, val=val, valv=valv,
+                                                    diag_m=dM))))
 print(f"notebook time: {time.perf_counter() - T0:.0f} s")

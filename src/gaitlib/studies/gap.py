@@ -681,7 +681,7 @@ def _left_line(lab: str, c: dict) -> str:
 
 def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis, diag_n: diagnose.Diagnosis, check_s: dict,
              check_u: dict, gaps: pd.DataFrame, emg: pd.DataFrame, val: gval.Validation | None = None,
-             valv: gval.Validation | None = None) -> list[str]:
+             valv: gval.Validation | None = None, diag_m: diagnose.Diagnosis | None = None) -> list[str]:
     """The chapter's findings as Markdown paragraphs, every number and verdict from the
     results: the twin checks (``tv`` on the coarse mesh, :func:`twin_validation`;
     ``tv_full`` on 20 × 5, :func:`twin_validation_full_mesh`), the SK diagnoses of Schwartz
@@ -689,7 +689,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     book's own solutions (:func:`book_gaps`) and the NMSK attribution (``diag_n``,
     :func:`nmsk_attribution`, with its :func:`emg_gap_table` ``emg``) and, if given, the
     validation on manipulated real data (``val``) and on model-variant twins (``valv``), both
-    :func:`stored_validation`."""
+    :func:`stored_validation`, and the library's candidates on the Ch 5 MSK solution
+    (``diag_m``, :func:`ch5_attribution`)."""
     s, sf = tv.summary(), tv_full.summary()
     acc = tv.accuracy()
     sS, sU = summary(diag_s), summary(diag_u)
@@ -742,7 +743,35 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     cc = co_contraction_text(diag_n, emg)
     if cc:
         out.append(cc)
+    if diag_m is not None:
+        out.append(msk_diagnosis_text(diag_m))
     return out
+
+
+def msk_diagnosis_text(diag: diagnose.Diagnosis, top: int = 3) -> str:
+    """One paragraph on the library's candidates on the Ch 5 MSK solution
+    (:func:`ch5_attribution` of "MSK"): the verdict, and the ranked candidates' share of the
+    gap closed and ΔBIC (the ``top`` first); how many candidates widened the gap or ended
+    above the baseline's located gap."""
+    rk = diag.ranking
+    ranked = rk[rk["rank"].notna()].sort_values("rank")
+    lines = [f"{r['effect']} {r['pct_closed']:.1f} % (ΔBIC {r['dBIC']:.0f}"
+             + (", comparison only" if "comparison only" in str(r["status"]) else "") + ")"
+             for _, r in ranked.head(top).iterrows()]
+    worse = int((ranked["pct_closed"] < 0).sum())
+    above = int(rk["rank"].isna().sum())
+    edge = ""
+    fit = diag.fits.get(diag.top_effect)
+    if fit is not None and fit.profile:  # a profiled top effect at the end of its grid: the optimum may lie beyond
+        grid = [m for m, _, _ in fit.profile]
+        best = min(fit.profile, key=lambda t: t[1])[0]
+        if best in (min(grid), max(grid)):
+            edge = (f" (its best magnitude, {best:g}, is the {'lowest' if best == min(grid) else 'highest'} point of its "
+                    f"profile grid {', '.join(f'{m:g}' for m in grid)}: the best fit may lie beyond it)")
+    return (f"**The Ch 5 MSK solution, the library's {len(rk)} candidates.** Verdict **{diag.verdict}**"
+            + (f", top effect {diag.top_effect}{edge}" if diag.top_effect != "unexplained" else "")
+            + f"; closing the most: {', '.join(lines)}. {worse} ranked candidate(s) widen the gap; {above} end "
+              f"above the baseline's located gap and are not ranked.")
 
 
 def co_contraction_text(diag_n: diagnose.Diagnosis, emg: pd.DataFrame, closes_most: float = 0.5) -> str | None:
