@@ -104,6 +104,19 @@ def test_cli_writes_card(cli_card):
     assert c.loc[~track, "gap"].isna().all()
 
 
+def test_ch6_excitation_claims_checked_from_the_thesis_guess(cli_card):
+    """A not-reproduced excitation claim of Ch 6 says what the runs from the thesis's partial
+    guess (a second start) decide, with their ranking, rather than "unknown"."""
+    c = cli_card
+    exc = c[(c["chapter"] == 6) & c["item"].str.contains("predicts the (?:most|least) accurate excitations")
+            & (c["verdict"] == "not reproduced")]
+    if exc.empty:
+        pytest.skip("no such row is decided on the stored runs")
+    assert exc["cause"].str.match(r"(not the start|the start decides it): from the thesis's partial guess "
+                                  r"\(Sec 6\.1; \d valid NMSK runs\)").all()
+    assert exc["cause"].str.contains(r"rank \d of \d").all()
+
+
 def test_card_reads_the_stored_numbers(tmp_path, monkeypatch):
     """Change a stored number in a copy of the Ch 5 MSK entry (the book's reading, which the
     card's Ch 5 rows report): the card's row follows it."""

@@ -644,18 +644,19 @@ def _ch5_bases(reading: str = "thesis") -> dict:
 # ======================================================================================
 # Chapters 6 and 7: cost functions and speeds
 # ======================================================================================
-def _runs(bases: dict, which: str, reading: str = "thesis", **changes) -> dict:
+def _runs(bases: dict, which: str, reading: str = "thesis", policy: str | None = None, **changes) -> dict:
     """name → StoredGait (or None) of the Ch 6 (``which="ch6"``) or Ch 7 runs in ``reading``
     (``bases``: the Ch 5 solutions of that reading), found as
     :func:`gaitlib.studies.predictive.cost_function_study` / ``speed_study`` store them;
     ``changes``: GaitSpec fields of a variant of those runs (e.g. ``max_iter=3000``: the
     reruns of :meth:`gaitlib.studies.predictive.StudyResult.rerun_failed`; ``weights=``: the
-    Ch 7 pin experiment)."""
+    Ch 7 pin experiment); ``policy``: the runs' start (:data:`gaitlib.studies.predictive.
+    GUESS_POLICY` by default; ``"thesis"``: the thesis's partial guess, Ch 6 only)."""
     out = {}
     for m, base in bases.items():
         if which == "ch6":
             specs = pr.ch6_specs(m, base, pr.CH6_COSTS, reading=reading, **pr.default_params())
-            guesses = {k: pr.run_guess(base, pr.GUESS_POLICY[m]) for k in specs}
+            guesses = {k: pr.run_guess(base, policy or pr.GUESS_POLICY[m]) for k in specs}
         else:
             specs = pr.ch7_specs(m, base, pr.CH7_CLASSES, reading=reading, **pr.default_params())
             guesses = {}
@@ -759,6 +760,7 @@ def _ch6_claims(bases: dict, runs: dict, valid: dict, free, reruns: dict) -> lis
                if timed else None)
     fp_where = _anchor("ch06_costfun", "FP with the gait's phase timing")
     act_cause = _ch6_activation_cause(bases, runs)
+    start_check = _ch6_start_check(n5, free)
     rows = []
     for _, r in table[~table["numeric"].astype(bool)].iterrows():
         # a decided claim is computed from the usable runs alone; an untested one names all
@@ -776,12 +778,38 @@ def _ch6_claims(bases: dict, runs: dict, valid: dict, free, reruns: dict) -> lis
         model_pair = r["claim"].split(":")[0] in pr.CH6_COSTS and ("MSK" in r["claim"] and "NMSK" in r["claim"])
         if cause == "unknown" and model_pair and act_cause:
             cause = act_cause
+        if cause == "unknown" and exc and r["claim"] in start_check:
+            cause = start_check[r["claim"]]
         if r["depends on metric"]:
             cause = f"depends on the metric: {other} says {r[f'{other}: verdict']} ({r[other]}) [{where}]"
         rows.append(Row(6, f"{r['claim']} (Sec {r['thesis']})", "holds", ours, "", cause,
                         f"Ch 6 {', '.join(names)}", _joint({n: valid.get(n, "") for n in names}),
                         holds=None if r["verdict"] == "not tested" else r[f"{metric}: verdict"] == "holds"))
     return rows
+
+
+def _ch6_start_check(n5, free) -> dict:
+    """claim → what the Ch 6 conclusions say on the NMSK runs started from the thesis's
+    partial guess (Sec 6.1; the book's reading, converged and valid runs only) for the
+    excitation claims that are decided there: a second start, which tells whether a claim's
+    fate comes from the book's start (the Ch 5 solution). Empty when not stored."""
+    if n5 is None:
+        return {}
+    tg = {k: v for k, v in _runs({"NMSK": n5}, "ch6", "book", policy="thesis").items()
+          if v is not None and not _blocked(gate(v, k))}
+    if not tg:
+        return {}
+    where = _anchor("ch06_costfun", "Did every run converge? Solver statistics and Table 6.3")
+    t = ch6_claims.conclusions(tg, free, ch5_nmsk=n5)
+    out = {}
+    for _, r in t.iterrows():
+        if isinstance(r["RMSE: verdict"], str) and r["verdict"] != "not tested":
+            guess = f"from the thesis's partial guess (Sec 6.1; {len(tg)} valid NMSK runs)"
+            out[r["claim"]] = (f"the start decides it: {guess} it holds: {r['RMSE']} [{where}]"
+                               if r["RMSE: verdict"] == "holds" else
+                               f"not the start: {guess} it does not hold either: {r['RMSE']} [{where}]; what else "
+                               f"decides the ranking is not measured")
+    return out
 
 
 def _ch6_activation_cause(bases: dict, runs: dict) -> str:
