@@ -799,7 +799,7 @@ def _ch6_start_check(n5, free) -> dict:
           if v is not None and not _blocked(gate(v, k))}
     if not tg:
         return {}
-    where = _anchor("ch06_costfun", "Did every run converge? Solver statistics and Table 6.3")
+    where = _anchor("ch06_costfun", "A second start: the excitation claims on the runs from the thesis's partial guess")
     t = ch6_claims.conclusions(tg, free, ch5_nmsk=n5)
     out = {}
     for _, r in t.iterrows():
