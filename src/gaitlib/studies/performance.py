@@ -324,12 +324,13 @@ def e2e_findings(res: dict) -> list[str]:
             out.append(f"• What is left of the compiled solve is IPOPT's own work, {comp['ipopt_rest_s']:.1f} of "
                        f"{comp['solve_s']:.1f} s ({1e3 * comp['ipopt_rest_s'] / max(comp['iterations'], 1):.0f} ms per "
                        f"iteration, mostly MUMPS factorising the KKT matrix — more than once in an iteration that needs "
-                       f"an inertia correction). At that rate the {tgt:.0f}-s target allows "
-                       f"{tgt / (comp['ms_per_iteration'] / 1e3):.0f} iterations; this path took {comp['iterations']}.")
+                       f"an inertia correction). At the compiled path's {comp['ms_per_iteration']:.0f} ms per iteration the "
+                       f"{tgt:.0f}-s target allows {tgt / (comp['ms_per_iteration'] / 1e3):.0f} iterations; this path took "
+                       f"{comp['iterations']}.")
     gap = [r for r in res.get("gap", []) if r.get("status") == "ok"]
     if gap:
         best = min(gap, key=lambda r: r["e2e_s"])
-        out.append("• `gaitlib gap` on a new CSV, default mesh: "
+        out.append("• gaitlib gap on a new CSV, default mesh: "
                    + "; ".join(f"{r['variant']} {r['e2e_s']:.0f} s ({r.get('verdict', '?')})" for r in gap)
                    + f". Fastest {best['e2e_s']:.0f} s against the target of {E2E_TARGETS['gap']:.0f} s — "
                    + ("met." if best["e2e_s"] <= E2E_TARGETS["gap"] else
