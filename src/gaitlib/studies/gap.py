@@ -44,12 +44,12 @@ from ..gap import method as gap_method
 from . import performance as perf
 from .. import data as data_mod
 from . import msk
-from ..gap.solve import solve_on
+from ..gap.solve import solve_many, solve_on
 from ..marks import failure_label
 from . import predictive as pr
 
 __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "NMSK_CANDIDATES", "effect_table", "twin_validation",
-           "sk_diagnosis", "nmsk_attribution", "ch5_attribution", "emg_gap_table", "exact_left_leg", "left_leg_check",
+           "sk_diagnosis", "nmsk_attribution", "ch5_attribution", "ch5_profile", "emg_gap_table", "exact_left_leg", "left_leg_check",
            "book_gaps", "twin_validation_full_mesh", "twin_full_mesh_lines", "twin_full_mesh_verdict",
            "left_leg_flips", "co_contraction_text", "findings",
            "validation_cases", "validation_lines", "visibility_text",
@@ -165,6 +165,41 @@ def ch5_attribution(model: str, candidates=None, resamples: int = 200, serial: b
     return diagnose.assemble(ds, spec0, base_sol, fits, objective="cost", resamples=resamples, skipped=skipped,
                       settings={"objective": "cost", "candidates": names,
                                 "baseline": f"Ch 5 {model} solution, {reading}'s reading"})
+
+
+def ch5_profile(model: str, effect: str, magnitudes, reading: str = "book", root=None,
+                serial: bool = True) -> pd.DataFrame:
+    """A profiled effect on the Ch 5 solution of ``model`` at ``magnitudes`` of our choosing
+    — outside the frozen method's grid (:data:`gaitlib.gap.diagnose.PROFILE_GRID`), so it
+    changes no verdict: each point is re-solved as :func:`ch5_attribution` re-solves it (the
+    spec's own cost function plus the effect at that magnitude, warm-started from the Ch 5
+    solution, same mesh) and its located gap measured. Rows: magnitude, status, RSS of the
+    located gap, % of the baseline's RSS closed and the share of that closing that comes from
+    the EMG channels; the baseline (magnitude = the effect's null value) first."""
+    base_sol = msk.solve(model, root=root, reading=reading)
+    spec0 = base_sol.spec
+    ds = gio.load_real(spec0.speed_class, spec0.source)
+    groups = {f"{effect}@{m}": (diagnose.with_effects(spec0, ((effect, m),)), [(f"data|{effect}@{m}", ds.gait, base_sol)])
+              for m in magnitudes}
+    res = solve_many(groups, root=root, objective="cost", serial=serial)
+    loc0 = locate.locate(base_sol, ds)
+    rss0, ch0 = loc0.rss, loc0.channels.set_index("channel")["rss"]
+    null = effects_mod.EFFECTS[effect].params[0].null
+    rows = [{"magnitude": null, "status": base_sol.stats["status"], "RSS": rss0, "% closed": 0.0,
+             "EMG share of the closed gap (%)": np.nan}]
+    for m in magnitudes:
+        sol = res.get(f"data|{effect}@{m}")
+        if sol is None:
+            rows.append({"magnitude": m, "status": "error", "RSS": np.nan, "% closed": np.nan,
+                         "EMG share of the closed gap (%)": np.nan})
+            continue
+        loc = locate.locate(sol, ds, thetas=sol.stats.get("effects", {}))
+        drop = ch0 - loc.channels.set_index("channel")["rss"]
+        emg = float(drop[drop.index.str.startswith("emg:")].sum())
+        rows.append({"magnitude": m, "status": sol.stats["status"], "RSS": loc.rss,
+                     "% closed": 100 * (rss0 - loc.rss) / rss0,
+                     "EMG share of the closed gap (%)": 100 * emg / (rss0 - loc.rss) if rss0 != loc.rss else np.nan})
+    return pd.DataFrame(rows)
 
 
 def _emg_rss(loc: locate.Located, stems) -> dict:
