@@ -342,3 +342,26 @@ def test_mesh_verdict_says_whether_the_real_data_verdict_depends_on_the_mesh():
     assert other.startswith("**The real-data verdict depends on the mesh**")
     assert "top arm_swing" in other and "ΔBIC -14.0" in other and "not measured" in other
     assert gs.mesh_verdict(table("left_shift", "explained"), -10).startswith("**The real-data verdict depends")
+
+
+def test_ch5_profile_rows_and_emg_share(monkeypatch):
+    """The profile's % closed and the EMG channels' share of it, on hand-made located gaps."""
+    base = SimpleNamespace(spec=SimpleNamespace(speed_class="Free", source="schwartz2008"),
+                           stats={"status": "Solve_Succeeded"})
+    sol = SimpleNamespace(stats={"status": "Solve_Succeeded", "effects": {"joint_stiffness": {"k": -0.7}}})
+    monkeypatch.setattr(G.msk, "solve", lambda model, **kw: base)
+    monkeypatch.setattr(G.gio, "load_real", lambda *a: SimpleNamespace(gait="g"))
+    monkeypatch.setattr(G.diagnose, "with_effects", lambda spec, eff: ("spec", eff))
+    monkeypatch.setattr(G, "solve_many", lambda groups, **kw: {"data|joint_stiffness@-0.7": sol})
+
+    def loc(s, ds, thetas=None):
+        rss = {"emg:TA_r": 100.0, "angle:knee_r": 50.0} if s is base else {"emg:TA_r": 40.0, "angle:knee_r": 30.0}
+        return SimpleNamespace(rss=sum(rss.values()),
+                               channels=pd.DataFrame({"channel": list(rss), "rss": list(rss.values())}))
+
+    monkeypatch.setattr(G.locate, "locate", loc)
+    t = G.ch5_profile("MSK", "joint_stiffness", (-0.7,))
+    assert list(t["magnitude"]) == [0.0, -0.7]
+    # 150 → 70: 53.3 % closed, of which the EMG's 60 of 80 = 75 %
+    assert t["% closed"].iloc[1] == pytest.approx(100 * 80 / 150)
+    assert t["EMG share of the closed gap (%)"].iloc[1] == pytest.approx(75.0)
