@@ -67,23 +67,30 @@ def _gait_row(sol: dict) -> dict:
             "ipopt_rest_s": sol["solve_time"] - evals, "objective": sol["objective"]}
 
 
-def gait_rows(quick: bool, libs: Path) -> list[dict]:
-    mesh = ["--intervals", "4", "--degree", "3"] if quick else []
+def _timed(label: str, args: list[str], libs: Path, parse) -> list[dict]:
+    """``gaitlib <args> --out <tmp>/out <variant flags>`` for every variant, each timed from
+    the shell in a fresh process; ``parse(out_dir)`` turns its outputs into row fields."""
     rows = []
     for name, extra in VARIANTS:
         with tempfile.TemporaryDirectory(prefix="bench-e2e-") as tmp:
-            cmd = [sys.executable, "-m", "gaitlib", "run", "gait", "--model", "MSK", "--cost", "DT", "--speed", "Free",
-                   "--no-cache", "--no-figures", "--quiet", "--out", f"{tmp}/out", *mesh, *extra]
+            cmd = [sys.executable, "-m", "gaitlib", *args, "--out", f"{tmp}/out", *extra]
             load = os.getloadavg()[0]
             wall, p = _run(cmd, {**os.environ, **ENV1, "GAITLIB_COMPILED": str(libs)})
-            row = {"command": "gaitlib run gait --model MSK --cost DT --speed Free", "variant": name,
-                   "flags": " ".join(extra), "e2e_s": wall, "load_at_start": load}
+            row = {"command": label, "variant": name, "flags": " ".join(extra), "e2e_s": wall, "load_at_start": load}
             if p.returncode != 0:
                 rows.append({**row, "status": "error: " + " ".join((p.stderr or p.stdout)[-300:].split())})
             else:
-                rows.append({**row, **_gait_row(json.loads((Path(tmp) / "out" / "ocp" / "solution.json").read_text()))})
-        print(f"{name}: {rows[-1].get('status')}, {rows[-1].get('iterations')} it, e2e {wall:.1f} s", flush=True)
+                rows.append({**row, **parse(Path(tmp) / "out")})
+        print(f"{label} — {name}: {rows[-1].get('status')}, e2e {wall:.1f} s", flush=True)
     return rows
+
+
+def gait_rows(quick: bool, libs: Path) -> list[dict]:
+    mesh = ["--intervals", "4", "--degree", "3"] if quick else []
+    return _timed("gaitlib run gait --model MSK --cost DT --speed Free",
+                  ["run", "gait", "--model", "MSK", "--cost", "DT", "--speed", "Free", "--no-cache", "--no-figures",
+                   "--quiet", *mesh], libs,
+                  lambda out: _gait_row(json.loads((out / "ocp" / "solution.json").read_text())))
 
 
 def gap_rows(quick: bool, libs: Path, work: Path) -> list[dict]:
@@ -96,23 +103,13 @@ def gap_rows(quick: bool, libs: Path, work: Path) -> list[dict]:
     if p.returncode != 0:
         raise RuntimeError(f"{' '.join(twin)}: {p.stderr[-500:]}")
     mesh = ["--intervals", "4", "--degree", "3"] if quick else []
-    rows = []
-    for name, extra in VARIANTS:
-        with tempfile.TemporaryDirectory(prefix="bench-e2e-") as tmp:
-            cmd = [sys.executable, "-m", "gaitlib", "gap", "--data", str(csv),
-                   "--no-cache", "--no-figures", "--out", f"{tmp}/out", *mesh, *extra]
-            load = os.getloadavg()[0]
-            wall, p = _run(cmd, {**os.environ, **ENV1, "GAITLIB_COMPILED": str(libs)})
-            row = {"command": "gaitlib gap --data twin_knee_offset.csv", "variant": name,
-                   "flags": " ".join(extra), "e2e_s": wall, "load_at_start": load}
-            if p.returncode != 0:
-                rows.append({**row, "status": "error: " + " ".join((p.stderr or p.stdout)[-300:].split())})
-            else:
-                d = json.loads((Path(tmp) / "out" / "diagnosis.json").read_text())
-                rows.append({**row, "status": "ok", "verdict": d.get("verdict", d.get("top")),
-                             **_gap_solves(d)})
-        print(f"gap {name}: {rows[-1].get('status')}, e2e {wall:.1f} s", flush=True)
-    return rows
+
+    def parse(out: Path) -> dict:
+        d = json.loads((out / "diagnosis.json").read_text())
+        return {"status": "ok", "verdict": d.get("verdict", d.get("top")), **_gap_solves(d)}
+
+    return _timed("gaitlib gap --data twin_knee_offset.csv",
+                  ["gap", "--data", str(csv), "--no-cache", "--no-figures", *mesh], libs, parse)
 
 
 def _gap_solves(d: dict) -> dict:
