@@ -191,6 +191,12 @@ def test_msk_diagnosis_text():
                         "joint_stiffness (its best magnitude, -0.5, is the lowest point of its profile grid -0.5, 1, 2")
     assert ("closing the most: joint_stiffness 33.6 % (ΔBIC -144), activation_timing 31.5 % (ΔBIC -132, comparison "
             "only), arm_swing 4.6 % (ΔBIC -11). 1 ranked candidate(s) widen the gap; 1 end above") in t
+    prof = pd.DataFrame({"magnitude": [0.0, -0.5, -0.9], "status": ["Solve_Succeeded"] * 3,
+                         "RSS": [2432.0, 1615.0, 1405.0], "% closed": [0.0, 33.6, 42.2],
+                         "EMG share of the closed gap (%)": [np.nan, 99.5, 99.57]})
+    # the grid's own point (-0.5) and the baseline are not "beyond the grid"
+    assert G.msk_diagnosis_text(diag, profile=prof).endswith(
+        " Beyond the grid (outside the frozen method): -0.9 closes 42.2 % (99.6 % of that in the EMG channels).")
     fit.profile = [(-0.5, 3000.0, "ok"), (1.0, 1000.0, "ok"), (2.0, 4564.0, "ok")]  # interior best: no caveat
     assert "profile grid" not in G.msk_diagnosis_text(diag)
 

@@ -55,7 +55,7 @@ import pandas as pd
 import matplotlib.pyplot as plt
 from IPython.display import HTML, Markdown, display
 
-from gaitlib import data, marks, plots, validity
+from gaitlib import data, marks, plots
 from gaitlib.model import ChildModel
 from gaitlib.studies import ch6_claims, gait, msk, predictive as pr
 
@@ -207,11 +207,11 @@ display(Markdown(
 # starts does not fail because of where the book's runs start.
 
 # %%
-tg_usable = {k: s for k, s in res_thesis_guess.solutions.items()
-             if s is not None and s.stats["status"] in validity.CONVERGED_STATUSES and validity.check(s).passed}
-claims_tg = ch6_claims.conclusions(tg_usable, free, ch5_nmsk=res.baselines["NMSK"])
+tg_usable, tg_left_out, _ = ch6_claims.usable(res_thesis_guess)
+claims_tg = ch6_claims.conclusions(tg_usable, free, ch5_nmsk=res.baselines["NMSK"], excluded=tg_left_out)
 print(f"{len(tg_usable)} of {len(res_thesis_guess.solutions)} runs from the thesis's partial guess are usable")
-claims_tg[claims_tg["claim"].str.contains("excitation")][["claim", "verdict", "RMSE", "NRMSE", "ours"]]
+with pd.option_context("display.max_colwidth", None):
+    display(claims_tg[claims_tg["claim"].str.contains("excitation")][["claim", "verdict", "RMSE", "NRMSE", "ours"]])
 
 # %% [markdown]
 # ## The fully predictive NMSK gait (thesis Figs 6.5–6.8)

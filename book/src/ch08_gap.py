@@ -639,13 +639,13 @@ if prof_js is not None:
     best_js = ok_js.loc[ok_js["RSS"].idxmin()]
     print(f"Lowest located gap among the converged points: k = {best_js['magnitude']:g}, RSS {best_js['RSS']:.0f} "
           f"({best_js['% closed']:.1f} % of the baseline's {prof_js['RSS'].iloc[0]:.0f} closed), "
-          f"{best_js['EMG share of the closed gap (%)']:.0f} % of it in the EMG channels (the generators' "
-          f"activations against the EMG), the rest in angles, torques and GRFs.")
+          f"{best_js['EMG share of the closed gap (%)']:.1f} % of that in the EMG channels (the generators' "
+          f"activations against the EMG).")
 
 # %% [markdown]
 # ## Findings
 
 # %%
 display(Markdown("\n\n".join(gap_study.findings(tv, tvf, dS, dU, dN, chkS, chkU, bg, emg, val=val, valv=valv,
-                                                    diag_m=dM))))
+                                                    diag_m=dM, profile_m=prof_js))))
 print(f"notebook time: {time.perf_counter() - T0:.0f} s")

@@ -716,7 +716,8 @@ def _left_line(lab: str, c: dict) -> str:
 
 def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis, diag_n: diagnose.Diagnosis, check_s: dict,
              check_u: dict, gaps: pd.DataFrame, emg: pd.DataFrame, val: gval.Validation | None = None,
-             valv: gval.Validation | None = None, diag_m: diagnose.Diagnosis | None = None) -> list[str]:
+             valv: gval.Validation | None = None, diag_m: diagnose.Diagnosis | None = None,
+             profile_m: pd.DataFrame | None = None) -> list[str]:
     """The chapter's findings as Markdown paragraphs, every number and verdict from the
     results: the twin checks (``tv`` on the coarse mesh, :func:`twin_validation`;
     ``tv_full`` on 20 × 5, :func:`twin_validation_full_mesh`), the SK diagnoses of Schwartz
@@ -725,7 +726,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     :func:`nmsk_attribution`, with its :func:`emg_gap_table` ``emg``) and, if given, the
     validation on manipulated real data (``val``) and on model-variant twins (``valv``), both
     :func:`stored_validation`, and the library's candidates on the Ch 5 MSK solution
-    (``diag_m``, :func:`ch5_attribution`)."""
+    (``diag_m``, :func:`ch5_attribution`, with its top effect profiled beyond the grid,
+    ``profile_m``, :func:`ch5_profile`)."""
     s, sf = tv.summary(), tv_full.summary()
     acc = tv.accuracy()
     sS, sU = summary(diag_s), summary(diag_u)
@@ -779,15 +781,17 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     if cc:
         out.append(cc)
     if diag_m is not None:
-        out.append(msk_diagnosis_text(diag_m))
+        out.append(msk_diagnosis_text(diag_m, profile=profile_m))
     return out
 
 
-def msk_diagnosis_text(diag: diagnose.Diagnosis, top: int = 3) -> str:
+def msk_diagnosis_text(diag: diagnose.Diagnosis, top: int = 3, profile: pd.DataFrame | None = None) -> str:
     """One paragraph on the library's candidates on the Ch 5 MSK solution
     (:func:`ch5_attribution` of "MSK"): the verdict, and the ranked candidates' share of the
     gap closed and ΔBIC (the ``top`` first); how many candidates widened the gap or ended
-    above the baseline's located gap."""
+    above the baseline's located gap; and, with ``profile`` (:func:`ch5_profile` of the top
+    effect), each converged point beyond the grid with its share of the gap closed and the
+    EMG channels' part in it."""
     rk = diag.ranking
     ranked = rk[rk["rank"].notna()].sort_values("rank")
     lines = [f"{r['effect']} {r['pct_closed']:.1f} % (ΔBIC {r['dBIC']:.0f}"
@@ -806,7 +810,27 @@ def msk_diagnosis_text(diag: diagnose.Diagnosis, top: int = 3) -> str:
     return (f"**The Ch 5 MSK solution, the library's {len(rk)} candidates.** Verdict **{diag.verdict}**"
             + (f", top effect {diag.top_effect}{edge}" if diag.top_effect != "unexplained" else "")
             + f"; closing the most: {', '.join(lines)}. {worse} ranked candidate(s) widen the gap; {above} end "
-              f"above the baseline's located gap and are not ranked.")
+              f"above the baseline's located gap and are not ranked." + _profile_sentence(diag, profile))
+
+
+def _profile_sentence(diag, profile: pd.DataFrame | None) -> str:
+    if profile is None or fit_grid(diag) is None:
+        return ""
+    grid = fit_grid(diag)
+    pts = profile.iloc[1:]  # the first row is the baseline
+    ok = pts[pts["status"].isin(["Solve_Succeeded", "Solved_To_Acceptable_Level"])
+             & ~pts["magnitude"].isin(grid) & pts["% closed"].notna()]
+    if ok.empty:
+        return ""
+    return (f" Beyond the grid (outside the frozen method): "
+            + ", ".join(f"{r['magnitude']:g} closes {r['% closed']:.1f} % ({r['EMG share of the closed gap (%)']:.1f} % "
+                        f"of that in the EMG channels)" for _, r in ok.iterrows()) + ".")
+
+
+def fit_grid(diag) -> list | None:
+    """The profile grid of the diagnosis's top effect (None if it was not profiled)."""
+    fit = diag.fits.get(diag.top_effect)
+    return [m for m, _, _ in fit.profile] if fit is not None and fit.profile else None
 
 
 def co_contraction_text(diag_n: diagnose.Diagnosis, emg: pd.DataFrame, closes_most: float = 0.5) -> str | None:
