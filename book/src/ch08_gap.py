@@ -35,7 +35,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from gaitlib import cache, gap, marks
+from gaitlib import cache, gap, marks, validity
 from gaitlib.gap import diagnose, locate, twin
 from gaitlib.gap import figures as gap_figures
 from gaitlib.studies import gap as gap_study
@@ -621,10 +621,10 @@ if dM is not None:
     display(gap_study.ranking_table(dM))
 
 # %% [markdown]
-# The top effect's best magnitude on the method's grid is its lowest point, k = −0.5 (the
-# hip, knee and ankle stiffness and damping halved). Below it, outside the frozen method (so
-# no verdict above changes): the same re-solve at k = −0.7 and −0.9, the effect's bound
-# (`gap_study.ch5_profile`).
+# Joint stiffness (the hip, knee and ankle stiffness and damping multiplied by 1 + k) below
+# the method's grid, whose lowest point is k = −0.5: the same re-solve at k = −0.7 and −0.9,
+# the effect's bound (`gap_study.ch5_profile`). This is outside the frozen method, so no
+# verdict above changes; the findings below say whether the grid's best point was its edge.
 
 # %%
 try:
@@ -635,7 +635,7 @@ except cache.NotCached as e:
     print(f"Not stored yet: {e}")
 if prof_js is not None:
     display(prof_js)
-    ok_js = prof_js[prof_js["status"].isin(["Solve_Succeeded", "Solved_To_Acceptable_Level"])]
+    ok_js = prof_js[prof_js["status"].isin(list(validity.CONVERGED_STATUSES))]
     best_js = ok_js.loc[ok_js["RSS"].idxmin()]
     print(f"Lowest located gap among the converged points: k = {best_js['magnitude']:g}, RSS {best_js['RSS']:.0f} "
           f"({best_js['% closed']:.1f} % of the baseline's {prof_js['RSS'].iloc[0]:.0f} closed), "

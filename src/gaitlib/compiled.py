@@ -1,7 +1,7 @@
 """CasADi functions compiled to C once and kept on disk (the per-node functions of an NLP).
 
 :func:`compiled` takes an SX :class:`casadi.Function`, generates its C code
-(``Function.generate``), compiles it with the system's C compiler into a shared library and
+(``casadi.CodeGenerator``), compiles it with the system's C compiler into a shared library and
 returns ``casadi.external`` of that library: a function with the same inputs, outputs and
 sparsity that evaluates the same operations, in the same order, as CasADi's SX virtual
 machine. It is compiled without ``-ffast-math`` or contraction to fused multiply-adds

@@ -46,6 +46,7 @@ from .. import data as data_mod
 from . import msk
 from ..gap.solve import solve_many, solve_on
 from ..marks import failure_label
+from .. import validity
 from . import predictive as pr
 
 __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "NMSK_CANDIDATES", "effect_table", "twin_validation",
@@ -818,7 +819,7 @@ def _profile_sentence(diag, profile: pd.DataFrame | None) -> str:
         return ""
     grid = fit_grid(diag)
     pts = profile.iloc[1:]  # the first row is the baseline
-    ok = pts[pts["status"].isin(["Solve_Succeeded", "Solved_To_Acceptable_Level"])
+    ok = pts[pts["status"].isin(list(validity.CONVERGED_STATUSES))
              & ~pts["magnitude"].isin(grid) & pts["% closed"].notna()]
     if ok.empty:
         return ""
