@@ -158,3 +158,66 @@ def test_stored_validation_is_refused_for_another_method(tmp_path, monkeypatch):
     monkeypatch.undo()
     for name in G.VALIDATION_RUNS:
         assert G.stored_validation(name).settings["method_hash"] == M.METHOD.hash()
+
+
+def test_resample_adds_only_the_sampling_error_of_the_means(tmp_path, frame):
+    """The null set's data: each curve's mean moves by SD/√n times a smooth unit-variance
+    curve; nothing else changes; the same seed gives the same data; a user's reader
+    accepts it."""
+    n = 82
+    a, b, c = V.resample(frame, 7, n), V.resample(frame, 7, n), V.resample(frame, 8, n)
+    assert a.equals(b) and not a["mean"].equals(c["mean"])
+    assert a.drop(columns="mean").equals(frame.drop(columns="mean"))
+    sd = frame["sd"].to_numpy(float)
+    z = (a["mean"].to_numpy(float) - frame["mean"].to_numpy(float))[sd > 0] / (sd[sd > 0] / math.sqrt(n))
+    assert 0.6 < z.std() < 1.4 and abs(z.mean()) < 0.5  # unit variance, centred (18 smooth curves)
+    assert np.all(a.loc[sd == 0, "mean"].to_numpy() == frame.loc[sd == 0, "mean"].to_numpy())
+    # smooth: successive points (2 % of the cycle apart, correlation length 5 %) move together
+    q = a["quantity"] == "knee_flexion"
+    dz = np.diff((a.loc[q, "mean"] - frame.loc[q, "mean"]).to_numpy() / (frame.loc[q, "sd"].to_numpy() / math.sqrt(n)))
+    assert np.std(dz) < 0.8
+    _read(tmp_path, a, "null")
+    with pytest.raises(ValueError, match="n \\(subjects\\)"):
+        V.resample(frame, 7, 0)
+
+
+def test_null_draws_follow_the_method_hash():
+    d = V.draws(("null",))
+    assert len(d) == V.NULL_DRAWS and (d["unit"] == "seed").all() and d["magnitude"].nunique() == V.NULL_DRAWS
+    other = dataclasses.replace(M.METHOD, bic_threshold=-9.0)
+    assert (V.draws(("null",), method=other)["magnitude"] != d["magnitude"]).all()
+
+
+def test_null_spread_and_visibility_by_hand():
+    """Hand-made null draws: the spread of each candidate's ΔBIC and of the baseline's RSS;
+    an injection reaches naming when its ΔBIC is below min(threshold, best other null mean
+    − margin)."""
+    import pandas as pd
+
+    null_rows = pd.DataFrame([
+        {"set": "null", "named": "unexplained", "rss_baseline": 110.0, "dBIC": {"a": -20.0, "b": -2.0}},
+        {"set": "null", "named": "a", "rss_baseline": 95.0, "dBIC": {"a": -30.0, "b": 0.0}},
+        {"set": "null", "named": "unexplained", "rss_baseline": 100.0, "dBIC": {"a": -25.0, "b": 2.0}},
+    ])
+    null = V.Validation(null_rows, {"named": "unexplained", "rss_baseline": 100.0, "dBIC": {"a": -24.0, "b": 1.0}}, {})
+    s = V.null_spread(null)
+    assert s["draws"] == 3 and s["same_verdict"] == 2 and s["rss_pct"] == [10.0, -5.0, 0.0]
+    c = s["candidates"]
+    assert c.loc["a", "mean"] == -25.0 and c.loc["a", "sd"] == pytest.approx(5.0)
+    assert c.loc["b", "mean"] == 0.0 and c.loc["b", "sd"] == pytest.approx(2.0)
+    assert c.loc["a", "unedited"] == -24.0 and list(c.index) == ["a", "b"]
+    real = V.Validation(pd.DataFrame([
+        {"injection": "x", "band": "middle", "magnitude": 1.0, "unit": "1", "expected": "b", "named": "a",
+         "correct": False, "added_pct": 3.0, "expected_dBIC": -30.0},
+        {"injection": "y", "band": "large", "magnitude": 2.0, "unit": "1", "expected": "b", "named": "b",
+         "correct": True, "added_pct": 9.0, "expected_dBIC": -40.0},
+        {"injection": "z", "band": "large", "magnitude": 2.0, "unit": "1", "expected": "unexplained",
+         "named": "a", "correct": False, "added_pct": 1.0, "expected_dBIC": np.nan},
+    ]), {}, {})
+    v = V.visibility(real, s, margin=10.0)
+    assert list(v["injection"]) == ["x", "y"]  # z expects no library effect
+    assert v["needed"].tolist() == [-35.0, -35.0]  # a's null mean −25 minus the margin, below −10
+    assert v["reaches"].tolist() == [False, True]
+    assert v["z"].tolist() == pytest.approx([-15.0, -20.0]) and v["null_rss_pct_max"].tolist() == [10.0, 10.0]
+    with pytest.raises(ValueError, match="no 'null' rows"):
+        V.null_spread(real)

@@ -219,7 +219,7 @@ def add_parsers(sub) -> None:
                                             "(in-library and out-of-library effects)")
     v.add_argument("--out", required=True, help="output directory")
     v.add_argument("--set", default="all", help="all (default) or a comma-separated list of: independent, "
-                                                "out-of-library, model-variant")
+                                                "out-of-library, model-variant, null")
     v.add_argument("--per-band", type=int_at_least(1), default=1, help="draws per manipulation and magnitude band")
     v.add_argument("--speed", default="Free", help="speed class of the real data (default Free)")
     v.add_argument("--serial", action="store_true", help="solve in this process without dask")
