@@ -314,8 +314,8 @@ def test_ch7_findings_verdicts():
                               ("NMSK", "Slow"): (0.1, 0.2, 0.4)}.items():   # NMSK Fast: not converged
         rows += [(m, c, "angle", a, a), (m, c, "torque", t, t), (m, c, "grf", g, g)]
     control = pd.DataFrame({"angle": [0.15, 0.1], "torque": [0.25, 0.2], "grf": [0.3, 0.3]}, index=list(classes))
-    cot = pd.DataFrame({"mark": ["", "", "", "NOT CONVERGED: x"], "COT (J/kg/m)": [2.0, 1.5, 1.6, 3.0]},
-                       index=["Slow", "Free", "Ch5", "Fast"])
+    cot = pd.DataFrame({"mark": ["", "", "", "NOT CONVERGED: x"], "COT (J/kg/m)": [2.0, 1.5, 1.6, 3.0],
+                        "speed (m/s)": [0.8, 1.2, 1.2, 1.5]}, index=["Slow", "Free", "Ch5", "Fast"])
     f = pr.ch7_findings(_study(stats, _scores(rows), {}), classes, control, cot, {}, "Ch5")
     assert f[0] == "- 3 of 4 runs converged; not converged: NMSK Fast (Maximum_Iterations_Exceeded); IPOPT solve " \
                    "time 10–40 s per run here vs 4–18 h in the thesis (Table 7.2)."
@@ -331,6 +331,13 @@ def test_ch7_findings_verdicts():
                            "3.00 J/(kg·m); minimum at Free (the natural speed — a U-curve as the thesis reports). "
                            "Thesis (Fig 7.5): 2.18, 1.99, 1.53, 1.96, 1.99 at XS, S, N, M, L.")
     assert f[3].endswith("The Ch 5 NMSK solution (Eq 5.55, its own activation parameters) has 1.60; it is not on the curve.")
+    # minimum at Free but a step the wrong way after it: not a U
+    cot.loc["VeryFast"] = ["", 2.5, 1.9]
+    f = pr.ch7_findings(_study(stats, _scores(rows), {}), classes, control, cot, {}, "Ch5")
+    assert "minimum at Free (the natural speed, but not a U: the COT moves the wrong way between Fast 3.00 → " \
+           "VeryFast 2.50)." in f[3]
+    assert pr.u_breaks({"a": (1.0, 3.0), "b": (2.0, 2.0), "c": (3.0, 2.5)}) == []
+    assert pr.u_breaks({"a": (1.0, 3.0), "b": (2.0, 3.5), "c": (3.0, 2.0)}) == ["a 3.00 → b 3.50"]
 
 
 def test_mesh_verdict_says_whether_the_real_data_verdict_depends_on_the_mesh():
@@ -348,6 +355,16 @@ def test_mesh_verdict_says_whether_the_real_data_verdict_depends_on_the_mesh():
     assert other.startswith("**The real-data verdict depends on the mesh**")
     assert "top arm_swing" in other and "ΔBIC -14.0" in other and "not measured" in other
     assert gs.mesh_verdict(table("left_shift", "explained"), -10).startswith("**The real-data verdict depends")
+    # with the null draws: how often the verdict changed at one mesh, the candidates' ΔBIC spread
+    from gaitlib.gap import validate as V
+
+    null = V.Validation(pd.DataFrame([
+        {"set": "null", "named": "unexplained", "rss_baseline": 100.0, "dBIC": {"a": -20.0, "b": -2.0}},
+        {"set": "null", "named": "a", "rss_baseline": 100.0, "dBIC": {"a": -30.0, "b": 2.0}},
+        {"set": "null", "named": "b", "rss_baseline": 100.0, "dBIC": {"a": -25.0, "b": 0.0}},
+    ]), {"named": "unexplained", "rss_baseline": 100.0, "dBIC": {}}, {})
+    t = gs.mesh_verdict(table("arm_swing"), -10, null)
+    assert "changed it in 2 of 3 draws" in t and "SD of 2.0–5.0" in t and "not measured" not in t.split("chapter's.")[0]
 
 
 def test_ch5_profile_rows_and_emg_share(monkeypatch):

@@ -221,3 +221,27 @@ def test_null_spread_and_visibility_by_hand():
     assert v["z"].tolist() == pytest.approx([-15.0, -20.0]) and v["null_rss_pct_max"].tolist() == [10.0, 10.0]
     with pytest.raises(ValueError, match="no 'null' rows"):
         V.null_spread(real)
+
+
+def test_null_lines_count_from_the_runs():
+    import pandas as pd
+    from gaitlib.studies import gap as G
+
+    null = V.Validation(pd.DataFrame([
+        {"set": "null", "named": "unexplained", "rss_baseline": 104.0, "dBIC": {"a": -20.0, "b": -1.0}},
+        {"set": "null", "named": "a", "rss_baseline": 98.0, "dBIC": {"a": -30.0, "b": 1.0}},
+    ]), {"named": "unexplained", "rss_baseline": 100.0, "dBIC": {"a": -24.0, "b": 0.0}}, {})
+    real = V.Validation(pd.DataFrame([
+        {"injection": "x", "band": "middle", "magnitude": 1.0, "unit": "1", "expected": "b", "named": "b",
+         "correct": True, "added_pct": 5.0, "expected_dBIC": -40.0},
+        {"injection": "x", "band": "small", "magnitude": 0.5, "unit": "1", "expected": "b", "named": "a",
+         "correct": False, "added_pct": 1.0, "expected_dBIC": -2.0},
+    ]), {}, {})
+    first, second = G.null_lines(null, real)
+    assert "RSS moved by -2.0 to +4.0 %" in first and "in 1 of 2 draws (otherwise: a 1×)" in first
+    assert "a -24.0, -25.0 ± 7.1 (-30.0 to -20.0)" in first
+    assert ("of the 1 independent injections at middle and large magnitudes the injected effect's ΔBIC moved beyond "
+            "twice its null SD in 1 of 1") in second
+    assert "reached what naming needs against the other candidates' null ΔBIC in 1" in second
+    assert "largest change (4.0 %) in 1; named right: 1" in second
+    assert "At small magnitudes: the injected effect's ΔBIC moved beyond twice its null SD in 0 of 1" in second

@@ -156,7 +156,8 @@ def test_reading_of_the_ch6_ch7_runs(monkeypatch):
 def test_cot_minimum_text_needs_every_speed():
     import pandas as pd
     from gaitlib.studies import predictive as pr
-    full = pd.DataFrame({"mark": ["", "", ""]}, index=["Slow", "Free", "Fast"])
+    full = pd.DataFrame({"mark": ["", "", ""], "speed (m/s)": [0.8, 1.2, 1.5], "COT (J/kg/m)": [2.0, 1.5, 1.8]},
+                        index=["Slow", "Free", "Fast"])
     assert "a U-curve as the thesis reports" in pr._cot_minimum_text("Free", full)
     gap = pd.DataFrame({"mark": ["NOT CONVERGED: x", "", ""]}, index=["Slow", "Free", "Fast"])
     t = pr._cot_minimum_text("Free", gap)

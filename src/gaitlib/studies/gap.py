@@ -53,7 +53,7 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "NMSK_CANDIDATES", "effect_tabl
            "sk_diagnosis", "nmsk_attribution", "ch5_attribution", "ch5_profile", "emg_gap_table", "exact_left_leg", "left_leg_check",
            "book_gaps", "twin_validation_full_mesh", "twin_full_mesh_lines", "twin_full_mesh_verdict",
            "left_leg_flips", "co_contraction_text", "findings",
-           "validation_cases", "validation_lines", "visibility_text",
+           "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines",
            "VALIDATION_RUNS", "stored_validation"]
 
 #: Baseline of the twin study: SK, data tracking (Eq 4.11), 10 × 3 LGR — the coarse mesh (the full 20 × 5 mesh costs ≈ 10× per solve and the twin study
@@ -302,6 +302,7 @@ VALIDATION_RUNS = {
             "benchmarks/results/gap_validation/real",
     "variants": "gaitlib gap-validate --set model-variant --derivatives nodes --out "
                 "benchmarks/results/gap_validation/variants",
+    "null": "gaitlib gap-validate --set null --derivatives nodes --out benchmarks/results/gap_validation/null",
 }
 
 
@@ -404,6 +405,59 @@ def visibility_text(v: gval.Validation) -> str:
     return out + "."
 
 
+def null_tables(null: gval.Validation, real: gval.Validation) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(every candidate's ΔBIC on the unedited data and over ``null``'s draws; each
+    independent injection of ``real`` against that spread): :func:`gaitlib.gap.validate.null_spread`,
+    :func:`gaitlib.gap.validate.visibility`."""
+    sp = gval.null_spread(null)
+    return sp["candidates"], gval.visibility(real, sp)
+
+
+def null_lines(null: gval.Validation, real: gval.Validation, top: int = 4) -> list[str]:
+    """What the diagnosis does with nothing injected (``null``'s draws: the unedited data
+    resampled within SD/√n), and each independent injection of ``real`` against that spread
+    (:func:`gaitlib.gap.validate.visibility`), in sentences computed from the two runs."""
+    sp = gval.null_spread(null)
+    c = sp["candidates"]
+    k = sp["draws"]
+    others = {n: m for n, m in sp["verdicts"].items() if n != null.unedited["named"]}
+    rss = sp["rss_pct"]
+    lines = [f"**With nothing injected** ({k} draws of the unedited data's means within SD/√n): the baseline fit's "
+             f"RSS moved by {min(rss):+.1f} to {max(rss):+.1f} % of the unedited data's "
+             f"({null.unedited['rss_baseline']:.0f}), and the verdict was the unedited data's "
+             f"({null.unedited['named']}) in {sp['same_verdict']} of {k} draws"
+             + (" (otherwise: " + ", ".join(f"{n} {m}×" for n, m in others.items()) + ")" if others else "") + ". "
+             "The candidates that close the most of the data's own gap, ΔBIC on the unedited data and over the draws "
+             "(mean ± SD, range): "
+             + "; ".join(f"{e} {r['unedited']:.1f}, {r['mean']:.1f} ± {r['sd']:.1f} ({r['min']:.1f} to {r['max']:.1f})"
+                         for e, r in c.head(top).iterrows()) + "."]
+    v = gval.visibility(real, sp)
+    if v.empty:
+        return lines
+    mid = v[v["band"].isin(["middle", "large"])]
+
+    def part(d):
+        moved = d[d["z"] <= -2.0]
+        return (f"the injected effect's ΔBIC moved beyond twice its null SD in {len(moved)} of {len(d)} (z ≤ −2), "
+                f"reached what naming needs against the other candidates' null ΔBIC in {int(d['reaches'].sum())}, "
+                f"and the baseline's RSS changed by more than the null draws' largest change "
+                f"({d['null_rss_pct_max'].iloc[0]:.1f} %) in {int((d['added_pct'].abs() > d['null_rss_pct_max']).sum())}; "
+                f"named right: {int(d['correct'].sum())}")
+
+    lines.append(f"**Against this spread**, of the {len(mid)} independent injections at middle and large magnitudes "
+                 + part(mid) + ". At small magnitudes: " + part(v[v["band"] == "small"]) + ".")
+    named_unreached = mid[mid["correct"] & ~mid["reaches"]]
+    missed_reached = mid[~mid["correct"] & mid["reaches"]]
+    if len(missed_reached):
+        lines.append("Reached what naming needs but not named right: " + "; ".join(
+            f"{r.injection} {r.band} (ΔBIC {r.dBIC:.1f}, needed {r.needed:.1f}; named {r.named})"
+            for r in missed_reached.itertuples()) + ".")
+    if len(named_unreached):
+        lines.append("Named right without reaching it (another candidate fell short of its null mean): " + "; ".join(
+            f"{r.injection} {r.band}" for r in named_unreached.itertuples()) + ".")
+    return lines
+
+
 def mesh_table(diags: dict, index: str = "mesh") -> pd.DataFrame:
     """The same data diagnosed on several meshes (``diags``: mesh label → Diagnosis; or
     other variants, named by ``index``): the baseline's status, RMS z and significant cells,
@@ -419,18 +473,30 @@ def mesh_table(diags: dict, index: str = "mesh") -> pd.DataFrame:
     return pd.DataFrame(rows).set_index(index)
 
 
-def mesh_verdict(table: pd.DataFrame, threshold: float) -> str:
+def mesh_verdict(table: pd.DataFrame, threshold: float, null: gval.Validation | None = None) -> str:
     """One sentence: whether the verdict on the real data depends on the mesh
-    (:func:`mesh_table`), with the numbers; ``threshold``: the ΔBIC naming threshold."""
+    (:func:`mesh_table`), with the numbers; ``threshold``: the ΔBIC naming threshold;
+    ``null``: the null draws (:func:`gaitlib.gap.validate.null_spread`, 10 × 3), whose
+    verdict changes measure how stable a verdict is at one mesh."""
     verdicts = {f"{v} ({t})" if t != "—" else v for v, t in zip(table["verdict"], table["top effect"])}
     parts = "; ".join(f"{m}: {r['verdict']}" + (f", top {r['top effect']}" if r["top effect"] != "—" else "")
                       + (f", best candidate {r['best candidate']} at ΔBIC {r['its ΔBIC']:.1f}" if r["best candidate"] != "—" else "")
                       for m, r in table.iterrows())
     if len(verdicts) == 1:
         return f"**The real-data verdict does not depend on the mesh** ({parts}; naming threshold ΔBIC ≤ {threshold:g})."
-    return (f"**The real-data verdict depends on the mesh** ({parts}; naming threshold ΔBIC ≤ {threshold:g}): "
+    head = (f"**The real-data verdict depends on the mesh** ({parts}; naming threshold ΔBIC ≤ {threshold:g}): "
             "a user running `gaitlib gap` at its default coarse mesh would read another verdict than this "
-            "chapter's. The cause of the difference is not measured here.")
+            "chapter's.")
+    if null is None:
+        return head + " The cause of the difference is not measured here."
+    sp = gval.null_spread(null)
+    top = sp["candidates"].head(4)
+    return (head + f" The verdict is not stable at one mesh either: on the 10 × 3 mesh, redrawing the data's means "
+            f"within their sampling error changed it in {sp['draws'] - sp['same_verdict']} of {sp['draws']} draws, "
+            f"and the leading candidates' ΔBIC moved with an SD of {top['sd'].min():.1f}–{top['sd'].max():.1f} between "
+            f"draws, against a naming threshold and runner-up margin of {abs(threshold):g} and "
+            f"{gap_method.RUNNER_UP_MARGIN:g}. A change of mesh is a change of that size; whether the 20 × 5 verdict is "
+            "steadier is not measured (its draws would cost ≈ 10× as much).")
 
 
 def path_verdict(table: pd.DataFrame, pairs: list, threshold: float) -> str:

@@ -50,7 +50,7 @@ from ..marks import failure_label
 __all__ = ["CH6_COSTS", "CH7_CLASSES", "THESIS_CLASS", "THESIS_HOURS_TABLE_6_3", "THESIS_HOURS_TABLE_7_2",
            "THESIS_COT_FIG_7_5", "THESIS_FP_GAIN_PCT", "THESIS_FP_EXCITATION_GAIN_PCT",
            "THESIS_TORQUE_GAIN_PCT_CH7", "BASELINE_COST", "GUESS_POLICY", "baseline", "default_params", "thesis_guess", "run_guess", "ch6_specs", "ch7_specs",
-           "score", "excitation_score", "StudyResult", "cost_function_study", "speed_study", "cot_table",
+           "score", "excitation_score", "StudyResult", "cost_function_study", "speed_study", "cot_table", "u_breaks",
            "times_table", "SDT3_ENOUGH_FACTOR", "COT_CURVE_MIN_POINTS", "kind_nrmse", "mean_nrmse", "ch6_findings",
            "ch7_findings", "cot_figure"]
 
@@ -350,6 +350,7 @@ class StudyResult:
     scores: pd.DataFrame = field(default_factory=pd.DataFrame)
     guess: dict = field(default_factory=dict)  # model → "thesis" | "ch5" (run_guess)
     guesses: dict = field(default_factory=dict, repr=False)  # run → the initial guess used
+    rerun_used: tuple = ()  # runs whose converged rerun stands in for them (:meth:`with_reruns`)
 
     def rerun(self, name: str, *, root=None, progress: bool = False, **changes) -> gait_ocp.GaitSolution:
         """Run ``name`` again from the same initial guess with spec fields changed (e.g.
@@ -362,6 +363,33 @@ class StudyResult:
         """:meth:`rerun` every run whose record is not ok with ``max_iter`` iterations:
         name → GaitSolution (the investigation of runs that stopped at the limit)."""
         return {k: self.rerun(k, max_iter=max_iter, **kw) for k, r in self.records.items() if not r.ok}
+
+    def with_reruns(self, reruns: dict) -> "StudyResult":
+        """This study with each run that is marked (did not converge, or fails the validity
+        gates) replaced by its rerun in ``reruns`` (:meth:`rerun_failed`) where that rerun
+        converged and passes the gates: its record, solution, spec and scores.
+        :attr:`rerun_used` names the replaced runs (every use is labelled by the caller).
+        The book's rule for results built on several runs (Chs 6–7): a run that stopped at
+        the 1000-iteration limit is represented by its converged 3000-iteration rerun, from
+        the same start, rather than left out; a rerun that did not converge or is invalid
+        changes nothing."""
+        use = {k: s for k, s in reruns.items()
+               if k in self.records and s is not None and s.stats.get("success") and not marks.failure_label(s)
+               and marks.failure_label(self.solutions.get(k, self.records[k]))}
+        if not use:
+            return self
+        recs, sols, specs = dict(self.records), dict(self.solutions), dict(self.specs)
+        for k, s in use.items():
+            recs[k] = replace(recs[k], ok=True, status=s.stats["status"], value=s, error=None)
+            sols[k], specs[k] = s, s.spec
+        gaits = {(s.spec.speed_class, s.spec.source): data_mod.load_gait_data(s.spec.speed_class, s.spec.source)
+                 for s in use.values()}
+        new = _scores(use, gaits, lambda s: (s.spec.speed_class, s.spec.source))
+        sc = self.scores[~self.scores["run"].isin(list(use))] if not self.scores.empty else self.scores
+        order = {k: i for i, k in enumerate(self.records)}
+        sc = pd.concat([sc, new], ignore_index=True).sort_values("run", key=lambda r: r.map(order), kind="stable")
+        return replace(self, specs=specs, records=recs, solutions=sols, scores=sc.reset_index(drop=True),
+                       rerun_used=tuple(self.rerun_used) + tuple(use))
 
     def rerun_table(self, reruns: dict) -> pd.DataFrame:
         """The study's own status and objective of each rerun run beside the rerun's."""
@@ -734,15 +762,31 @@ def ch6_findings(res: StudyResult, thesis_guess_stats: pd.DataFrame, reruns: dic
     return lines
 
 
+def u_breaks(points: dict) -> list[str]:
+    """Where a COT curve is not U-shaped: ``points`` label → (speed, COT); the steps (in
+    order of speed) that rise before the minimum or fall after it, as ``"A 3.83 → B 4.08"``;
+    empty for a U (or a monotone curve's one arm)."""
+    order = sorted(points, key=lambda k: points[k][0])
+    cots = [points[k][1] for k in order]
+    i = int(np.argmin(cots))
+    return [f"{order[j]} {cots[j]:.2f} → {order[j + 1]} {cots[j + 1]:.2f}" for j in range(len(cots) - 1)
+            if (j < i and cots[j + 1] > cots[j]) or (j >= i and cots[j + 1] < cots[j])]
+
+
 def _cot_minimum_text(imin: str, curve: pd.DataFrame) -> str:
     """What the COT minimum ``imin`` of the unmarked points says; with a speed left out
-    (marked: not converged or invalid) the U-curve claim is not tested."""
+    (marked: not converged or invalid) the U-curve claim is not tested; with the minimum at
+    Free but a step the wrong way (:func:`u_breaks`), it is not a U."""
     left = [c for c, m in curve["mark"].items() if m]
     if imin != "Free":
         return "not at the natural speed — no U-curve with the minimum at Free"
     if left:
         return (f"the natural speed among these points, but the U-curve claim is not tested: {', '.join(left)} "
                 "left out (not converged or invalid)")
+    ok = curve[curve["mark"] == ""]
+    breaks = u_breaks({c: (r["speed (m/s)"], r["COT (J/kg/m)"]) for c, r in ok.iterrows()})
+    if breaks:
+        return "the natural speed, but not a U: the COT moves the wrong way between " + "; ".join(breaks)
     return "the natural speed — a U-curve as the thesis reports"
 
 
@@ -754,10 +798,15 @@ def ch7_findings(res: StudyResult, classes, control: pd.DataFrame, cot: pd.DataF
     time-scaled Free data they tracked (``control``: class × kind NRMSE of that data against
     the class's); the COT curve (:func:`cot_table`; its minimum, with at least
     :data:`COT_CURVE_MIN_POINTS` converged points; row ``ch5_row`` is the Ch 5 solution,
-    off the curve); and the 3000-iteration ``reruns`` of NMSK runs."""
+    off the curve); and the 3000-iteration ``reruns`` of the runs that stopped at the limit
+    (those in ``res.rerun_used`` stand in for them, :meth:`StudyResult.with_reruns`)."""
     stats = res.stats()
     pred_ok = kind_nrmse(res.converged_scores())
-    lines = [_converged_line(stats)
+    used, rerun_used = "", tuple(getattr(res, "rerun_used", ()))
+    if rerun_used:
+        used = (f" ({len(stats) - len(rerun_used)} within 1000 iterations; "
+                + ", ".join(f"{k} in its 3000-iteration rerun" for k in rerun_used) + ")")
+    lines = [_converged_line(stats, used)
              + f"; IPOPT solve time {stats['solve (s)'].min():.0f}–{stats['solve (s)'].max():.0f} s per run here vs "
                "4–18 h in the thesis (Table 7.2)."]
     both = [c for c in classes if ("NMSK", c) in pred_ok.index and ("MSK", c) in pred_ok.index]
@@ -788,11 +837,17 @@ def ch7_findings(res: StudyResult, classes, control: pd.DataFrame, cot: pd.DataF
                      + (f" The Ch 5 NMSK solution (Eq 5.55, its own activation parameters) has {r5['COT (J/kg/m)']:.2f}"
                         + (f" ({r5['mark']})" if r5["mark"] else "") + "; it is not on the curve." if r5 is not None else ""))
     for k, r in reruns.items():
-        if k.startswith("NMSK "):
+        cot_text = f" with COT {r.stats['COT']:.2f} J/(kg·m)" if np.isfinite(r.stats.get("COT", np.nan)) else ""
+        if k in rerun_used:
+            lines.append(f"- {k} stopped at 1000 iterations; its 3000-iteration rerun converged ({r.stats['status']}, "
+                         f"{r.stats['iterations']} iterations){cot_text}, passes the validity gates and stands in "
+                         "for it in every result on this page except the compute times.")
+        else:
             lines.append(f"- {k} stopped at 1000 iterations; rerun at 3000 it "
                          f"{'converged' if r.stats['success'] else 'did NOT converge'} ({r.stats['status']}, "
-                         f"{r.stats['iterations']} iterations) with COT {r.stats.get('COT', float('nan')):.2f} J/(kg·m) "
-                         "(not in the figure, which keeps the study's own runs).")
+                         f"{r.stats['iterations']} iterations){cot_text}; "
+                         + ("it fails a validity gate, so " if r.stats['success'] else "")
+                         + "it is not used: the run stays marked and out of the findings.")
     return lines
 
 
