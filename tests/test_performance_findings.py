@@ -225,3 +225,34 @@ def test_moco_line_gives_the_best_variant_against_the_targets():
            "(target ≥ 5×: met)" in line
     del res["speedups"]["hermite-simpson"]["speedup_best"]  # an older results file: no such clause
     assert "fastest converged" not in perf._moco_lines(perf.moco_table(res))[0]
+
+
+def test_ipopt_options_findings_separate_same_and_other_solutions():
+    """Hand-made screen: a variant with fewer iterations on another solution (> 1°) is
+    named as such; one within 1° of the default's is the lever, with the iterations the
+    target allows at the default's time per iteration; an option IPOPT rejects is a row
+    without numbers."""
+    from gaitlib.studies import performance as perf
+
+    ok = "Solve_Succeeded"
+    res = {"rows": [
+        {"variant": "default", "options": {}, "status": ok, "iterations": 400, "solve_s": 40.0,
+         "ms_per_iteration": 100.0, "objective": 0.10, "inertia_corrections": 360, "rms_vs_default_deg": 0.0,
+         "load_at_start": 0.5},
+        {"variant": "A", "options": {"mu_init": 0.01}, "status": ok, "iterations": 200, "solve_s": 20.0,
+         "ms_per_iteration": 100.0, "objective": 0.15, "inertia_corrections": 100, "rms_vs_default_deg": 6.0,
+         "load_at_start": 1.0},
+        {"variant": "B", "options": {"bound_push": 1e-6}, "status": ok, "iterations": 300, "solve_s": 33.0,
+         "ms_per_iteration": 110.0, "objective": 0.099, "inertia_corrections": 270, "rms_vs_default_deg": 0.5,
+         "load_at_start": 2.0},
+        {"variant": "C", "options": {"x": "y"}, "status": "Invalid_Option (not in this IPOPT build)"},
+    ]}
+    t = perf.ipopt_options_table(res)
+    assert t.loc["B", "options"] == "bound_push=1e-06" and t.loc["default", "options"] == "—"
+    assert t.loc["C", "status"].startswith("Invalid_Option")
+    f = perf.ipopt_options_findings(res, target_s=20.0)
+    assert f[0].startswith("• The default needed 400 iterations (40.0 s), 360 of them with an inertia correction; "
+                           "in the converged variants 50–90 %")
+    assert "A 200 it, objective 0.15 (+50 %), 6.0° from the default's" in f[1]
+    assert "B 300 it, objective 0.099 (-1.0 %)" in f[2] and "B, takes 25 % fewer iterations" in f[2]
+    assert "would allow 200 iterations, against its 300" in f[2] and "between 0.5 and 2.0" in f[2]

@@ -184,6 +184,26 @@ if e2e is not None:
     print("\n".join(perf.e2e_findings(e2e)))
 
 # %% [markdown]
+# ### Fewer iterations? IPOPT's own options
+#
+# On the compiled path the rest is IPOPT's own work per iteration, so the other lever is
+# the number of iterations. `bench_ipopt_options.py` solves the same MSK DT Free problem
+# (20 × 5, per-node derivatives, compiled, from its data-based guess) once per variant of
+# IPOPT's options — the barrier's start (`mu_init`), the NLP scaling, how far the start is
+# pushed inside the bounds, the Hessian regularisation's schedule, the curvature test that
+# replaces the inertia test, the adaptive barrier — and reads IPOPT's iteration log for the
+# iterations that needed an inertia correction. A variant that lands on another local
+# optimum is another result, not the same one faster: the last column is the RMS distance of
+# its joint angles from the default variant's solution.
+
+# %%
+ipo = perf.load_optional("ipopt_options")
+if ipo is not None:
+    print(perf.measured_on(ipo))
+    display(perf.ipopt_options_table(ipo))
+    print("\n".join(perf.ipopt_options_findings(ipo)))
+
+# %% [markdown]
 # ## Every optimisation of the book beside the thesis's times
 #
 # `bench_thesis_times.py` lists every optimisation the chapters run — by calling the same

@@ -338,6 +338,61 @@ def e2e_findings(res: dict) -> list[str]:
     return out
 
 
+def ipopt_options_table(res: dict) -> pd.DataFrame:
+    """``bench_ipopt_options.py``: one row per IPOPT option variant on the MSK gait problem —
+    status, iterations, solve time, objective, the iterations that needed an inertia
+    correction, and the RMS distance of its joint angles from the default variant's."""
+    cols = {"variant": "variant", "options": "options", "status": "status", "iterations": "iterations",
+            "solve_s": "solve (s)", "ms_per_iteration": "ms / iteration", "objective": "objective",
+            "inertia_corrections": "inertia corrections", "median_lg_dw": "median log10 δ_w",
+            "restoration_iterations": "restoration iterations", "rms_vs_default_deg": "RMS from default (deg)"}
+    df = pd.DataFrame(res.get("rows", []))
+    df["options"] = df["options"].map(lambda d: ", ".join(f"{k}={v}" for k, v in dict(d).items()) or "—")
+    return df[[c for c in cols if c in df.columns]].rename(columns=cols).set_index("variant")
+
+
+#: A variant lands on "the same solution" as the default within this RMS of the joint angles.
+SAME_SOLUTION_DEG = 1.0
+
+
+def ipopt_options_findings(res: dict, target_s: float = E2E_TARGETS["gait"]) -> list[str]:
+    """What the option screen says, computed from its rows: how often the Hessian needed an
+    inertia correction, which variants cut the iterations and whether they kept the default's
+    solution (within :data:`SAME_SOLUTION_DEG`) and objective, and the best such variant
+    against the iterations ``target_s`` allows."""
+    rows = [r for r in res.get("rows", []) if "iterations" in r]
+    d = next((r for r in rows if r["variant"] == "default"), None)
+    if d is None:
+        return []
+    conv = [r for r in rows if r["status"] in ("Solve_Succeeded", "Solved_To_Acceptable_Level")]
+    share = [100.0 * r["inertia_corrections"] / max(r["iterations"], 1) for r in conv]
+    out = [f"• The default needed {d['iterations']} iterations ({d['solve_s']:.1f} s), {d['inertia_corrections']} of "
+           f"them with an inertia correction; in the converged variants {min(share):.0f}–{max(share):.0f} % of the "
+           f"iterations did (the fewest with the curvature test that replaces the inertia test)."]
+    fewer = [r for r in conv if r["variant"] != "default" and r["iterations"] < d["iterations"]]
+    same = [r for r in fewer if r["rms_vs_default_deg"] <= SAME_SOLUTION_DEG]
+    other = [r for r in fewer if r["rms_vs_default_deg"] > SAME_SOLUTION_DEG]
+    if other:
+        out.append("• Fewer iterations, another solution: " + "; ".join(
+            f"{r['variant']} {r['iterations']} it, objective {r['objective']:.4g} ({100 * (r['objective'] / d['objective'] - 1):+.0f} %), "
+            f"{r['rms_vs_default_deg']:.1f}° from the default's" for r in other) + f" (default objective {d['objective']:.4g}).")
+    if same:
+        b = min(same, key=lambda r: r["iterations"])
+        allowed = target_s / (d["ms_per_iteration"] / 1e3)
+        loads = [r.get("load_at_start", np.nan) for r in rows]
+        out.append(f"• Fewer iterations, the same solution (within {SAME_SOLUTION_DEG:g}°): " + "; ".join(
+            f"{r['variant']} {r['iterations']} it, objective {r['objective']:.4g} "
+            f"({100 * (r['objective'] / d['objective'] - 1):+.1f} %)" for r in same)
+            + f". The best, {b['variant']}, takes {100 * (1 - b['iterations'] / d['iterations']):.0f} % fewer iterations; "
+              f"at the default's {d['ms_per_iteration']:.0f} ms per iteration the {target_s:.0f}-s target would allow "
+              f"{allowed:.0f} iterations, against its {b['iterations']}. (Times per iteration are not compared here: "
+              f"the variants ran one after another with the 1-minute load at start between {np.nanmin(loads):.1f} and "
+              f"{np.nanmax(loads):.1f} on 2 cores.)")
+    else:
+        out.append(f"• No variant cut the iterations and kept the default's solution (within {SAME_SOLUTION_DEG:g}°).")
+    return out
+
+
 def msk_profile_tables(res: dict | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
     """``bench_msk_profile.py``: (runs, graph sizes). Runs: per IPOPT option variant, status,
     iterations, solve time (s), ms per iteration, IPOPT's split of the solve (Lagrangian
