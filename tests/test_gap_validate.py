@@ -245,3 +245,21 @@ def test_null_lines_count_from_the_runs():
     assert "reached what naming needs against the other candidates' null ΔBIC in 1" in second
     assert "largest change (4.0 %) in 1; named right: 1" in second
     assert "At small magnitudes: the injected effect's ΔBIC moved beyond twice its null SD in 0 of 1" in second
+
+
+def test_null_refit_lines_count_from_the_experiment():
+    from gaitlib.studies import gap as G
+
+    refit = {"top": 3, "cases": {
+        "unedited": {"source": "kept", "rss0": 100.0, "rss1": 100.0, "named0": "unexplained", "named1": "unexplained",
+                     "dBIC0": {"a": -5.0, "b": 0.0}, "dBIC1": {"a": -5.0, "b": 0.0}},
+        "null_0": {"source": "a", "rss0": 110.0, "rss1": 99.0, "named0": "a", "named1": "unexplained",
+                   "dBIC0": {"a": -30.0, "b": 0.0}, "dBIC1": {"a": -2.0, "b": -10.0}},
+        "null_1": {"source": "kept", "rss0": 100.0, "rss1": 100.0, "named0": "unexplained", "named1": "unexplained",
+                   "dBIC0": {"a": -10.0, "b": 2.0}, "dBIC1": {"a": -4.0, "b": 10.0}},
+    }}
+    (line,) = G.null_refit_lines(refit, top=2)
+    assert "A better baseline was found in 1 of 3 cases (RSS lower by 10.0–10.0 %)" in line
+    assert "verdicts changed in 1 (null_0: a → unexplained)" in line
+    assert "an effect was named in 0 of 2 draws after against 1 before" in line
+    assert "a 14.1 → 1.4; b 1.4 → 14.1" in line and "largest SD after it: b, 14.1" in line

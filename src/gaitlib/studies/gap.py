@@ -28,6 +28,7 @@ functions run serially (one process) unless ``serial=False`` is passed.
 from __future__ import annotations
 
 import contextlib
+import json
 from dataclasses import replace
 
 import numpy as np
@@ -53,7 +54,7 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "NMSK_CANDIDATES", "effect_tabl
            "sk_diagnosis", "nmsk_attribution", "ch5_attribution", "ch5_profile", "emg_gap_table", "exact_left_leg", "left_leg_check",
            "book_gaps", "twin_validation_full_mesh", "twin_full_mesh_lines", "twin_full_mesh_verdict",
            "left_leg_flips", "co_contraction_text", "findings",
-           "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines",
+           "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
            "VALIDATION_RUNS", "stored_validation"]
 
 #: Baseline of the twin study: SK, data tracking (Eq 4.11), 10 × 3 LGR — the coarse mesh (the full 20 × 5 mesh costs ≈ 10× per solve and the twin study
@@ -456,6 +457,56 @@ def null_lines(null: gval.Validation, real: gval.Validation, top: int = 4) -> li
         lines.append("Named right without reaching it (another candidate fell short of its null mean): " + "; ".join(
             f"{r.injection} {r.band}" for r in named_unreached.itertuples()) + ".")
     return lines
+
+
+#: The stored result of ``benchmarks/gap_null_refit.py`` (the null set's baselines re-fitted).
+NULL_REFIT_FILE = "null_refit.json"
+
+
+def stored_null_refit() -> dict | None:
+    """``benchmarks/gap_null_refit.py``'s result, or None if absent; refused if made with
+    another method than the current one."""
+    f = perf.results_dir() / "gap_validation" / NULL_REFIT_FILE
+    if not f.is_file():
+        return None
+    r = json.loads(f.read_text())
+    if r.get("method_hash") != gap_method.METHOD.hash():
+        raise RuntimeError(f"{f}: made with method {r.get('method_hash')}, the method is now "
+                           f"{gap_method.METHOD.hash()}: rerun benchmarks/gap_null_refit.py")
+    return r
+
+
+def null_refit_lines(refit: dict, top: int = 4) -> list[str]:
+    """The refit experiment (:func:`stored_null_refit`) in sentences computed from it: how
+    often a top candidate's solution gave a better baseline, the verdicts before and after,
+    and the candidates' ΔBIC spread between the draws before and after."""
+    cases = refit["cases"]
+    draws = [k for k in cases if k != "unedited"]
+    better = [k for k, c in cases.items() if c["source"] != "kept"]
+    drops = [100.0 * (1 - cases[k]["rss1"] / cases[k]["rss0"]) for k in better]
+    sd = {}
+    for when in ("0", "1"):
+        df = pd.DataFrame({k: cases[k][f"dBIC{when}"] for k in draws})
+        sd[when] = pd.DataFrame({"mean": df.mean(axis=1), "sd": df.std(axis=1)})
+    lead = list(dict.fromkeys(list(sd["0"].sort_values("mean").index[:top]) + list(sd["1"].sort_values("mean").index[:top])))
+    changed = [f"{k}: {c['named0']} → {c['named1']}" for k, c in cases.items() if c["named0"] != c["named1"]]
+    named = {w: sum(cases[k][f"named{w}"] != "unexplained" for k in draws) for w in ("0", "1")}
+    worst = sd["1"]["sd"].idxmax()
+    return [f"**Is the spread the baseline's local optimum?** An experiment outside the frozen method "
+            f"(`benchmarks/gap_null_refit.py`): the baseline re-fitted from each of the top {refit['top']} candidates' "
+            f"solutions (their effect parameters dropped), and, where that gave a lower objective, every candidate "
+            f"re-fitted from the new baseline and ranked again. A better baseline was found in {len(better)} of "
+            f"{len(cases)} cases"
+            + (f" (RSS lower by {min(drops):.1f}–{max(drops):.1f} %)" if drops else "")
+            + f"; verdicts changed in {len(changed)}" + (f" ({'; '.join(changed)})" if changed else "")
+            + f", and an effect was named in {named['1']} of {len(draws)} draws after against {named['0']} before. "
+            "The candidates' ΔBIC SD between the draws, before → after: "
+            + "; ".join(f"{e} {sd['0'].loc[e, 'sd']:.1f} → {sd['1'].loc[e, 'sd']:.1f}" for e in lead
+                        if e in sd["0"].index and e in sd["1"].index)
+            + f". One round of re-fitting moves which candidate looks best but does not steady the ranking (the "
+              f"largest SD after it: {worst}, {sd['1'].loc[worst, 'sd']:.1f}, against a runner-up margin of "
+              f"{gap_method.RUNNER_UP_MARGIN:g}): a change of the data within its sampling error still moves the "
+              "candidates' ΔBIC by more than the method's margins."]
 
 
 def mesh_table(diags: dict, index: str = "mesh") -> pd.DataFrame:
