@@ -563,3 +563,52 @@ def test_data_signature_sees_a_column_scaled_by_a_power_of_ten(real):
     g = real.gait
     scaled = dataclasses.replace(g, sd=g.sd * 10.0)
     assert gio.signature(scaled) != gio.signature(g)
+
+
+def test_activation_timing_twin_carries_the_delay_in_its_emg(real):
+    """Activation timing is comparison-only (no re-solve): its twin must carry it in the
+    data — the twin's EMG at t is the model's activation at t + Δd — and the effect's own
+    data adjustment (the data's EMG at t − Δd) undoes it; angles, torques and GRFs equal the
+    effect-free twin's."""
+    import dataclasses
+
+    from gaitlib.gap import twin
+
+    spec = gait_ocp.GaitSpec(model="MSK", cost="DT", n_intervals=4, degree=2, max_iter=40, derivatives="nodes")
+    gp = gait_ocp.build(spec)
+    sol = gait_ocp.postprocess(gp, ocp.transcribe(gp.problem, gp.mesh, ocp.SolverOptions(max_iter=0)).solve(gp.guess))
+    dd = 0.04
+    sol_d = dataclasses.replace(sol, spec=dataclasses.replace(spec, effects=(("activation_timing", dd),)))
+    a = twin.twin_frame(sol, real, seed=None, noise=False)
+    b = twin.twin_frame(sol_d, real, seed=None, noise=False)
+    emg = a["quantity"].str.startswith("emg_")
+    assert emg.any()
+    assert np.array_equal(a.loc[~emg, "mean"].to_numpy(), b.loc[~emg, "mean"].to_numpy())
+    assert not np.allclose(a.loc[emg, "mean"].to_numpy(), b.loc[emg, "mean"].to_numpy())
+    # hand check on one channel: b(τ) = a(τ + Δd/T), a periodic curve sampled every 2 %
+    T = real.gait.cycle_time
+    q = a["quantity"].iloc[int(np.flatnonzero(emg.to_numpy())[0])]
+    pick = lambda f: f[(f["quantity"] == q) & (f["side"] == "R")].sort_values("percent_cycle")  # noqa: E731
+    pa, pb = pick(a), pick(b)
+    tau = pa["percent_cycle"].to_numpy() / 100
+    ya = pa["mean"].to_numpy()
+    shifted = np.interp(np.mod(tau + dd / T, 1.0), np.concatenate([tau[:-1] - 1, tau[:-1], tau[:-1] + 1]),
+                        np.tile(ya[:-1], 3))
+    assert np.max(np.abs(shifted - pb["mean"].to_numpy())) < 0.05 * np.ptp(ya)
+    # the effect's data adjustment brings the twin's EMG back onto the activations
+    p = effects_mod.EFFECTS["activation_timing"]
+    ds_b = gio.read_data(_write(b, real))
+    back = p.data_adjust(ds_b.gait, {"dd": dd})
+    ds_a = gio.read_data(_write(a, real))
+    col = next(c for c in ds_a.gait.mean.columns if c.startswith("emg_") and c.endswith("_r"))
+    err = back.mean[col].to_numpy() - ds_a.gait.mean[col].to_numpy()
+    assert np.max(np.abs(err[5:-5])) < 0.05 * np.ptp(ds_a.gait.mean[col].to_numpy())
+
+
+def _write(frame, real):
+    import tempfile
+    from pathlib import Path
+
+    p = Path(tempfile.mkdtemp()) / "twin.csv"
+    frame.to_csv(p, index=False, float_format="%.12g")
+    return p

@@ -71,9 +71,15 @@ def twin_frame(sol: gait_ocp.GaitSolution, real: gio.DataSet, seed: int | None, 
     ts = sim.index.to_numpy(float)
     t_data = np.asarray(gait.time, float) / float(gait.cycle_time)
 
-    def at(col):
+    # a comparison-only effect changes no solution, only how the data relate to it: the twin
+    # carries it in its data — activation timing Δd: the model's activation at t is the
+    # data's EMG at t − Δd, so the twin's EMG at t is the activation at t + Δd
+    lead = sum(float(m) for n, m in getattr(sol.spec, "effects", ()) if n == "activation_timing" and m is not None)
+    lead /= float(gait.cycle_time)
+
+    def at(col, shift=0.0):
         ext = np.concatenate([ts - 1.0, ts, ts + 1.0])
-        return np.interp(np.mod(tau, 1.0), ext, np.tile(sim[col].to_numpy(), 3))
+        return np.interp(np.mod(tau + shift, 1.0), ext, np.tile(sim[col].to_numpy(), 3))
 
     def real_sd(col):
         return np.interp(tau, t_data, gait.sd[col].to_numpy())
@@ -91,7 +97,7 @@ def twin_frame(sol: gait_ocp.GaitSolution, real: gio.DataSet, seed: int | None, 
             sd[(q, side)] = np.abs(gio.model_to_data_units(stem, real_sd(f"{stem}_{s_}"), gait.body_mass))
         for c in sim.columns:
             if c.startswith("emg_") and c.endswith(f"_{s_}") and c in gait.sd.columns:
-                values[(c[:-2], side)] = at(c)
+                values[(c[:-2], side)] = at(c, lead)
                 sd[(c[:-2], side)] = real_sd(c)
     if noise:
         rng = np.random.default_rng(seed)

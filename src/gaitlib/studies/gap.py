@@ -50,7 +50,7 @@ from ..marks import failure_label
 from .. import validity
 from . import predictive as pr
 
-__all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "NMSK_CANDIDATES", "effect_table", "twin_validation",
+__all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWIN_MAGNITUDES", "muscle_twin_validation", "NMSK_CANDIDATES", "effect_table", "twin_validation",
            "sk_diagnosis", "nmsk_attribution", "ch5_attribution", "ch5_profile", "emg_gap_table", "exact_left_leg", "left_leg_check",
            "book_gaps", "twin_validation_full_mesh", "twin_full_mesh_lines", "twin_full_mesh_verdict",
            "left_leg_flips", "co_contraction_text", "findings",
@@ -86,6 +86,23 @@ def twin_validation(seeds=TWIN_SEEDS, base: dict | None = None, serial: bool = T
     """:func:`gaitlib.gap.twin.validate_twins` over every SK twin effect × its three
     magnitudes × ``seeds`` with the coarse SK baseline (:data:`TWIN_BASE`)."""
     return twin.validate_twins(seeds=tuple(seeds), base=dict(base or TWIN_BASE), serial=serial, progress=False, **kw)
+
+
+#: Muscle-level twins (issue 25): the MSK baseline at the twins' coarse mesh, per-node derivatives.
+MUSCLE_TWIN_BASE = dict(model="MSK", cost="DT", n_intervals=10, degree=3, derivatives="nodes")
+#: The muscle-level effects (signature: EMG) and the magnitude of each twin — between the
+#: points of the profile grids (:data:`gaitlib.gap.method.PROFILE_GRID`), so that a grid point
+#: cannot hit the truth exactly; activation timing is fitted by a scalar search.
+MUSCLE_TWIN_MAGNITUDES = {"co_contraction": (0.27,), "joint_stiffness": (1.5,), "activation_timing": (0.05,)}
+
+
+def muscle_twin_validation(seeds=TWIN_SEEDS, serial: bool = False, **kw):
+    """Twins of the MSK model with one muscle-level effect (co-contraction, joint stiffness,
+    activation timing: :data:`MUSCLE_TWIN_MAGNITUDES`) and the effect-free twin per seed,
+    each diagnosed with the MSK baseline (:data:`MUSCLE_TWIN_BASE`) against its EMG, the three
+    muscle-level effects as candidates (:func:`gaitlib.gap.twin.validate_twins`)."""
+    return twin.validate_twins(tuple(MUSCLE_TWIN_MAGNITUDES), magnitudes=MUSCLE_TWIN_MAGNITUDES, seeds=tuple(seeds),
+                               base=dict(MUSCLE_TWIN_BASE), serial=serial, progress=False, **kw)
 
 
 def sk_diagnosis(source: str = "schwartz2008", speed_class: str = "Free", resamples: int = 200,
