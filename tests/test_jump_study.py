@@ -260,3 +260,30 @@ def test_strength_findings_read_claims_on_converged_valid_jumps_only():
     assert "18 cm: holds" in text
     assert "outside the 20–70 cm" in text  # 12 cm, below the human range
     assert "ellipsoid contact 0.34 vs welded toeless, kinematic contact 2.10 — less, as in the thesis" in text
+
+
+def test_strength_retry_findings_tell_procedure_from_problem():
+    """A jump that stops at a feasible point without converging under another continuation
+    has jumps (the procedure failed); infeasible from every continuation: said so."""
+    from types import SimpleNamespace
+
+    def fake(cont, status, it, viol, rise=0.2, obj=1.0, mu=2.0):
+        return SimpleNamespace(success=status == "Solve_Succeeded", status=status, stats={"iterations": it},
+                               solution=SimpleNamespace(max_violation=viol, objective=obj, worst_constraint="x"),
+                               jump_height={"com_rise_flight": rise}, required_friction=mu,
+                               spec=SimpleNamespace(label="toe-included, kinematic contact", continuation=cont))
+
+    sols = {"toe": fake((5,), "Infeasible_Problem_Detected", 2114, 1e-2, rise=0.01)}
+    retries = {"toe": {(): fake((), "Infeasible_Problem_Detected", 2068, 1e-6),
+                       (7,): fake((7,), "Maximum_Iterations_Exceeded", 5000, 7e-8, rise=0.22, mu=6.16)}}
+    (line,) = J.strength_retry_findings(sols, retries)
+    assert line.startswith("**toe-included, kinematic contact** — a 5-interval continuation stage (the spec's own): "
+                           "Infeasible_Problem_Detected after 2114 iterations; no continuation: "
+                           "Infeasible_Problem_Detected after 2068 iterations; a 7-interval continuation stage: "
+                           "Maximum_Iterations_Exceeded after 5000 iterations.")
+    # the no-continuation run's violation 1e-6 also counts as feasible; the lower objective is kept (tie: first)
+    assert "it stopped at a feasible point" in line and "IPOPT did not converge to one" in line
+    retries["toe"][(7,)] = fake((7,), "Infeasible_Problem_Detected", 900, 0.3)
+    retries["toe"][()] = fake((), "Infeasible_Problem_Detected", 900, 0.3)
+    (line,) = J.strength_retry_findings(sols, retries)
+    assert line.endswith("No procedure found a feasible point.")

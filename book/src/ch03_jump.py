@@ -343,6 +343,20 @@ marks.mark_table(jump.strength_table(strong, strong_gates),
 # %%
 display(Markdown("\n\n".join(jump.strength_findings(strong, {n: validity.check(s).passed for n, s in strong.items()}))))
 
+# %% [markdown]
+# **A strength-limited jump that did not converge: the procedure or the problem?** Each
+# such jump is solved again with two other mesh continuations (`JumpSpec.continuation`):
+# none (the full mesh straight from the box-limited start), and a 7-interval stage instead
+# of the 5-interval one. A procedure that stops at a feasible point without converging
+# shows that the problem has jumps; one that reports infeasibility from every start would
+# point at the problem itself.
+
+# %%
+strong_retries = jump.strength_retries(strong)
+if strong_retries:
+    display(jump.strength_retry_table(strong, strong_retries))
+    display(Markdown("\n\n".join(jump.strength_retry_findings(strong, strong_retries))))
+
 # %%
 fig = jump.plot_channels(strong, "torques")
 for k, ax in enumerate(fig.axes):

@@ -287,6 +287,16 @@ def _ch3() -> list[Row]:
         rows.append(Row(3, "ellipsoid contact needs less friction than either welded foot (Sec 3.4.3)",
                         "μ_s ellipsoid < toeless, toe", ", ".join(f"{n} {m:.2f}" for n, m in mu.items()), "",
                         "unknown", "jump (3 solutions)", v, holds=mu["ellipsoid"] < min(mu["toeless"], mu["toe"])))
+    retries = {}  # the other continuations of a strength-limited jump that did not converge (stored ones)
+    for n, s in strong.items():
+        if not s.success:
+            specs = {c: replace(s.spec, continuation=c) for c in jump.STRENGTH_RETRY_CONTINUATIONS}
+            got = {c: jump.solve(sp, use_cache=True) for c, sp in specs.items()
+                   if cache.find(jump.cache_location(sp), "solution.json", to_solve=False) is not None}
+            if len(got) == len(specs):
+                retries[n] = got
+    retry_text = {n: re.sub(r"\*\*[^*]*\*\* — ", "", t) for n, t in
+                  zip(retries, jump.strength_retry_findings(strong, retries))}
     for n, s in strong.items():
         rise = s.jump_height["com_rise_flight"]
         name = f"jump/{cache.find(jump.cache_location(jump.strength_specs()[n]), 'solution.json', to_solve=False).name} ({n}, strength-limited)"
@@ -294,7 +304,8 @@ def _ch3() -> list[Row]:
                            "ours: COM rise in flight)", jump.THESIS[n]["jump_height_cm"], 100 * rise, "cm",
                         f"the MTG strength envelope (Eq 5.8, Eq 5.21): COM rise {100 * rise:.0f} cm, "
                         f"{'inside' if lo <= rise <= hi else 'outside'} the {100 * lo:.0f}–{100 * hi:.0f} cm of human "
-                        f"standing jumps [{where_strong}]", name, strong_valid[n]))
+                        f"standing jumps" + (f"; {retry_text[n]}" if n in retry_text else "") + f" [{where_strong}]",
+                        name, strong_valid[n]))
     if len(strong) == len(jump.THESIS):
         rise = {n: s.jump_height["com_rise_flight"] for n, s in strong.items()}
         order = sorted(rise, key=rise.get)

@@ -5,6 +5,8 @@ results beside the thesis's (labelled references), the channel figures and the a
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pandas as pd
 
@@ -17,7 +19,8 @@ from .. import plots
 __all__ = ["solve_all", "results_table", "stats_table", "plot_channels", "animate", "THESIS", "SPECS",
            "JumpSpec", "JumpSolution", "joint_bounds", "spec", "solve", "build", "cache_location",
            "THESIS_HEIGHT_ORDER", "AT_BOUND", "torques_at_bound", "findings", "HUMAN_JUMP_RISE_M", "strength_specs",
-           "solve_strength", "strength_use", "strength_table", "strength_findings"]
+           "solve_strength", "strength_use", "strength_table", "strength_findings", "STRENGTH_RETRY_CONTINUATIONS",
+           "strength_retries", "strength_retry_table"]
 
 
 def solve_all(names=("toeless", "toe", "ellipsoid"), use_cache: bool = False,
@@ -308,4 +311,59 @@ def strength_findings(sols: dict[str, JumpSolution], valid: dict[str, bool]) -> 
         out.append(f"Required friction: ellipsoid contact {mu_e:.2f} vs welded "
                    + ", ".join(f"{LABELS[n]} {v:.2f}" for n, v in welded.items())
                    + (" — less, as in the thesis." if mu_e < min(welded.values()) else " — NOT less, unlike the thesis."))
+    return out
+
+
+#: Other mesh continuations (:attr:`JumpSpec.continuation`) tried for a strength-limited jump
+#: that did not converge with its own: none (the full mesh from the box-limited start's
+#: guess) and a 7-interval stage instead of the 5-interval one.
+STRENGTH_RETRY_CONTINUATIONS = ((), (7,))
+
+
+def strength_retries(sols: dict[str, JumpSolution], use_cache: bool = True) -> dict[str, dict[tuple, JumpSolution]]:
+    """For every strength-limited jump in ``sols`` that did not converge: name → {continuation:
+    the same spec solved with that continuation (:data:`STRENGTH_RETRY_CONTINUATIONS`)} —
+    whether the failure is the procedure's or the problem's. Cached like every jump."""
+    return {n: {c: solve(replace(s.spec, continuation=c), use_cache=use_cache) for c in STRENGTH_RETRY_CONTINUATIONS}
+            for n, s in sols.items() if not s.success}
+
+
+def strength_retry_table(sols: dict[str, JumpSolution], retries: dict) -> pd.DataFrame:
+    """The spec's own continuation beside each retry of :func:`strength_retries`: status,
+    iterations, largest constraint violation, COM rise in flight (cm), required μ_s."""
+    rows = []
+    for n, per in retries.items():
+        for c, s in {sols[n].spec.continuation: sols[n], **per}.items():
+            rows.append({"jump": s.spec.label, "continuation (intervals)": ", ".join(map(str, c)) or "none",
+                         "IPOPT status": s.status, "iterations": s.stats["iterations"],
+                         "max violation": s.solution.max_violation, "worst constraint": s.solution.worst_constraint,
+                         "COM rise in flight (cm)": 100 * s.jump_height["com_rise_flight"],
+                         "required μ_s": s.required_friction})
+    return pd.DataFrame(rows)
+
+
+def strength_retry_findings(sols: dict[str, JumpSolution], retries: dict) -> list[str]:
+    """One sentence per jump of :func:`strength_retries`: the status of each procedure and,
+    where one ended at a feasible point (largest violation ≤ 1e-6) without converging, its
+    COM rise and required friction."""
+    def lab(c):
+        return f"a {', '.join(map(str, c))}-interval continuation stage" if c else "no continuation"
+
+    out = []
+    for n, per in retries.items():
+        runs = {sols[n].spec.continuation: sols[n], **per}
+        own = " (the spec's own)"
+        parts = [f"{lab(c)}{own if c == sols[n].spec.continuation else ''}: {s.status} after "
+                 f"{s.stats['iterations']} iterations" for c, s in runs.items()]
+        feas = [(c, s) for c, s in runs.items() if not s.success and s.solution.max_violation <= 1e-6]
+        line = f"**{sols[n].spec.label}** — " + "; ".join(parts) + "."
+        if feas:
+            c, s = min(feas, key=lambda cs: cs[1].solution.objective)
+            line += (f" With {lab(c)} it stopped at a feasible point (largest "
+                     f"violation {s.solution.max_violation:.1e}; COM rise {100 * s.jump_height['com_rise_flight']:.0f} cm, "
+                     f"required μ_s {s.required_friction:.1f}): the strength-limited problem has jumps, IPOPT did not "
+                     "converge to one.")
+        elif not any(s.success for s in runs.values()):
+            line += " No procedure found a feasible point."
+        out.append(line)
     return out
