@@ -50,7 +50,7 @@ from ..marks import failure_label
 from .. import validity
 from . import predictive as pr
 
-__all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWIN_MAGNITUDES", "muscle_twin_validation", "NMSK_CANDIDATES", "effect_table", "twin_validation",
+__all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWIN_MAGNITUDES", "muscle_twin_validation", "muscle_twin_lines", "NMSK_CANDIDATES", "effect_table", "twin_validation",
            "sk_diagnosis", "nmsk_attribution", "ch5_attribution", "ch5_profile", "emg_gap_table", "exact_left_leg", "left_leg_check",
            "book_gaps", "twin_validation_full_mesh", "twin_full_mesh_lines", "twin_full_mesh_verdict",
            "left_leg_flips", "co_contraction_text", "findings",
@@ -103,6 +103,29 @@ def muscle_twin_validation(seeds=TWIN_SEEDS, serial: bool = False, **kw):
     muscle-level effects as candidates (:func:`gaitlib.gap.twin.validate_twins`)."""
     return twin.validate_twins(tuple(MUSCLE_TWIN_MAGNITUDES), magnitudes=MUSCLE_TWIN_MAGNITUDES, seeds=tuple(seeds),
                                base=dict(MUSCLE_TWIN_BASE), serial=serial, progress=False, **kw)
+
+
+def muscle_twin_lines(tv) -> list[str]:
+    """The muscle-level twins (:func:`muscle_twin_validation`) in sentences computed from the
+    rows: named right per effect, the effect-free twins, the identified magnitudes, what the
+    misnamed twins were called."""
+    r = tv.rows
+    inj = r[r["injected"] != "none"]
+    free = r[r["injected"] == "none"]
+    per = []
+    for e, g in inj.groupby("injected", sort=False):
+        mags = ", ".join(f"{m:.3g}" for m in g["identified_magnitude"] if np.isfinite(m))
+        per.append(f"{e} ({g['magnitude'].iloc[0]:g}): {int(g['correct'].sum())} of {len(g)}"
+                   + (f", identified {mags}" if mags else ""))
+    out = [f"**Muscle-level twins: {int(inj['correct'].sum())} of {len(inj)} named right** — " + "; ".join(per)
+           + f". Effect-free twins read \"unexplained\": {int(free['correct'].sum())} of {len(free)}."]
+    wrong = r[~r["correct"]]
+    if len(wrong):
+        out.append("Misnamed: " + "; ".join(
+            f"{w.twin} → {w.top} ({w.verdict}; ΔBIC named {w.dBIC_top:.1f}, injected {w.dBIC_true:.1f})"
+            if np.isfinite(w.dBIC_top) else f"{w.twin} → {w.top} (ΔBIC injected {w.dBIC_true:.1f})"
+            for w in wrong.itertuples()) + ".")
+    return out
 
 
 def sk_diagnosis(source: str = "schwartz2008", speed_class: str = "Free", resamples: int = 200,
