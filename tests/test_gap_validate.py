@@ -263,3 +263,25 @@ def test_null_refit_lines_count_from_the_experiment():
     assert "verdicts changed in 1 (null_0: a → unexplained)" in line
     assert "an effect was named in 0 of 2 draws after against 1 before" in line
     assert "a 14.1 → 1.4; b 1.4 → 14.1" in line and "largest SD after it: b, 14.1" in line
+
+
+def test_muscle_twin_lines_from_the_rows():
+    import pandas as pd
+    from types import SimpleNamespace
+    from gaitlib.studies import gap as G
+
+    rows = pd.DataFrame([
+        {"twin": "none#1", "injected": "none", "magnitude": 0.0, "top": "joint_stiffness", "verdict": "partial",
+         "correct": False, "identified_magnitude": np.nan, "dBIC_top": -277.7, "dBIC_true": np.nan},
+        {"twin": "none#2", "injected": "none", "magnitude": 0.0, "top": "unexplained", "verdict": "unexplained",
+         "correct": True, "identified_magnitude": np.nan, "dBIC_top": np.nan, "dBIC_true": np.nan},
+        {"twin": "co@0#1", "injected": "co_contraction", "magnitude": 0.27, "top": "activation_timing",
+         "verdict": "partial", "correct": False, "identified_magnitude": 0.2, "dBIC_top": -52.2, "dBIC_true": -15.2},
+        {"twin": "co@0#2", "injected": "co_contraction", "magnitude": 0.27, "top": "co_contraction",
+         "verdict": "partial", "correct": True, "identified_magnitude": 0.2, "dBIC_top": -188.3, "dBIC_true": -188.3},
+    ])
+    first, second = G.muscle_twin_lines(SimpleNamespace(rows=rows))
+    assert first.startswith("**Muscle-level twins: 1 of 2 named right (50 %)** — co_contraction (0.27): 1 of 2, "
+                            "identified 0.2, 0.2. Effect-free twins read \"unexplained\": 1 of 2.")
+    assert second == ("Misnamed: none#1 (no effect) → joint_stiffness (partial; ΔBIC -277.7); co@0#1 → "
+                      "activation_timing (partial; ΔBIC named -52.2, injected -15.2).")

@@ -117,14 +117,20 @@ def muscle_twin_lines(tv) -> list[str]:
         mags = ", ".join(f"{m:.3g}" for m in g["identified_magnitude"] if np.isfinite(m))
         per.append(f"{e} ({g['magnitude'].iloc[0]:g}): {int(g['correct'].sum())} of {len(g)}"
                    + (f", identified {mags}" if mags else ""))
-    out = [f"**Muscle-level twins: {int(inj['correct'].sum())} of {len(inj)} named right** — " + "; ".join(per)
-           + f". Effect-free twins read \"unexplained\": {int(free['correct'].sum())} of {len(free)}."]
+    n_ok = int(inj["correct"].sum())
+    out = [f"**Muscle-level twins: {n_ok} of {len(inj)} named right ({100 * n_ok / max(len(inj), 1):.0f} %)** — "
+           + "; ".join(per) + f". Effect-free twins read \"unexplained\": {int(free['correct'].sum())} of {len(free)}."]
+
+    def why(w):
+        if w.injected == "none":
+            return f"{w.twin} (no effect) → {w.top} ({w.verdict}; ΔBIC {w.dBIC_top:.1f})"
+        if np.isfinite(w.dBIC_top):
+            return f"{w.twin} → {w.top} ({w.verdict}; ΔBIC named {w.dBIC_top:.1f}, injected {w.dBIC_true:.1f})"
+        return f"{w.twin} → {w.top} (ΔBIC injected {w.dBIC_true:.1f})"
+
     wrong = r[~r["correct"]]
     if len(wrong):
-        out.append("Misnamed: " + "; ".join(
-            f"{w.twin} → {w.top} ({w.verdict}; ΔBIC named {w.dBIC_top:.1f}, injected {w.dBIC_true:.1f})"
-            if np.isfinite(w.dBIC_top) else f"{w.twin} → {w.top} (ΔBIC injected {w.dBIC_true:.1f})"
-            for w in wrong.itertuples()) + ".")
+        out.append("Misnamed: " + "; ".join(why(w) for w in wrong.itertuples()) + ".")
     return out
 
 
