@@ -280,7 +280,12 @@ def test_muscle_twin_lines_from_the_rows():
         {"twin": "co@0#2", "injected": "co_contraction", "magnitude": 0.27, "top": "co_contraction",
          "verdict": "partial", "correct": True, "identified_magnitude": 0.2, "dBIC_top": -188.3, "dBIC_true": -188.3},
     ])
-    first, second = G.muscle_twin_lines(SimpleNamespace(rows=rows))
+    rows["rss_base"] = [1200.0, 500.0, 1600.0, 1200.0]
+    rows["rss_top"] = [600.0, 500.0, 1500.0, 800.0]
+    rows["rss_gen"] = [12.0, 10.0, 12.0, 10.0]
+    first, second, third = G.muscle_twin_lines(SimpleNamespace(rows=rows))
+    assert "has an RSS of 1200, 500 against the generating solution's 12, 10 (50–100×)" in third
+    assert "on none#1, joint_stiffness closed 50 % with no effect injected." in third
     assert first.startswith("**Muscle-level twins: 1 of 2 named right (50 %)** — co_contraction (0.27): 1 of 2, "
                             "identified 0.2, 0.2. Effect-free twins read \"unexplained\": 1 of 2.")
     assert second == ("Misnamed: none#1 (no effect) → joint_stiffness (partial; ΔBIC -277.7); co@0#1 → "

@@ -248,13 +248,28 @@ def validate_twins(effects=None, *, magnitudes: dict | None = None, seeds=(1,), 
                                 settings={"twin": key})
         sol_t = ref.get(f"true|{key}")
         gen_sol = res.get(f"gen|{key.split('#')[0]}")
-        refs[key] = {"rss_gen": locate.locate(gen_sol, ds).rss if gen_sol is not None else np.nan,
+        refs[key] = {"rss_gen": locate.locate(gen_sol, _as_generated(ds, truth[key]["effects"])).rss
+                     if gen_sol is not None else np.nan,
                      "rss_true_fixed": locate.locate(sol_t, ds).rss if sol_t is not None else np.nan,
                      "status_true_fixed": sol_t.stats["status"] if sol_t is not None else ("n/a" if not truth[key]["effects"] else "error")}
     return TwinValidation.build(diags, truth, mags, gen_stats, refs=refs, settings={
         "base": spec0.to_dict(), "objective": objective, "gen_objective": gen_objective, "seeds": list(seeds),
         "effects": list(effects), "magnitudes": {e: list(v) for e, v in mags.items()}, "real": real.label,
         "n_subjects": real.n, "noise_length": NOISE_LENGTH, "baseline_failed": base_failed})
+
+
+def _as_generated(ds: gio.DataSet, effects) -> gio.DataSet:
+    """``ds`` read as its generating model sees it: a comparison-only effect (activation
+    timing) is in the twin's data, not in the generating solution, so its data adjustment
+    at the injected magnitude is applied before the generating solution's RSS is taken."""
+    import dataclasses
+
+    gait = ds.gait
+    for n, m in effects or ():
+        e = EFFECTS[n]
+        if not e.resolve and e.data_adjust is not None and m is not None:
+            gait = e.data_adjust(gait, {e.magnitude.name: float(m)})
+    return ds if gait is ds.gait else dataclasses.replace(ds, gait=gait)
 
 
 def _best_other(rk: pd.DataFrame, inj: str) -> float:

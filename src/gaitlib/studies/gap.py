@@ -131,6 +131,18 @@ def muscle_twin_lines(tv) -> list[str]:
     wrong = r[~r["correct"]]
     if len(wrong):
         out.append("Misnamed: " + "; ".join(why(w) for w in wrong.itertuples()) + ".")
+    if len(free) and "rss_gen" in free:
+        ratio = free["rss_base"] / free["rss_gen"]
+        fp = free[~free["correct"]]
+        out.append(f"**The MSK baseline fit stops far above the noise.** On the effect-free twins, whose generating "
+                   f"solution is a member of the baseline model, the kept baseline fit has an RSS of "
+                   + ", ".join(f"{x:.0f}" for x in free["rss_base"]) + " against the generating solution's "
+                   + ", ".join(f"{x:.0f}" for x in free["rss_gen"])
+                   + f" ({ratio.min():.0f}–{ratio.max():.0f}×): a local optimum, not the model's limit"
+                   + (". A candidate that does not nest the baseline (profiled on a grid without its null value) can "
+                      "close part of that shortfall by landing in a better optimum: " + "; ".join(
+                          f"on {w.twin}, {w.top} closed {100 * (1 - w.rss_top / w.rss_base):.0f} % with no effect "
+                          "injected" for w in fp.itertuples()) if len(fp) else "") + ".")
     return out
 
 
