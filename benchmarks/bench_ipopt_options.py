@@ -3,6 +3,7 @@
 
     .venv/bin/python benchmarks/bench_ipopt_options.py            # MSK DT Free 20 × 5, ≈ 10 min
     .venv/bin/python benchmarks/bench_ipopt_options.py --quick    # 4 × 3 mesh (checks the script)
+    .venv/bin/python benchmarks/bench_ipopt_options.py --model NMSK --only default "bound_push/frac 1e-6" "mu_init 1e-2"
 
 The problem of ``gaitlib run gait --model MSK --cost DT --speed Free`` (the book's Ch 5 MSK
 data-tracking solve's spec, from its data-based guess), built once on the per-node path with
@@ -77,12 +78,13 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--only", nargs="*", help="variant names (default: all)")
+    ap.add_argument("--model", default="MSK", choices=["SK", "MSK", "NMSK"], help="gait model (default MSK)")
     args = ap.parse_args(argv)
     from gaitlib import conventions as cv, ocp
     from gaitlib.problems import gait as gait_ocp
 
     mesh = dict(n_intervals=4, degree=3) if args.quick else {}
-    spec = gait_ocp.GaitSpec(model="MSK", cost="DT", speed_class="Free", derivatives="nodes", **mesh)
+    spec = gait_ocp.GaitSpec(model=args.model, cost="DT", speed_class="Free", derivatives="nodes", **mesh)
     t0 = time.perf_counter()
     gp = gait_ocp.build(spec)
     gp = replace(gp, options=replace(gp.options, compiled=True))
@@ -132,8 +134,8 @@ def _write(args, spec, build_s, rows):
     doc = {"measured": datetime.now(timezone.utc).isoformat(timespec="seconds"), "machine": machine_info(),
            "spec": spec.to_dict(), "build_s": build_s, "quick": args.quick, "rows": rows}
     m = doc["machine"]
-    md = [f"# IPOPT options on the MSK gait problem ({doc['measured']}, {m['cpu']}, {m['cores']} cores)", "",
-          f"MSK DT Free, {spec.n_intervals} × {spec.degree} LGR, per-node derivatives, compiled; one build "
+    md = [f"# IPOPT options on the {spec.model} gait problem ({doc['measured']}, {m['cpu']}, {m['cores']} cores)", "",
+          f"{spec.model} DT Free, {spec.n_intervals} × {spec.degree} LGR, per-node derivatives, compiled; one build "
           f"({build_s:.1f} s), one solve per variant from the data-based guess, one BLAS thread. "
           "`inertia_corrections`: iterations whose Hessian IPOPT regularised (δ_w > 0); `rms_vs_default_deg`: RMS "
           "difference of the solution's joint angles from the default variant's. "
@@ -141,7 +143,8 @@ def _write(args, spec, build_s, rows):
     md += md_table(["variant", "options", "status", "iterations", "solve_s", "ms_per_iteration", "objective",
                     "max_violation", "inertia_corrections", "median_lg_dw", "max_lg_dw", "restoration_iterations",
                     "rms_vs_default_deg", "load_at_start"], rows)
-    write_report(OUT, "ipopt_options_quick" if args.quick else "ipopt_options", doc, md)
+    stem = "ipopt_options" + ("" if args.model == "MSK" else f"_{args.model.lower()}") + ("_quick" if args.quick else "")
+    write_report(OUT, stem, doc, md)
 
 
 if __name__ == "__main__":

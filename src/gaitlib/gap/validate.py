@@ -52,7 +52,7 @@ from . import diagnose
 from . import io as gio
 from . import locate
 from . import twin
-from .method import METHOD, Method
+from .method import BIC_THRESHOLD, METHOD, RUNNER_UP_MARGIN, Method
 from .noise import smooth_noise
 
 __all__ = ["Injection", "INJECTIONS", "SETS", "BANDS", "PLATE_THRESHOLD_BW", "VARIANTS", "VARIANT_SEEDS", "ALL_SETS",
@@ -419,8 +419,6 @@ def visibility(real: Validation, spread: dict, margin: float | None = None) -> p
     it must reach to be named when the other candidates keep their null means — the
     method's threshold, or the best other candidate's null mean minus the runner-up margin,
     whichever is lower; ``reaches`` = ΔBIC ≤ needed."""
-    from .method import BIC_THRESHOLD, RUNNER_UP_MARGIN
-
     margin = RUNNER_UP_MARGIN if margin is None else margin
     c = spread["candidates"]
     floor = max(abs(x) for x in spread["rss_pct"])
