@@ -267,23 +267,34 @@ def test_strength_retry_findings_tell_procedure_from_problem():
     has jumps (the procedure failed); infeasible from every continuation: said so."""
     from types import SimpleNamespace
 
-    def fake(cont, status, it, viol, rise=0.2, obj=1.0, mu=2.0):
+    def fake(cont, status, it, viol, rise=0.2, obj=1.0, mu=2.0, limit=5000):
         return SimpleNamespace(success=status == "Solve_Succeeded", status=status, stats={"iterations": it},
                                solution=SimpleNamespace(max_violation=viol, objective=obj, worst_constraint="x"),
                                jump_height={"com_rise_flight": rise}, required_friction=mu,
-                               spec=SimpleNamespace(label="toe-included, kinematic contact", continuation=cont))
+                               spec=SimpleNamespace(label="toe-included, kinematic contact", continuation=cont,
+                                                    max_iter=limit))
 
     sols = {"toe": fake((5,), "Infeasible_Problem_Detected", 2114, 1e-2, rise=0.01)}
-    retries = {"toe": {(): fake((), "Infeasible_Problem_Detected", 2068, 1e-6),
-                       (7,): fake((7,), "Maximum_Iterations_Exceeded", 5000, 7e-8, rise=0.22, mu=6.16)}}
+    retries = {"toe": {((), None): fake((), "Infeasible_Problem_Detected", 2068, 1e-6, obj=3.0),
+                       ((7,), None): fake((7,), "Maximum_Iterations_Exceeded", 5000, 7e-8, rise=0.22, mu=6.16,
+                                          obj=2.0),
+                       ((7,), 15000): fake((7,), "Maximum_Iterations_Exceeded", 15000, 2e-11, rise=0.30, mu=7.4,
+                                           obj=1.0, limit=15000)}}
     (line,) = J.strength_retry_findings(sols, retries)
     assert line.startswith("**toe-included, kinematic contact** — a 5-interval continuation stage (the spec's own): "
-                           "Infeasible_Problem_Detected after 2114 iterations; no continuation: "
-                           "Infeasible_Problem_Detected after 2068 iterations; a 7-interval continuation stage: "
-                           "Maximum_Iterations_Exceeded after 5000 iterations.")
-    # the no-continuation run's violation 1e-6 also counts as feasible; the lower objective is kept (tie: first)
-    assert "it stopped at a feasible point" in line and "IPOPT did not converge to one" in line
-    retries["toe"][(7,)] = fake((7,), "Infeasible_Problem_Detected", 900, 0.3)
-    retries["toe"][()] = fake((), "Infeasible_Problem_Detected", 900, 0.3)
+                           "Infeasible_Problem_Detected after 2114 iterations; no continuation, limit 5000 iterations: "
+                           "Infeasible_Problem_Detected after 2068 iterations; a 7-interval continuation stage, limit "
+                           "5000 iterations: Maximum_Iterations_Exceeded after 5000 iterations; a 7-interval "
+                           "continuation stage, limit 15000 iterations: Maximum_Iterations_Exceeded after 15000 "
+                           "iterations.")
+    # the feasible point with the lowest objective is reported
+    assert ("With a 7-interval continuation stage, limit 15000 iterations it stopped at a feasible point (largest "
+            "violation 2.0e-11; COM rise 30 cm, required μ_s 7.4)") in line
+    retries["toe"][((7,), 15000)] = fake((7,), "Solve_Succeeded", 9000, 1e-9, rise=0.31, mu=7.0, limit=15000)
+    (line,) = J.strength_retry_findings(sols, retries)
+    assert line.endswith("Converged with a 7-interval continuation stage, limit 15000 iterations: COM rise 31 cm, "
+                         "required μ_s 7.0.")
+    for k in retries["toe"]:
+        retries["toe"][k] = fake((), "Infeasible_Problem_Detected", 900, 0.3)
     (line,) = J.strength_retry_findings(sols, retries)
     assert line.endswith("No procedure found a feasible point.")

@@ -345,11 +345,12 @@ display(Markdown("\n\n".join(jump.strength_findings(strong, {n: validity.check(s
 
 # %% [markdown]
 # **A strength-limited jump that did not converge: the procedure or the problem?** Each
-# such jump is solved again with two other mesh continuations (`JumpSpec.continuation`):
-# none (the full mesh straight from the box-limited start), and a 7-interval stage instead
-# of the 5-interval one. A procedure that stops at a feasible point without converging
-# shows that the problem has jumps; one that reports infeasibility from every start would
-# point at the problem itself.
+# such jump is solved again by three other procedures (`jump.STRENGTH_RETRIES`): no mesh
+# continuation (the full mesh straight from the box-limited start), a 7-interval stage
+# instead of the 5-interval one, and that with 15,000 iterations instead of Table 3.11's
+# 5,000. A procedure that stops at a feasible point without converging shows that the
+# problem has jumps; one that reports infeasibility from every start would point at the
+# problem itself. A retry that has not converged supplies no result.
 
 # %%
 strong_retries = jump.strength_retries(strong)

@@ -290,7 +290,7 @@ def _ch3() -> list[Row]:
     retries = {}  # the other continuations of a strength-limited jump that did not converge (stored ones)
     for n, s in strong.items():
         if not s.success:
-            specs = {c: replace(s.spec, continuation=c) for c in jump.STRENGTH_RETRY_CONTINUATIONS}
+            specs = {r: jump.retry_spec(s.spec, r) for r in jump.STRENGTH_RETRIES}
             got = {c: jump.solve(sp, use_cache=True) for c, sp in specs.items()
                    if cache.find(jump.cache_location(sp), "solution.json", to_solve=False) is not None}
             if len(got) == len(specs):

@@ -20,7 +20,7 @@ __all__ = ["solve_all", "results_table", "stats_table", "plot_channels", "animat
            "JumpSpec", "JumpSolution", "joint_bounds", "spec", "solve", "build", "cache_location",
            "THESIS_HEIGHT_ORDER", "AT_BOUND", "torques_at_bound", "findings", "HUMAN_JUMP_RISE_M", "strength_specs",
            "solve_strength", "strength_use", "strength_table", "strength_findings", "STRENGTH_RETRY_CONTINUATIONS",
-           "strength_retries", "strength_retry_table"]
+           "STRENGTH_RETRIES", "retry_spec", "strength_retries", "strength_retry_table", "strength_retry_findings"]
 
 
 def solve_all(names=("toeless", "toe", "ellipsoid"), use_cache: bool = False,
@@ -314,17 +314,26 @@ def strength_findings(sols: dict[str, JumpSolution], valid: dict[str, bool]) -> 
     return out
 
 
-#: Other mesh continuations (:attr:`JumpSpec.continuation`) tried for a strength-limited jump
-#: that did not converge with its own: none (the full mesh from the box-limited start's
-#: guess) and a 7-interval stage instead of the 5-interval one.
-STRENGTH_RETRY_CONTINUATIONS = ((), (7,))
+#: Other procedures tried for a strength-limited jump that did not converge with its own,
+#: as (mesh continuation :attr:`JumpSpec.continuation`, IPOPT iteration limit or None for the
+#: spec's): no continuation (the full mesh from the box-limited start's guess); a 7-interval
+#: stage instead of the 5-interval one; the same with three times the iterations.
+STRENGTH_RETRIES = (((), None), ((7,), None), ((7,), 15000))
+#: The continuations of :data:`STRENGTH_RETRIES` (kept for callers of the first version).
+STRENGTH_RETRY_CONTINUATIONS = tuple(dict.fromkeys(c for c, _ in STRENGTH_RETRIES))
+
+
+def retry_spec(sp: JumpSpec, retry: tuple) -> JumpSpec:
+    """``sp`` with one procedure of :data:`STRENGTH_RETRIES`."""
+    c, it = retry
+    return replace(sp, continuation=c, **({} if it is None else {"max_iter": it}))
 
 
 def strength_retries(sols: dict[str, JumpSolution], use_cache: bool = True) -> dict[str, dict[tuple, JumpSolution]]:
-    """For every strength-limited jump in ``sols`` that did not converge: name → {continuation:
-    the same spec solved with that continuation (:data:`STRENGTH_RETRY_CONTINUATIONS`)} —
-    whether the failure is the procedure's or the problem's. Cached like every jump."""
-    return {n: {c: solve(replace(s.spec, continuation=c), use_cache=use_cache) for c in STRENGTH_RETRY_CONTINUATIONS}
+    """For every strength-limited jump in ``sols`` that did not converge: name → {procedure of
+    :data:`STRENGTH_RETRIES`: the same spec solved with it} — whether the failure is the
+    procedure's or the problem's. Cached like every jump."""
+    return {n: {r: solve(retry_spec(s.spec, r), use_cache=use_cache) for r in STRENGTH_RETRIES}
             for n, s in sols.items() if not s.success}
 
 
@@ -333,9 +342,11 @@ def strength_retry_table(sols: dict[str, JumpSolution], retries: dict) -> pd.Dat
     iterations, largest constraint violation, COM rise in flight (cm), required μ_s."""
     rows = []
     for n, per in retries.items():
-        for c, s in {sols[n].spec.continuation: sols[n], **per}.items():
+        for _, s in {"own": sols[n], **per}.items():
+            c = s.spec.continuation
             rows.append({"jump": s.spec.label, "continuation (intervals)": ", ".join(map(str, c)) or "none",
-                         "IPOPT status": s.status, "iterations": s.stats["iterations"],
+                         "iteration limit": s.spec.max_iter,
+                         "IPOPT status": s.status, "iterations": s.stats["iterations"], "objective": s.solution.objective,
                          "max violation": s.solution.max_violation, "worst constraint": s.solution.worst_constraint,
                          "COM rise in flight (cm)": 100 * s.jump_height["com_rise_flight"],
                          "required μ_s": s.required_friction})
@@ -346,20 +357,25 @@ def strength_retry_findings(sols: dict[str, JumpSolution], retries: dict) -> lis
     """One sentence per jump of :func:`strength_retries`: the status of each procedure and,
     where one ended at a feasible point (largest violation ≤ 1e-6) without converging, its
     COM rise and required friction."""
-    def lab(c):
-        return f"a {', '.join(map(str, c))}-interval continuation stage" if c else "no continuation"
+    def lab(s, own=False):
+        c = s.spec.continuation
+        t = f"a {', '.join(map(str, c))}-interval continuation stage" if c else "no continuation"
+        return t + (" (the spec's own)" if own else f", limit {s.spec.max_iter} iterations")
 
     out = []
     for n, per in retries.items():
-        runs = {sols[n].spec.continuation: sols[n], **per}
-        own = " (the spec's own)"
-        parts = [f"{lab(c)}{own if c == sols[n].spec.continuation else ''}: {s.status} after "
-                 f"{s.stats['iterations']} iterations" for c, s in runs.items()]
-        feas = [(c, s) for c, s in runs.items() if not s.success and s.solution.max_violation <= 1e-6]
+        runs = {"own": sols[n], **per}
+        parts = [f"{lab(s, k == 'own')}: {s.status} after {s.stats['iterations']} iterations" for k, s in runs.items()]
+        feas = [s for s in runs.values() if not s.success and s.solution.max_violation <= 1e-6]
         line = f"**{sols[n].spec.label}** — " + "; ".join(parts) + "."
-        if feas:
-            c, s = min(feas, key=lambda cs: cs[1].solution.objective)
-            line += (f" With {lab(c)} it stopped at a feasible point (largest "
+        conv = [s for s in per.values() if s.success]
+        if conv:
+            s = min(conv, key=lambda x: x.solution.objective)
+            line += (f" Converged with {lab(s)}: COM rise {100 * s.jump_height['com_rise_flight']:.0f} cm, required "
+                     f"μ_s {s.required_friction:.1f}.")
+        elif feas:
+            s = min(feas, key=lambda x: x.solution.objective)
+            line += (f" With {lab(s)} it stopped at a feasible point (largest "
                      f"violation {s.solution.max_violation:.1e}; COM rise {100 * s.jump_height['com_rise_flight']:.0f} cm, "
                      f"required μ_s {s.required_friction:.1f}): the strength-limited problem has jumps, IPOPT did not "
                      "converge to one.")
