@@ -194,14 +194,17 @@ if e2e is not None:
 # replaces the inertia test, the adaptive barrier — and reads IPOPT's iteration log for the
 # iterations that needed an inertia correction. A variant that lands on another local
 # optimum is another result, not the same one faster: the last column is the RMS distance of
-# its joint angles from the default variant's solution.
+# its joint angles from the default variant's solution. The variants that looked promising
+# on MSK are then tried on the NMSK problem (`--model NMSK`): a lever for the book must hold
+# for every model.
 
 # %%
-ipo = perf.load_optional("ipopt_options")
-if ipo is not None:
-    print(perf.measured_on(ipo))
-    display(perf.ipopt_options_table(ipo))
-    print("\n".join(perf.ipopt_options_findings(ipo)))
+for name in ("ipopt_options", "ipopt_options_nmsk"):  # MSK (all variants), then NMSK (the promising ones)
+    ipo = perf.load_optional(name)
+    if ipo is not None:
+        print(f"{ipo['spec']['model']} DT Free — " + perf.measured_on(ipo))
+        display(perf.ipopt_options_table(ipo))
+        print("\n".join(perf.ipopt_options_findings(ipo)))
 
 # %% [markdown]
 # ## Every optimisation of the book beside the thesis's times

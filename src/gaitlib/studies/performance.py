@@ -366,9 +366,16 @@ def ipopt_options_findings(res: dict, target_s: float = E2E_TARGETS["gait"]) -> 
         return []
     conv = [r for r in rows if r["status"] in ("Solve_Succeeded", "Solved_To_Acceptable_Level")]
     share = [100.0 * r["inertia_corrections"] / max(r["iterations"], 1) for r in conv]
+    curv = any("neg_curv_test_tol" in dict(r.get("options", {})) for r in conv)
+    spread = f"{min(share):.0f} %" if round(min(share)) == round(max(share)) else f"{min(share):.0f}–{max(share):.0f} %"
     out = [f"• The default needed {d['iterations']} iterations ({d['solve_s']:.1f} s), {d['inertia_corrections']} of "
-           f"them with an inertia correction; in the converged variants {min(share):.0f}–{max(share):.0f} % of the "
-           f"iterations did (the fewest with the curvature test that replaces the inertia test)."]
+           f"them with an inertia correction; in the converged variants {spread} of the iterations did"
+           + (" (the fewest with the curvature test that replaces the inertia test)." if curv else ".")]
+    stuck = [r for r in rows if r not in conv]
+    if stuck:
+        out.append("• Not converged: " + "; ".join(f"{r['variant']} ({r['status']} after {r['iterations']} iterations, "
+                                                    f"largest violation {r.get('max_violation', np.nan):.1e})"
+                                                    for r in stuck) + ".")
     fewer = [r for r in conv if r["variant"] != "default" and r["iterations"] < d["iterations"]]
     same = [r for r in fewer if r["rms_vs_default_deg"] <= SAME_SOLUTION_DEG]
     other = [r for r in fewer if r["rms_vs_default_deg"] > SAME_SOLUTION_DEG]
