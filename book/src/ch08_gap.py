@@ -689,5 +689,5 @@ if prof_js is not None:
 
 # %%
 display(Markdown("\n\n".join(gap_study.findings(tv, tvf, dS, dU, dN, chkS, chkU, bg, emg, val=val, valv=valv,
-                                                    diag_m=dM, profile_m=prof_js))))
+                                                    diag_m=dM, profile_m=prof_js, valn=valn, tv_muscle=tvm))))
 print(f"notebook time: {time.perf_counter() - T0:.0f} s")
