@@ -19,7 +19,7 @@ from .. import plots
 __all__ = ["solve_all", "results_table", "stats_table", "plot_channels", "animate", "THESIS", "SPECS",
            "JumpSpec", "JumpSolution", "joint_bounds", "spec", "solve", "build", "cache_location",
            "THESIS_HEIGHT_ORDER", "AT_BOUND", "torques_at_bound", "findings", "HUMAN_JUMP_RISE_M", "strength_specs",
-           "solve_strength", "strength_use", "strength_table", "strength_findings", "STRENGTH_RETRY_CONTINUATIONS",
+           "solve_strength", "strength_use", "strength_table", "strength_findings",
            "STRENGTH_RETRIES", "retry_spec", "strength_retries", "strength_retry_table", "strength_retry_findings"]
 
 
@@ -319,8 +319,6 @@ def strength_findings(sols: dict[str, JumpSolution], valid: dict[str, bool]) -> 
 #: spec's): no continuation (the full mesh from the box-limited start's guess); a 7-interval
 #: stage instead of the 5-interval one; the same with three times the iterations.
 STRENGTH_RETRIES = (((), None), ((7,), None), ((7,), 15000))
-#: The continuations of :data:`STRENGTH_RETRIES` (kept for callers of the first version).
-STRENGTH_RETRY_CONTINUATIONS = tuple(dict.fromkeys(c for c, _ in STRENGTH_RETRIES))
 
 
 def retry_spec(sp: JumpSpec, retry: tuple) -> JumpSpec:
