@@ -105,3 +105,28 @@ def test_every_weighted_cost_term_has_a_goal_factory_for_its_model():
                 assert term in gp_mod.COST_TERMS, (model, cost, term)
                 assert gp_mod.COST_TERMS[term](ctx[model]) is not None, (model, cost, term)
     assert gp_mod.goal_act(ctx["SK"]) is None and gp_mod.goal_mtb(ctx["MSK"]) is None
+
+
+def test_q_term_leaves_the_planned_metatarsal_angles_out_only_when_asked():
+    """GaitSpec.track_mtp=False drops exactly the two metatarsal angles from Q: an offset of
+    0.2 rad at mtp_r (range 0.4 rad) costs (0.2 / 0.4)² = 0.25 when tracked and nothing when
+    not; an offset at the knee costs the same either way. The unset option keeps the key."""
+    from collections import defaultdict
+
+    from gaitlib import conventions as cv
+    from gaitlib.problems import gait as gp_mod
+
+    rg = defaultdict(lambda: 0.4)
+    d = {f"ref_{k}": 0.0 for k in cv.COORDS}
+    tracked = gp_mod.goal_q(gp_mod.GoalContext(model="SK", ranges=rg, node=None, tf_of=None, stride=1.0))
+    untracked = gp_mod.goal_q(gp_mod.GoalContext(model="SK", ranges=rg, node=None, tf_of=None, stride=1.0,
+                                                 q_tracked=tuple(k for k in cv.COORDS if not k.startswith("mtp"))))
+    x_mtp = {k: (0.2 if k == "mtp_r" else 0.0) for k in cv.COORDS}
+    x_knee = {k: (0.2 if k == "knee_r" else 0.0) for k in cv.COORDS}
+    assert tracked(x_mtp, None, None, 0.0, d) == pytest.approx(0.25)
+    assert untracked(x_mtp, None, None, 0.0, d) == 0.0
+    assert untracked(x_knee, None, None, 0.0, d) == tracked(x_knee, None, None, 0.0, d) == pytest.approx(0.25)
+    base = gp_mod.GaitSpec(model="MSK")
+    from dataclasses import replace
+
+    assert replace(base, track_mtp=None).key() == base.key() != replace(base, track_mtp=False).key()

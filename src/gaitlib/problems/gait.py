@@ -228,7 +228,7 @@ for _name, _w in _T62_NMSK.items():
 
 #: Spec options that are left out of :meth:`GaitSpec.to_dict` (hence of every cache key)
 #: while unset: added after the store was written, they must not change existing keys.
-KEY_STABLE_OPTIONS = ("swing_load_max", "derivatives", "jerk_ranges")
+KEY_STABLE_OPTIONS = ("swing_load_max", "derivatives", "jerk_ranges", "track_mtp")
 
 #: How the Jrk term (Eq 4.11) normalises the jerk of each coordinate (:class:`GaitSpec`
 #: ``jerk_ranges``; :func:`reference`).
@@ -317,6 +317,10 @@ class GaitSpec:
         built. The same problem; set explicitly it is part of the cache key, because IPOPT's
         path (and so the local optimum) can differ between the two. It travels with the spec,
         so sweep workers and a gap diagnosis's fits use it too.
+    track_mtp : ``None`` / ``True`` (the thesis) or ``False``: whether the Q term tracks the
+        two metatarsal angles. Their reference is not measured: it is the thesis's planned
+        trajectory (Table 4.6), so ``False`` leaves the metatarsal joints to the dynamics — an
+        ablation of the Fidelity II study (:func:`gaitlib.studies.fidelity.ch5_changes`).
     """
 
     model: str = "SK"
@@ -349,6 +353,7 @@ class GaitSpec:
     swing_load_max: float | None = None
     derivatives: str | None = None
     jerk_ranges: str | None = None
+    track_mtp: bool | None = None
 
     def __post_init__(self):
         if self.jerk_ranges not in (None,) + JERK_RANGES:
@@ -734,6 +739,7 @@ class GoalContext:
     stride: float
     muscle_activations: Any = None
     basal: float = 0.0
+    q_tracked: tuple = cv.COORDS
 
 
 def _sq(e, r):
@@ -809,9 +815,10 @@ def goal_grf(c: GoalContext):
 
 
 def goal_q(c: GoalContext):
-    """Q: every coordinate tracking its reference."""
+    """Q: every coordinate tracking its reference (``c.q_tracked``: all but the metatarsal
+    angles when :attr:`GaitSpec.track_mtp` is ``False``)."""
     rg = c.ranges
-    return lambda x, u, p, t, d: sum(_sq(x[k] - d[f"ref_{k}"], rg[k]) for k in cv.COORDS)
+    return lambda x, u, p, t, d: sum(_sq(x[k] - d[f"ref_{k}"], rg[k]) for k in c.q_tracked)
 
 
 #: Cost term name → goal factory, in the order build() adds them.
@@ -1026,7 +1033,8 @@ def build(spec: GaitSpec) -> GaitProblem:
 
     goals = []
     ctx = GoalContext(model=spec.model, ranges=rg, node=node, tf_of=tf_of, stride=stride,
-                      muscle_activations=muscle_activations if nmsk else None, basal=basal if nmsk else 0.0)
+                      muscle_activations=muscle_activations if nmsk else None, basal=basal if nmsk else 0.0,
+                      q_tracked=tuple(k for k in cv.COORDS if spec.track_mtp is not False or not k.startswith("mtp")))
     for name, factory in COST_TERMS.items():
         f = factory(ctx) if name in w else None
         if f is None:
