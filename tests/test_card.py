@@ -163,3 +163,14 @@ def test_mtg_causes_say_where_eq_5_15_binds_on_our_data():
         assert causes[g].startswith("Eq 5.15 inactive" if m > 0 else "Eq 5.15 binds"), g
         assert f"{abs(m):.1f} N·m" in causes[g] and "#which-constraints-bind" in causes[g]
     assert any(m < 0 for m in margins) and any(m > 0 for m in margins)  # both kinds occur on our data
+
+
+def test_time_split_is_iterations_times_time_per_iteration():
+    """150 s in 50 iterations against 100 s in 100: ×0.5 the iterations at ×3 the time each
+    (0.5 × 3 = 1.5, the time ratio)."""
+    from gaitlib.studies import card as card_mod
+
+    a = {"iterations": 100, "solve_time_s": 90.0, "build_time_s": 10.0}
+    b = {"iterations": 50, "solve_time_s": 140.0, "build_time_s": 10.0}
+    assert card_mod._time_split(a, b, "NMSK FP", "MSK FP") == (
+        "NMSK FP 150 s in 50 iterations, MSK FP 100 s in 100: iterations ×0.50, time per iteration ×3.00")

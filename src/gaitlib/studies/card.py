@@ -157,7 +157,7 @@ class Row:
         cause = self.cause
         if v == "invalid":
             alone = verdict(self.thesis, self.ours, unit=self.unit, sd=self.sd, holds=self.holds)
-            cause = f"{'gates fail (valid column)' if cause == 'unknown' else cause}; the number alone: {alone}"
+            cause = f"{'gates fail (valid column)' if cause in ('unknown', '') else cause}; the number alone: {alone}"
         if _missing(self.ours) and cause == "unknown":
             cause = "no stored solution"
         if v in ("reproduced", "within data SD", "qualitatively reproduced") and cause == "unknown":
@@ -747,32 +747,66 @@ def _ch6(bases: dict, runs: dict, valid: dict, reruns: dict | None = None) -> li
             rows.append(_converges_row(6, f"{k} converges (Table 6.3: {h} h)", f"converged, {h} h", runs.get(k),
                                        reruns.get(k), valid.get(k, ""), status))
     free = data_mod.load_gait_data("Free")
-    sc = {k: pr.score(s, free) for k, s in runs.items() if s is not None}
     rows += _ch6_claims(bases, runs, valid, free, reruns)
-    # the fully predictive NMSK vs MSK: % lower RMSE (Sec 6.3)
+    rows += _ch6_fp(runs, valid, bases.get("NMSK"), free)
+    timed = _fp_timed(bases)
+    if timed:  # the same rows on the FP runs with the gait's phase timing (our reading), beside them
+        where = _anchor("ch06_costfun", "FP with the gait's phase timing")
+        rows += _ch6_fp({**runs, **timed}, {**valid, **{k: gate(v, k) for k, v in timed.items()}}, bases.get("NMSK"),
+                        free, " — FP with the gait's phase timing (ours: as printed, FP is not a gait)",
+                        f"[{where}]", _ch6_activation_cause(bases, runs))
+    rows.append(_time_ratio_row(6, "all 8 MSK runs' compute time ÷ all 8 NMSK runs' (Sec 6.3, Table 6.3)",
+                                pr.THESIS_HOURS_TABLE_6_3, runs, pr.CH6_COSTS, "Ch 6, 16 runs", valid))
+    return rows
+
+
+def _fp_timed(bases: dict) -> dict:
+    """The Ch 6 FP runs with the gait's phase timing (our reading, :func:`gaitlib.studies.
+    predictive.fp_timed_study`; the book's reading otherwise) that are stored, converged and
+    valid: name → StoredGait."""
+    return {k: v for k, v in _runs(bases, "ch6", "book", swing_load_max=validity.swing_bound()).items()
+            if k.endswith(" FP") and v is not None and not _blocked(gate(v, k))}
+
+
+def _time_split(sa: dict, sb: dict, b: str, a: str) -> str:
+    """Run ``b``'s compute time (build + solve) against ``a``'s (solver stats ``sb``, ``sa``),
+    split into the ratio of iterations and the ratio of time per iteration (their product)."""
+    ia, ib = int(sa["iterations"]), int(sb["iterations"])
+    ta, tb = 3600 * _hours(sa), 3600 * _hours(sb)
+    return (f"{b} {tb:.0f} s in {ib} iterations, {a} {ta:.0f} s in {ia}: iterations ×{ib / ia:.2f}, "
+            f"time per iteration ×{(tb / ib) / (ta / ia):.2f}")
+
+
+def _ch6_fp(runs: dict, valid: dict, n5, free, label: str = "", where: str = "", model_cause: str = "") -> list[Row]:
+    """The thesis's numeric FP claims (Secs 6.2.4, 6.3): NMSK FP's RMSE and compute time
+    against MSK FP's, and NMSK FP's excitations against Ch 5's data tracking (``n5``), on
+    ``runs``; ``label`` is appended to each item and ``where`` (the section the runs are
+    shown in) to each cause (both empty for the runs as printed); ``model_cause``: the
+    measured cause of an NMSK-vs-MSK accuracy difference, the RMSE rows' cause."""
+    def cause(c: str = "") -> str:
+        return "; ".join(x for x in (c, where) if x) or "unknown"
+
+    rows = []
+    a, b = "MSK FP", "NMSK FP"
+    sc = {k: pr.score(runs[k], free) for k in (a, b) if runs.get(k) is not None}
     for kind, tv in pr.THESIS_FP_GAIN_PCT.items():
-        a, b = "MSK FP", "NMSK FP"
         ours = (100 * (1 - _mean(sc[b], kind, "rmse") / _mean(sc[a], kind, "rmse"))) if a in sc and b in sc else np.nan
-        rows.append(Row(6, f"FP: NMSK {kind} RMSE lower than MSK's by (Sec 6.3)", tv, ours, "%", "unknown",
+        rows.append(Row(6, f"FP: NMSK {kind} RMSE lower than MSK's by (Sec 6.3){label}", tv, ours, "%", cause(model_cause),
                         f"Ch 6 {a}, {b}", _joint({a: valid.get(a, ""), b: valid.get(b, "")})))
     th = pr.THESIS_HOURS_TABLE_6_3
-    a, b = runs.get("MSK FP"), runs.get("NMSK FP")
-    rows.append(Row(6, "FP: NMSK compute time lower than MSK's by (Sec 6.2.4, Table 6.3)",
+    sa, sb = runs.get(a), runs.get(b)
+    rows.append(Row(6, f"FP: NMSK compute time lower than MSK's by (Sec 6.2.4, Table 6.3){label}",
                     100 * (1 - th["NMSK"]["FP"] / th["MSK"]["FP"]),
-                    100 * (1 - _hours(b.stats) / _hours(a.stats)) if a and b else np.nan, "%", "unknown",
-                    "Ch 6 MSK FP, NMSK FP", _joint({k: valid.get(k, "") for k in ("MSK FP", "NMSK FP")})))
-    rows.append(_time_ratio_row(6, "all 8 MSK runs' compute time ÷ all 8 NMSK runs' (Sec 6.3, Table 6.3)", th, runs,
-                                pr.CH6_COSTS, "Ch 6, 16 runs", valid))
-    ex = {c: float(pr.excitation_score(runs[f"NMSK {c}"], free)["rmse"].mean())
-          for c in pr.CH6_COSTS if runs.get(f"NMSK {c}") is not None}
-    n5 = bases.get("NMSK")
+                    100 * (1 - _hours(sb.stats) / _hours(sa.stats)) if sa and sb else np.nan, "%",
+                    cause(_time_split(sa.stats, sb.stats, b, a) if sa and sb else ""),
+                    f"Ch 6 {a}, {b}", _joint({k: valid.get(k, "") for k in (a, b)})))
     ours = np.nan
-    if n5 is not None and "FP" in ex:
-        e5 = float(pr.excitation_score(n5, free)["rmse"].mean())
-        ours = 100 * (1 - ex["FP"] / e5)
-    rows.append(Row(6, "NMSK FP excitation RMSE lower than the Ch 5 data tracking's by (Sec 6.2.4)",
-                    pr.THESIS_FP_EXCITATION_GAIN_PCT, ours, "%", "unknown", "Ch 6 NMSK FP, Ch 5 NMSK",
-                    _joint({"NMSK FP": valid.get("NMSK FP", ""), "Ch 5 NMSK": gate(n5, "NMSK") if n5 is not None else ""})))
+    if n5 is not None and runs.get(b) is not None:
+        ours = 100 * (1 - float(pr.excitation_score(runs[b], free)["rmse"].mean())
+                      / float(pr.excitation_score(n5, free)["rmse"].mean()))
+    rows.append(Row(6, f"NMSK FP excitation RMSE lower than the Ch 5 data tracking's by (Sec 6.2.4){label}",
+                    pr.THESIS_FP_EXCITATION_GAIN_PCT, ours, "%", cause(), f"Ch 6 {b}, Ch 5 NMSK",
+                    _joint({b: valid.get(b, ""), "Ch 5 NMSK": gate(n5, "NMSK") if n5 is not None else ""})))
     return rows
 
 
@@ -795,8 +829,7 @@ def _ch6_claims(bases: dict, runs: dict, valid: dict, free, reruns: dict) -> lis
     valid = {**valid, **{k: gate(s, k) for k, s in usable.items()},
              ch6_claims.CH5_NMSK: gate(n5, "NMSK") if n5 is not None else ""}
     # the FP claims again on the FP runs with the gait's phase timing (Ch 6, our reading)
-    timed = {k: v for k, v in _runs(bases, "ch6", "book", swing_load_max=validity.swing_bound()).items()
-             if k.endswith(" FP") and v is not None and not _blocked(gate(v, k))}
+    timed = _fp_timed(bases)
     table_t = (ch6_claims.conclusions({**usable, **timed}, free, ch5_nmsk=n5, notes=notes).set_index("claim")
                if timed else None)
     fp_where = _anchor("ch06_costfun", "FP with the gait's phase timing")
