@@ -341,6 +341,7 @@ def _ch4() -> list[Row]:
     ph = ci.grf_error_by_phase(res) if res else None
     where = _anchor("ch04_contact", "Why the GRF fits differ from the thesis's: where the error is")
     jerk = _jerk_causes("SK")
+    a_cause = _ch4_a_cause(table) if "a" in res else ""
     rows = []
     for k, th in ci.THESIS_RMSE.items():
         if k == "c_wide":
@@ -360,6 +361,8 @@ def _ch4() -> list[Row]:
             jk = ("torque", qty[4:], side) if qty.startswith("tau_") else ("grf", qty[4:], side)
             if cause == "unknown" and k != "a" and jk in jerk:  # (a) has no Jrk term (trajectory optimisation)
                 cause = jerk[jk]
+            if cause == "unknown" and k == "a" and a_cause:
+                cause = a_cause
             item = f"({k}) RMSE {qty}{' ' + side.upper() if side else ''} ({ci.THESIS_RMSE_SOURCE[k]})"
             rows.append(Row(4, item, tv, ours, unit, cause, names.get(k, ""), valid.get(k, ""), sd=sd))
     if {"a", "b", "c"} <= set(res):
@@ -378,6 +381,22 @@ def _ch4() -> list[Row]:
                         _total_mass(res["c"].p_body, masses, ci.P_BODY_NAMES), "kg", "unknown", names["c"],
                         valid["c"]))
     return rows
+
+
+def _ch4_a_cause(table: pd.DataFrame) -> str:
+    """Why approach (a) fails the residual gate by construction: its kinematics are the data's,
+    so the pelvis residual loads carry all of the motion's dynamic inconsistency (nothing in
+    Eq 4.5 bounds or weights them) — ours beside the thesis's own (a) (Table 4.9, a labelled
+    reference) against the gate's residual-force threshold (:mod:`gaitlib.validity`)."""
+    m = table[(table["approach"] == "a") & (table["quantity"] == "R_y")]
+    if not len(m):
+        return ""
+    th = ci.THESIS_RMSE["a"].get(("R_y", ""))
+    ours = float(m["ours"].iloc[0])
+    return (f"(a) fixes the kinematics to the data, and Eq 4.5 neither bounds nor weights the pelvis residuals: "
+            f"they carry all of the motion's dynamic inconsistency (R_y RMSE ours {ours:.0f} N"
+            + (f", the thesis's (a) {th:.0f} N (Table 4.9)" if th is not None else "")
+            + f") [{_anchor('ch04_contact', 'Residual loads on the pelvis (Fig 4.13)')}]")
 
 
 def _total_mass(p, idx, names) -> float:
