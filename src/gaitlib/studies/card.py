@@ -286,7 +286,10 @@ def _ch3() -> list[Row]:
         mu = {n: s.required_friction for n, s in sols.items()}
         rows.append(Row(3, "ellipsoid contact needs less friction than either welded foot (Sec 3.4.3)",
                         "μ_s ellipsoid < toeless, toe", ", ".join(f"{n} {m:.2f}" for n, m in mu.items()), "",
-                        "unknown", "jump (3 solutions)", v, holds=mu["ellipsoid"] < min(mu["toeless"], mu["toe"])))
+                        "thesis-bounds formulation (Table 3.5 torques to 4000 N·m): peak joint torques beyond the "
+                        f"body's strength (valid column), COM rises {', '.join(f'{n} {100 * r:.0f} cm' for n, r in rise.items())}"
+                        f" — not human jumps [{why}]", "jump (3 solutions)", v,
+                        holds=mu["ellipsoid"] < min(mu["toeless"], mu["toe"])))
     retries = {}  # the other continuations of a strength-limited jump that did not converge (stored ones)
     for n, s in strong.items():
         if not s.success:
