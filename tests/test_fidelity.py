@@ -8,6 +8,7 @@ from dataclasses import replace
 
 import casadi as ca
 import numpy as np
+import pandas as pd
 import pytest
 
 from gaitlib import data as data_mod
@@ -198,3 +199,24 @@ def test_cot_curve_findings_locate_the_minimum_and_the_term_that_moves_it():
     terms.loc["Free", "shortening"] = 0.5  # now Free is lowest
     terms["total"] = terms[["activation", "maintenance", "shortening", "basal", "work"]].sum(axis=1)
     assert "the natural speed, as the thesis" in " ".join(fidelity.cot_curve_findings(cot, terms))
+
+
+def test_metatarsal_findings_read_the_knees_from_the_ablation_and_the_floor():
+    """Hand-made channel table and floor: knees 4.0/4.4° in Ch 5, 2.6/2.4° with the coordinate
+    weight, 2.3/2.5° with both changes, target 1.8°; free-metatarsal floor 0.9/1.0°. The
+    largest drop from freeing the metatarsal is 2.6 − 2.3 = 0.3°, no knee meets the target,
+    and both combined runs are 2.3 − 0.9 = 1.4° and 2.5 − 1.0 = 1.5° above the floor."""
+    q = "coordinate weight ×4"
+    combo = f"{fidelity.METATARSAL_FREE} + {q}"
+    idx = pd.MultiIndex.from_tuples([("angle", "knee", "r", "deg"), ("angle", "knee", "l", "deg"),
+                                     ("angle", "hip", "r", "deg")], names=["kind", "channel", "side", "unit"])
+    ch = pd.DataFrame({fidelity.CH5_BASE_ROW: [4.0, 4.4, 1.0], q: [2.6, 2.4, 0.9], fidelity.METATARSAL_FREE: [3.9, 4.5, 1.0],
+                       combo: [2.3, 2.5, 0.8], "thesis (Table 5.4)": [1.1, 1.2, 0.6], "target": [1.8, 1.8, 1.8],
+                       "best change": [combo, q, combo], "met by": ["none", "none", "all"]}, index=idx)
+    floor = pd.DataFrame({"swing clearance (mm)": [1e3 * fidelity.TOUCH] * 2, "metatarsal": ["tracked (planned)", "free"],
+                          "knee_r (deg)": [2.2, 0.9], "knee_l (deg)": [2.0, 1.0]})
+    (line,) = fidelity.metatarsal_findings(ch, floor)
+    assert "R 4.0° → 3.9° untracked; 2.6° with the coordinate weight ×4 → 2.3° with both" in line
+    assert "lowers the knees by at most 0.3°" in line and "met by neither knee" in line
+    assert "stay 1.4–1.5° above the free-metatarsal geometric floor" in line
+    assert fidelity.metatarsal_findings(ch.drop(columns=[combo]), floor) == []

@@ -348,6 +348,45 @@ def ch5_ablation_findings(table: pd.DataFrame, per_channel: pd.DataFrame, floor:
     return out
 
 
+def metatarsal_findings(per_channel: pd.DataFrame, floor: pd.DataFrame, clearance_mm: float = 1e3 * TOUCH) -> list[str]:
+    """The metatarsal experiment of the Ch 5 ablation (:data:`METATARSAL_FREE`, alone and with
+    the coordinate weight raised), read from ``per_channel`` (:func:`channel_table` of the
+    usable runs): the knees' RMSE beside the runs without the change and the geometric floor
+    (``floor``: :func:`kinematic_floor_table`) with the metatarsal tracked and free. Empty
+    when a run it needs is not usable."""
+    cols = [c for c in per_channel.columns if c not in ("target", "best change", "met by") and not c.startswith("thesis")]
+    q = next((c for c in cols if c.startswith("coordinate weight")), None)
+    combo = f"{METATARSAL_FREE} + {q}" if q else None
+    if METATARSAL_FREE not in cols or combo not in cols or not cols:
+        return []
+    ang = per_channel.xs("angle", level="kind")
+    at = floor[np.isclose(floor["swing clearance (mm)"], clearance_mm)].set_index("metatarsal")
+    knees = [(ch, side) for ch, side, _ in ang.index if ch == "knee"]
+    parts = []
+    for ch, side in knees:
+        r = ang.xs((ch, side), level=("channel", "side")).iloc[0]
+        fcol = f"{ch}_{side} (deg)"
+        fl = f" (geometric floor {at[fcol].iloc[0]:.1f}° tracked, {at[fcol].iloc[1]:.1f}° free)" if fcol in at.columns else ""
+        parts.append(f"{side.upper()} {r[cols[0]]:.1f}° → {r[METATARSAL_FREE]:.1f}° untracked; {r[q]:.1f}° with the "
+                     f"{q} → {r[combo]:.1f}° with both{fl}")
+    rows = {k: ang.xs(k, level=("channel", "side")).iloc[0] for k in knees}
+    gain = max(float(r[q] - r[combo]) for r in rows.values())
+    met = [f"{side.upper()}" for (ch, side), r in rows.items() if r[combo] <= r["target"]]
+    above = [float(r[combo] - at[f"{ch}_{side} (deg)"].iloc[1]) for (ch, side), r in rows.items()
+             if f"{ch}_{side} (deg)" in at.columns]
+    tail = (f"With the coordinate weight raised, freeing the metatarsal lowers the knees by at most {gain:.1f}°; "
+            f"the {rows[knees[0]]['target']:.1f}° target is met by {', '.join(met) or 'neither knee'}"
+            + (f", and the solved knees stay {_span(above)}° above the free-metatarsal geometric floor: what holds "
+               "them there is not the metatarsal reference." if above else "."))
+    return [f"- **The metatarsal reference** (knee RMSE, book's Ch 5 → changed): {'; '.join(parts)}. {tail}"]
+
+
+def _span(v: list) -> str:
+    """``"a–b"`` (one decimal), or ``"a"`` when both ends print the same."""
+    lo, hi = f"{min(v):.1f}", f"{max(v):.1f}"
+    return lo if lo == hi else f"{lo}–{hi}"
+
+
 def usable_solutions(sols: dict) -> dict:
     """The converged solutions that pass the validity gates (what a conclusion may use)."""
     return {k: v for k, v in sols.items() if v is not None and v.stats["status"] in validity.CONVERGED_STATUSES
