@@ -241,3 +241,46 @@ def test_bounded_final_time_sk_solve():
     X = s.solution.phase("cycle").states
     assert X["pelvis_tx"].iloc[-1] - X["pelvis_tx"].iloc[0] == pytest.approx(gp0.stride, abs=1e-6)
     assert X.index[-1] == pytest.approx(tf)
+
+
+def test_ch5_activation_set_round_trips_and_is_checked(tmp_path, monkeypatch):
+    """save_activation writes the γ a Ch 5 NMSK solve identified; load_activation_params reads
+    back the same numbers, and refuses a value outside its Sec 5.3.4 bounds naming the file and
+    the entry. A spec with activation_params="ch5" reads the set (and hashes it); unset, the
+    spec's key is unchanged; the option is NMSK-only and excludes free_activation."""
+    import json as _json
+    from types import SimpleNamespace
+
+    from gaitlib import params as params_mod
+    from gaitlib.problems import gait as gp
+    from gaitlib.studies import msk
+
+    spec = gp.GaitSpec(model="NMSK", cost="Eq5.55", free_activation=True)
+    gamma = {"tau_act": 0.012, "c3": 0.4, "s1": 0.3, "s2": 0.2}
+    sol = SimpleNamespace(spec=spec, stats={"activation_parameters": gamma, "status": "Solve_Succeeded",
+                                            "iterations": 10, "objective": 1.5})
+    f = msk.save_activation(sol, tmp_path / "ch5_activation.json")
+    assert gp.load_activation_params(f) == gamma
+    raw = _json.loads(f.read_text())
+    raw["params"]["c3"] = 0.9
+    f.write_text(_json.dumps(raw))
+    with pytest.raises(ValueError, match=r"ch5_activation\.json: params\['c3'\] = 0\.9 outside its bounds"):
+        gp.load_activation_params(f)
+    with pytest.raises(FileNotFoundError, match="save_activation"):
+        gp.load_activation_params(tmp_path / "missing.json")
+    with pytest.raises(ValueError, match="not converge"):
+        msk.save_activation(SimpleNamespace(spec=spec, stats={**sol.stats, "status": "Maximum_Iterations_Exceeded"}),
+                            tmp_path / "x.json")
+
+    fixed = gp.GaitSpec(model="NMSK", cost="DT")
+    ours = dataclasses.replace(fixed, activation_params="ch5")
+    assert dataclasses.replace(fixed, activation_params=None).key() == fixed.key() != ours.key()
+    assert gp.ACTIVATION_SET in ours.identified_sets() and gp.ACTIVATION_SET not in fixed.identified_sets()
+    monkeypatch.setattr(params_mod, "identified_path", lambda name: tmp_path / f"{name}.json")
+    msk.save_activation(sol)
+    assert gp.activation_values(ours) == gamma
+    assert gp.activation_values(fixed) == {k: float(v) for k, v in gp.activation.ACTIVATION_IDENTIFIED.items()}
+    with pytest.raises(ValueError, match="NMSK model only"):
+        gp.GaitSpec(model="MSK", activation_params="ch5")
+    with pytest.raises(ValueError, match="choose one"):
+        gp.GaitSpec(model="NMSK", cost="Eq5.55", free_activation=True, activation_params="ch5")

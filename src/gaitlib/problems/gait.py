@@ -228,7 +228,7 @@ for _name, _w in _T62_NMSK.items():
 
 #: Spec options that are left out of :meth:`GaitSpec.to_dict` (hence of every cache key)
 #: while unset: added after the store was written, they must not change existing keys.
-KEY_STABLE_OPTIONS = ("swing_load_max", "derivatives", "jerk_ranges", "track_mtp")
+KEY_STABLE_OPTIONS = ("swing_load_max", "derivatives", "jerk_ranges", "track_mtp", "activation_params")
 
 #: How the Jrk term (Eq 4.11) normalises the jerk of each coordinate (:class:`GaitSpec`
 #: ``jerk_ranges``; :func:`reference`).
@@ -272,7 +272,11 @@ class GaitSpec:
         variable t_f.
     free_activation : NMSK only — identify the activation parameters γ = (τ_act, c3, s1,
         s2) (Eq 5.53; bounds Sec 5.3.4, guess Table 5.10 "initial"); otherwise they are
-        fixed to Table 5.10's identified values (as in Ch 6).
+        fixed to Table 5.10's identified values (as in Ch 6), or to ``activation_params``'s.
+    activation_params : NMSK with fixed γ only — ``None`` (Table 5.10's identified values, the
+        thesis's own) or ``"ch5"``: the values our Ch 5 NMSK solve identified on our data
+        (``data/identified/ch5_activation.json``, :func:`gaitlib.studies.msk.save_activation`):
+        the thesis's procedure — Ch 5's identified γ carried into Chs 6–7 — on our data.
     excitation_guess : NMSK only — ``"mtg"``: excitations from the inverse-MTG activations
         of the data (the MSK guess of Sec 5.2.1) through the inverted activation dynamics;
         ``"emg"``: the data's processed EMG where the source has the muscle (thesis Sec
@@ -354,6 +358,7 @@ class GaitSpec:
     derivatives: str | None = None
     jerk_ranges: str | None = None
     track_mtp: bool | None = None
+    activation_params: str | None = None
 
     def __post_init__(self):
         if self.jerk_ranges not in (None,) + JERK_RANGES:
@@ -366,8 +371,13 @@ class GaitSpec:
             lo, hi = self.tf_bounds
             if not 0.0 < float(lo) <= float(hi):
                 raise ValueError(f"tf_bounds must be () or (lo, hi) with 0 < lo <= hi, got {self.tf_bounds!r}")
-        if self.model != "NMSK" and (self.free_activation or self.excitation_guess != "mtg" or self.t_stim is not None):
-            raise ValueError("free_activation, excitation_guess and t_stim apply to the NMSK model only")
+        if self.model != "NMSK" and (self.free_activation or self.excitation_guess != "mtg" or self.t_stim is not None
+                                     or self.activation_params is not None):
+            raise ValueError("free_activation, activation_params, excitation_guess and t_stim apply to the NMSK model only")
+        if self.activation_params not in (None, "ch5"):
+            raise ValueError(f"activation_params must be None or 'ch5', got {self.activation_params!r}")
+        if self.activation_params is not None and self.free_activation:
+            raise ValueError("activation_params fixes γ; free_activation identifies it: choose one")
         if self.body_params not in ("default", "thesis", "ch4"):
             raise ValueError(f"body_params must be 'default', 'thesis' or 'ch4', got {self.body_params!r}")
         if self.mtg_params not in MTG_PARAM_SETS:
@@ -413,6 +423,8 @@ class GaitSpec:
             sets.append("ch4_child")
         if self.mtg_params == "ch5":
             sets.append("ch5_mtg")
+        if self.activation_params == "ch5":
+            sets.append(ACTIVATION_SET)
         return tuple(sets)
 
     def key(self) -> str:
@@ -701,9 +713,44 @@ def mtg_params_of(spec_or_name) -> dict | None:
 
 def activation_values(spec: GaitSpec) -> dict[str, float]:
     """Numeric activation parameters γ (Eq 5.53) of an NMSK spec: Table 5.10's identified
-    values, or its initial guesses when ``free_activation`` (then they are NLP variables)."""
+    values, ours (``activation_params="ch5"``, :func:`load_activation_params`), or Table
+    5.10's initial guesses when ``free_activation`` (then they are NLP variables)."""
+    if spec.activation_params == "ch5":
+        return load_activation_params(params_mod.identified_path(ACTIVATION_SET))
     src = activation.ACTIVATION_INITIAL if spec.free_activation else activation.ACTIVATION_IDENTIFIED
     return {k: float(src[k]) for k in ACTIVATION_PARAMS}
+
+
+#: The identified parameter set of :attr:`GaitSpec.activation_params` ``"ch5"``.
+ACTIVATION_SET = "ch5_activation"
+
+
+def load_activation_params(path) -> dict[str, float]:
+    """Activation parameters γ from a JSON file ``{"params": {τ_act (s), c3, s1, s2}, "provenance":
+    …}`` (written by :func:`gaitlib.studies.msk.save_activation`), each checked against its
+    bounds (:data:`gaitlib.activation.ACTIVATION_BOUNDS`, Sec 5.3.4). Errors name the file and
+    the entry."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"activation parameter file {path} not found: it is written by "
+                                f"gaitlib.studies.msk.save_activation (the Ch 5 NMSK solve's identified γ)")
+    try:
+        raw = json.loads(path.read_text())
+    except json.JSONDecodeError as e:
+        raise ValueError(f"{path}: not valid JSON ({e})") from None
+    if "params" not in raw or "provenance" not in raw:
+        raise ValueError(f"{path}: needs 'params' and 'provenance' entries")
+    d = raw["params"]
+    if set(d) != set(ACTIVATION_PARAMS):
+        raise ValueError(f"{path}: params must have exactly {ACTIVATION_PARAMS}, got {sorted(d)}")
+    out = {}
+    for k in ACTIVATION_PARAMS:
+        lo, hi = activation.ACTIVATION_BOUNDS[k]
+        v = float(d[k])
+        if not (math.isfinite(v) and lo - 1e-9 <= v <= hi + 1e-9):
+            raise ValueError(f"{path}: params[{k!r}] = {v!r} outside its bounds [{lo}, {hi}] (Sec 5.3.4)")
+        out[k] = v
+    return out
 
 
 def mtb_scale(t_f, stride: float, body_mass: float = cv.BODY_MASS):

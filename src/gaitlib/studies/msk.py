@@ -35,6 +35,9 @@ transcription's ``excitation_guess="emg"``) and the inverse-MTG excitations else
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 
@@ -48,6 +51,7 @@ from ..problems import gait as gait_ocp
 from . import gait as sg
 
 __all__ = ["EMG_MAP", "THESIS_TABLE_5_10", "THESIS_COT", "CHILD_COT_GROSS", "THESIS_HOURS", "parameter_sets", "ch5_spec", "solve",
+           "save_activation",
            "emg_table", "emg_reference", "excitation_scores", "activation_table", "cot_breakdown",
            "cot_readings", "pelvis_travel", "min_generator_torque", "THESIS_DISTANCE_M", "OPENSIM_BASAL_W_PER_KG",
            "mtb_scale_table", "excitation_figure", "saturation", "synergy_cost_table", "MOVED_TOL",
@@ -135,6 +139,34 @@ def solve(model: str = "MSK", *, guess: str = "msk", root=None, progress: bool =
     if guess not in ("msk", "data"):
         raise ValueError(f"guess must be 'msk' or 'data', got {guess!r}")
     return gait_ocp.solve_cached(spec, root=root, progress=progress)
+
+
+def save_activation(sol: gait_ocp.GaitSolution, path=None) -> Path:
+    """Write the activation parameters γ (τ_act s; c3, s1, s2 dimensionless, Eq 5.53) that the
+    Ch 5 NMSK solve ``sol`` identified (``free_activation``), with their provenance, to
+    ``data/identified/ch5_activation.json`` (default; the set ``GaitSpec(activation_params="ch5")``
+    reads). Refuses a solve that did not converge or did not identify γ. The file is part of
+    the cache keys of exactly the specs that read it."""
+    if not sol.spec.free_activation or not sol.stats.get("activation_parameters"):
+        raise ValueError("save_activation: expects an NMSK solve that identified its activation parameters")
+    if sol.stats["status"] not in ("Solve_Succeeded", "Solved_To_Acceptable_Level"):
+        raise ValueError(f"save_activation: the solve did not converge ({sol.stats['status']}); not saving")
+    path = Path(path) if path is not None else params_mod.identified_path(gait_ocp.ACTIVATION_SET)
+    ap = sol.stats["activation_parameters"]
+    out = {
+        "name": gait_ocp.ACTIVATION_SET,
+        "description": ("Activation parameters (Eq 5.53) identified by the Ch 5 NMSK data-tracking solve (Eq 5.55, "
+                        "free_activation) on the Schwartz 2008 Free-speed data; tau_act in s, c3, s1, s2 "
+                        "dimensionless."),
+        "params": {k: float(ap[k]) for k in gait_ocp.ACTIVATION_PARAMS},
+        "bounds": {k: [float(a), float(b)] for k, (a, b) in activation.ACTIVATION_BOUNDS.items()},
+        "provenance": {"study": "gaitlib.studies.msk.solve('NMSK', reading=...)", "spec": sol.spec.to_dict(),
+                       "spec_key": sol.spec.key(), "ipopt_status": sol.stats["status"],
+                       "iterations": int(sol.stats["iterations"]), "objective": float(sol.stats["objective"])},
+    }
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(out, indent=1) + "\n")
+    return path
 
 
 # --------------------------------------------------------------------------------------

@@ -143,6 +143,14 @@ def activation_study(costs=("DT",), **kw) -> StudyResult:
     return variant_study(("NMSK",), costs, free_activation=True, **kw)
 
 
+def ch5_activation_study(costs=CH6_COSTS, **kw) -> StudyResult:
+    """The NMSK Ch 6 runs in the book's reading with the activation parameters fixed to those
+    our Ch 5 NMSK solve identified on our data (``activation_params="ch5"``) instead of the
+    thesis's Table 5.10 values (:func:`variant_study`): the thesis's procedure — carry Ch 5's
+    identified γ into Ch 6 — applied to our data, everything else unchanged."""
+    return variant_study(("NMSK",), costs, activation_params="ch5", **kw)
+
+
 def activation_table(res: StudyResult, res_act: StudyResult, costs=("DT",)) -> pd.DataFrame:
     """The NMSK runs of ``costs`` with the thesis's activation parameters (``res``, the Ch 6
     study) beside the same runs with them identified (``res_act``, :func:`activation_study`),
@@ -169,7 +177,7 @@ def activation_table(res: StudyResult, res_act: StudyResult, costs=("DT",)) -> p
 def default_params() -> dict:
     """The parameter sets the thesis carries into Chs 6–7: those of the Ch 5 solves
     (:func:`gaitlib.studies.msk.parameter_sets`). The NMSK runs use the activation
-    parameters of thesis Table 5.10 (``GaitSpec`` has no field for ours yet)."""
+    parameters of thesis Table 5.10 (ours, carried from Ch 5: :func:`ch5_activation_study`)."""
     return msk.parameter_sets()
 
 
