@@ -110,3 +110,17 @@ def test_an_extremum_claim_fails_on_the_usable_runs_or_stays_untested():
     assert _row(t, "NMSK SDT3 predicts the most")["verdict"] == "does not hold"
     # "worse half" is no extremum: it needs all eight
     assert _row(t, "NMSK DT is among")["verdict"] == "not tested"
+
+
+def test_changed_lists_only_the_claims_whose_verdict_moves():
+    import pandas as pd
+
+    from gaitlib.studies import ch6_claims
+
+    before = pd.DataFrame({"claim": ["a", "b", "c"], "verdict": ["holds", "does not hold", "not tested"],
+                           "NRMSE": ["0.1 vs 0.2", "0.3 vs 0.1", "—"]})
+    after = pd.DataFrame({"claim": ["a", "b", "d"], "verdict": ["holds", "holds", "holds"],
+                          "NRMSE": ["0.1 vs 0.2", "0.1 vs 0.1", "x"]})
+    t = ch6_claims.changed(before, after)
+    assert list(t.index) == ["b"]
+    assert t.loc["b"].tolist() == ["does not hold", "holds", "0.3 vs 0.1", "0.1 vs 0.1"]

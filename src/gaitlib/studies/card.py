@@ -856,6 +856,13 @@ def _ch6_claims(bases: dict, runs: dict, valid: dict, free, reruns: dict) -> lis
                if timed else None)
     fp_where = _anchor("ch06_costfun", "FP with the gait's phase timing")
     act_cause = _ch6_activation_cause(bases, runs)
+    # the same claims with our Ch 5 activation parameters in every NMSK run (the thesis's procedure, our data)
+    c5 = ({k: v for k, v in _runs({"NMSK": n5}, "ch6", "book", activation_params="ch5").items()
+           if v is not None and not _blocked(gate(v, k))} if n5 is not None else {})
+    table_c5 = (ch6_claims.conclusions({**{k: v for k, v in usable.items() if not k.startswith("NMSK")}, **c5}, free,
+                                       ch5_nmsk=n5).set_index("claim") if c5 else None)
+    c5_where = _anchor("ch06_costfun", "The thesis's procedure on our data: Ch 5's activation parameters in every "
+                                       "NMSK run")
     start_check = _ch6_start_check(n5, free)
     rows = []
     for _, r in table[~table["numeric"].astype(bool)].iterrows():
@@ -874,6 +881,10 @@ def _ch6_claims(bases: dict, runs: dict, valid: dict, free, reruns: dict) -> lis
         model_pair = r["claim"].split(":")[0] in pr.CH6_COSTS and ("MSK" in r["claim"] and "NMSK" in r["claim"])
         if cause == "unknown" and model_pair and act_cause:
             cause = act_cause
+            if table_c5 is not None and r["claim"] in table_c5.index:
+                t = table_c5.loc[r["claim"]]
+                cause += (f"; with our Ch 5 activation parameters in every NMSK run (the thesis's procedure on our "
+                          f"data): {t['verdict']} ({t['NRMSE']}) [{c5_where}]")
         if cause == "unknown" and exc and r["claim"] in start_check:
             cause = start_check[r["claim"]]
         if r["depends on metric"]:

@@ -329,6 +329,16 @@ def usable(res: pr.StudyResult, reruns: dict | None = None) -> tuple[dict, dict,
     return runs, excluded, notes
 
 
+def changed(before: pd.DataFrame, after: pd.DataFrame) -> pd.DataFrame:
+    """The claims whose verdict differs between two :func:`conclusions` tables of the same
+    claims (e.g. two sets of runs): claim, verdict and NRMSE text before and after."""
+    a, b = before.set_index("claim"), after.set_index("claim")
+    common = [c for c in a.index if c in b.index and a.loc[c, "verdict"] != b.loc[c, "verdict"]]
+    return pd.DataFrame({"verdict before": a.loc[common, "verdict"], "verdict after": b.loc[common, "verdict"],
+                         "NRMSE before": a.loc[common, "NRMSE"], "NRMSE after": b.loc[common, "NRMSE"]},
+                        index=pd.Index(common, name="claim"))
+
+
 def summary(table: pd.DataFrame) -> str:
     """One sentence: how many claims hold, do not hold, depend on the metric, are not tested."""
     n = table["verdict"].value_counts().reindex(list(VERDICTS), fill_value=0)

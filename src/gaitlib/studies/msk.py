@@ -51,7 +51,7 @@ from ..problems import gait as gait_ocp
 from . import gait as sg
 
 __all__ = ["EMG_MAP", "THESIS_TABLE_5_10", "THESIS_COT", "CHILD_COT_GROSS", "THESIS_HOURS", "parameter_sets", "ch5_spec", "solve",
-           "save_activation",
+           "save_activation", "activation_sets",
            "emg_table", "emg_reference", "excitation_scores", "activation_table", "cot_breakdown",
            "cot_readings", "pelvis_travel", "min_generator_torque", "THESIS_DISTANCE_M", "OPENSIM_BASAL_W_PER_KG",
            "mtb_scale_table", "excitation_figure", "saturation", "synergy_cost_table", "MOVED_TOL",
@@ -167,6 +167,17 @@ def save_activation(sol: gait_ocp.GaitSolution, path=None) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(out, indent=1) + "\n")
     return path
+
+
+def activation_sets() -> pd.DataFrame:
+    """The activation parameters γ the NMSK runs of Chs 6–7 can carry: Table 5.10's identified
+    values (the thesis's, on its data) and ours (:func:`save_activation`, the Ch 5 NMSK solve on
+    our data), with their bounds (Sec 5.3.4). τ_act in s; c3, s1, s2 dimensionless."""
+    ours = gait_ocp.load_activation_params(params_mod.identified_path(gait_ocp.ACTIVATION_SET))
+    rows = {"Table 5.10 (thesis)": dict(activation.ACTIVATION_IDENTIFIED), "Ch 5 (ours, our data)": ours,
+            "lower bound": {k: v[0] for k, v in activation.ACTIVATION_BOUNDS.items()},
+            "upper bound": {k: v[1] for k, v in activation.ACTIVATION_BOUNDS.items()}}
+    return pd.DataFrame(rows).T[list(gait_ocp.ACTIVATION_PARAMS)].astype(float)
 
 
 # --------------------------------------------------------------------------------------
