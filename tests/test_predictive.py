@@ -201,3 +201,27 @@ def test_fp_may_be_timed_by_the_data_swing_but_not_with_a_free_final_time():
     assert s.swing_load_max == b and "Ang" not in s.term_weights and "Trq" not in s.term_weights
     with pytest.raises(ValueError, match="fixed final time"):
         gait_ocp.GaitSpec(model="MSK", cost="FP", swing_load_max=b, tf_bounds=(0.8, 1.2))
+
+
+def test_ch7_runs_carry_activation_params_but_their_ch5_baseline_does_not(monkeypatch):
+    """ch5_activation_speed_study: the Ch 5 NMSK baseline identifies its own γ (free_activation),
+    so activation_params="ch5" reaches the four NMSK runs only (GaitSpec forbids both at once)."""
+    from gaitlib.studies import predictive as pr_mod
+
+    seen = {}
+
+    def fake_baseline(model, **kw):
+        seen["baseline"] = kw
+        return "base"
+
+    def fake_specs(model, base, classes, **kw):
+        seen["runs"] = kw
+        return {}
+
+    monkeypatch.setattr(pr_mod, "baseline", fake_baseline)
+    monkeypatch.setattr(pr_mod, "ch7_specs", fake_specs)
+    monkeypatch.setattr(pr_mod, "_run", lambda specs, guesses, **kw: ({}, {}))
+    monkeypatch.setattr(pr_mod, "_scores", lambda *a, **kw: None)
+    pr_mod.ch5_activation_speed_study()
+    assert "activation_params" not in seen["baseline"] and seen["baseline"]["reading"] == "book"
+    assert seen["runs"]["activation_params"] == "ch5" and seen["runs"]["reading"] == "book"

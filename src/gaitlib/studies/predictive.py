@@ -504,7 +504,7 @@ def speed_study(models=("MSK", "NMSK"), classes=CH7_CLASSES, *, n_intervals: int
         params = {**(default_params() if params is None else params), "weights": tuple(weights)}
     params = default_params() if params is None else dict(params)
     how = {**GUESS_POLICY, **(guess or {})}
-    base_params = {k: v for k, v in params.items() if k != "weights"}
+    base_params = {k: v for k, v in params.items() if k not in _RUN_ONLY}
     bases = {m: baseline(m, n_intervals=n_intervals, degree=degree, root=root, source=source, reading=reading,
                          **base_params)
              for m in models}
@@ -521,6 +521,18 @@ def speed_study(models=("MSK", "NMSK"), classes=CH7_CLASSES, *, n_intervals: int
                       progress=progress)
     return StudyResult(specs, recs, sols, bases, _scores(sols, gaits, lambda s: s.spec.speed_class),
                        guess=how, guesses=guesses)
+
+
+#: ``params`` of :func:`speed_study` that set the runs only, not the Ch 5 baseline they start
+#: from (the baseline identifies its own activation parameters, Eq 5.55).
+_RUN_ONLY = ("weights", "activation_params")
+
+
+def ch5_activation_speed_study(**kw) -> StudyResult:
+    """The NMSK Ch 7 runs in the book's reading with our Ch 5 activation parameters
+    (:func:`ch5_activation_study`'s change) instead of Table 5.10's, everything else as
+    :func:`speed_study`."""
+    return speed_study(("NMSK",), reading="book", params={**default_params(), "activation_params": "ch5"}, **kw)
 
 
 #: The Ch 7 pin experiment: Table 7.1's three data-tracking weights (Trq, Ang, GRF; 1/4
