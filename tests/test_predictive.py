@@ -225,3 +225,23 @@ def test_ch7_runs_carry_activation_params_but_their_ch5_baseline_does_not(monkey
     pr_mod.ch5_activation_speed_study()
     assert "activation_params" not in seen["baseline"] and seen["baseline"]["reading"] == "book"
     assert seen["runs"]["activation_params"] == "ch5" and seen["runs"]["reading"] == "book"
+
+
+def test_torque_gain_lines_by_hand(monkeypatch):
+    """MSK torque NRMSE 0.10, NMSK 0.12 with Table 5.10's γ, 0.08 with ours: the NMSK gain is
+    100 (1 − 0.12/0.10) = −20 % → 100 (1 − 0.08/0.10) = +20 %; a class with a marked run is skipped."""
+    from types import SimpleNamespace
+
+    from gaitlib.studies import predictive as pr_mod
+
+    def sol(t, mark=""):
+        return SimpleNamespace(t=t, mark=mark, spec=SimpleNamespace(source="x"))
+
+    monkeypatch.setattr(pr_mod, "score", lambda s, g: pd.DataFrame({"kind": ["torque", "torque"], "nrmse": [s.t, s.t]}))
+    monkeypatch.setattr(pr_mod.data_mod, "load_gait_data", lambda c, src: None)
+    monkeypatch.setattr(pr_mod.marks, "failure_label", lambda s: s.mark)
+    book = SimpleNamespace(solutions={"MSK Slow": sol(0.10), "NMSK Slow": sol(0.12),
+                                      "MSK Fast": sol(0.10), "NMSK Fast": sol(0.12, "†")})
+    ours = SimpleNamespace(solutions={"NMSK Slow": sol(0.08), "NMSK Fast": sol(0.08)})
+    (line,) = pr_mod.torque_gain_lines(book, ours)
+    assert "Slow -20 % → +20 % (thesis S: +12 %)" in line and "Fast" not in line

@@ -857,8 +857,11 @@ def _ch6_claims(bases: dict, runs: dict, valid: dict, free, reruns: dict) -> lis
     fp_where = _anchor("ch06_costfun", "FP with the gait's phase timing")
     act_cause = _ch6_activation_cause(bases, runs)
     # the same claims with our Ch 5 activation parameters in every NMSK run (the thesis's procedure, our data)
-    c5 = ({k: v for k, v in _runs({"NMSK": n5}, "ch6", "book", activation_params="ch5").items()
-           if v is not None and not _blocked(gate(v, k))} if n5 is not None else {})
+    c5 = {}
+    if n5 is not None:  # a run blocked at the iteration limit counts through its converged, valid rerun (the page's rule)
+        c5, _ = _with_reruns(_runs({"NMSK": n5}, "ch6", "book", activation_params="ch5"),
+                             _runs({"NMSK": n5}, "ch6", "book", activation_params="ch5", max_iter=3000))
+        c5 = {k: v for k, v in c5.items() if v is not None and not _blocked(gate(v, k))}
     table_c5 = (ch6_claims.conclusions({**{k: v for k, v in usable.items() if not k.startswith("NMSK")}, **c5}, free,
                                        ch5_nmsk=n5).set_index("claim") if c5 else None)
     c5_where = _anchor("ch06_costfun", "The thesis's procedure on our data: Ch 5's activation parameters in every "
@@ -966,6 +969,8 @@ def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict, act_caus
     th = pr.THESIS_HOURS_TABLE_7_2
     rows.append(_time_ratio_row(7, "all 4 MSK runs' compute time ÷ all 4 NMSK runs' (Sec 7.3, Table 7.2)", th, runs,
                                 pr.CH7_CLASSES, "Ch 7, 8 runs", valid))
+    c5, c5_free = _ch7_c5(bases)  # the NMSK runs with our Ch 5 activation parameters (our reading), when stored
+    c5_where = _anchor("ch07_speed", "With our Ch 5 activation parameters")
     # NMSK torques more accurate than MSK's per class (Sec 7.2)
     for tc, tv in pr.THESIS_TORQUE_GAIN_PCT_CH7.items():
         c = inv[tc]
@@ -974,8 +979,15 @@ def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict, act_caus
         if a is not None and b is not None:
             g = data_mod.load_gait_data(c, a.spec.source)
             ours = 100 * (1 - _mean(pr.score(b, g), "torque") / _mean(pr.score(a, g), "torque"))
+        cause = act_cause or "unknown"
+        o = c5.get(f"NMSK {c}")
+        if a is not None and o is not None and not _blocked(gate(a, f"MSK {c}")):
+            g = data_mod.load_gait_data(c, a.spec.source)
+            gain = 100 * (1 - _mean(pr.score(o, g), "torque") / _mean(pr.score(a, g), "torque"))
+            cause = "; ".join(x for x in (act_cause, f"with our Ch 5 activation parameters in the NMSK run: "
+                                                     f"{gain:.1f} % [{c5_where}]") if x)
         rows.append(Row(7, f"{c} ({tc}): NMSK torque NRMSE lower than MSK's by (Sec 7.2)", tv, ours, "%",
-                        act_cause or "unknown", f"Ch 7 MSK {c}, NMSK {c}",
+                        cause, f"Ch 7 MSK {c}, NMSK {c}",
                         _joint({f"MSK {c}": valid.get(f"MSK {c}", ""), f"NMSK {c}": valid.get(f"NMSK {c}", "")})))
     # Fig 7.5: COT against speed; the natural-speed point is the like-for-like Ch 6 NMSK DT
     cot_page = _anchor("ch07_speed", "Cost of transport against speed (thesis Fig 7.5)")
@@ -1011,6 +1023,16 @@ def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict, act_caus
         ours = ", ".join(f"{k} {pts[k][1]:.2f}" for k in order) + f" (minimum at {order[i]})"
         if bumps:
             u_cause = "not U-shaped: the COT moves the wrong way between " + "; ".join(bumps)
+        pts5 = {k: (data_mod.load_gait_data(k).speed, float(v.stats.get("COT", np.nan)))
+                for k, v in {**{n.split(" ", 1)[1]: x for n, x in c5.items()}, "Free": c5_free}.items() if v is not None}
+        if len(pts5) == 5 and all(np.isfinite(v[1]) for v in pts5.values()):
+            o5 = sorted(pts5, key=lambda k: pts5[k][0])
+            b5 = pr.u_breaks(pts5)
+            u_cause = "" if u_cause == "unknown" else u_cause + "; "
+            u_cause += (f"with our Ch 5 activation parameters (every NMSK run, Free = Ch 6 DT): "
+                        + ", ".join(f"{k} {pts5[k][1]:.2f}" for k in o5)
+                        + f", minimum at {min(pts5, key=lambda k: pts5[k][1])}"
+                        + (f", not U-shaped ({'; '.join(b5)})" if b5 else ", U-shaped") + f" [{c5_where}]")
     else:
         holds, ours = None, np.nan
     rows.append(Row(7, "COT against speed is U-shaped with its minimum at the natural speed (Sec 7.2, Fig 7.5)",
@@ -1024,6 +1046,21 @@ def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict, act_caus
             rows[i].cause = "; ".join(x for x in (c, "uses " + "; ".join(used)) if x)
     rows += _ch7_consistent()
     return rows
+
+
+def _ch7_c5(bases: dict) -> tuple[dict, object]:
+    """The Ch 7 NMSK runs with our Ch 5 activation parameters (:func:`gaitlib.studies.predictive.
+    ch5_activation_speed_study`; a run blocked at the iteration limit through its converged,
+    valid rerun) that are stored, converged and valid, and the Ch 6 NMSK DT run with them (the
+    natural-speed point; None if not usable)."""
+    n5 = bases.get("NMSK")
+    if n5 is None:
+        return {}, None
+    runs, _ = _with_reruns(_runs({"NMSK": n5}, "ch7", "book", activation_params="ch5"),
+                           _runs({"NMSK": n5}, "ch7", "book", activation_params="ch5", max_iter=3000))
+    dt = _runs({"NMSK": n5}, "ch6", "book", activation_params="ch5").get("NMSK DT")
+    ok = {k: v for k, v in runs.items() if v is not None and not _blocked(gate(v, k))}
+    return ok, (dt if dt is not None and not _blocked(gate(dt, "NMSK DT")) else None)
 
 
 def _ch7_uses(item: str, run: str) -> bool:

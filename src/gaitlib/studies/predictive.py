@@ -688,6 +688,29 @@ def mean_nrmse(scores: pd.DataFrame) -> pd.Series:
     return kind_nrmse(scores).mean(axis=1)
 
 
+def torque_gain_lines(book: StudyResult, ours: StudyResult) -> list[str]:
+    """Thesis Secs 7.2–7.3 ("NMSK joint torques more accurate than MSK's by …"), per class:
+    100 (1 − NMSK ÷ MSK mean torque NRMSE) against each class's own data, with the NMSK runs of
+    ``book`` (Table 5.10's activation parameters) and of ``ours`` (another set, e.g.
+    :func:`ch5_activation_speed_study`), the MSK runs of ``book`` in both; only unmarked runs
+    count (:func:`gaitlib.marks.failure_label`), a class without both is skipped."""
+    def gain(n, m, cls):
+        g = data_mod.load_gait_data(cls, m.spec.source)
+        tn, tm = (kind_nrmse(score(x, g).assign(model="x", case="y"))["torque"].iloc[0] for x in (n, m))
+        return 100 * (1 - tn / tm)
+
+    parts = []
+    for cls, tc in ((c, THESIS_CLASS[c]) for c in CH7_CLASSES):
+        m, nb, no = (r.solutions.get(f"{k} {cls}") for r, k in ((book, "MSK"), (book, "NMSK"), (ours, "NMSK")))
+        if any(x is None or marks.failure_label(x) for x in (m, nb, no)):
+            continue
+        parts.append(f"{cls} {gain(nb, m, cls):+.0f} % → {gain(no, m, cls):+.0f} % (thesis {tc}: "
+                     f"{THESIS_TORQUE_GAIN_PCT_CH7[tc]:+.0f} %)")
+    if not parts:
+        return []
+    return ["**NMSK torque NRMSE below MSK's** (Table 5.10's activation parameters → ours): " + "; ".join(parts) + "."]
+
+
 def readings_table(results: dict, columns=("mark", "status", "iterations")) -> pd.DataFrame:
     """The same study in several readings side by side: label → :class:`StudyResult`; per
     reading ``columns`` of :meth:`StudyResult.stats` and the run's :func:`mean_nrmse`."""
