@@ -670,20 +670,26 @@ def _states(spec: GaitSpec) -> tuple[str, ...]:
     return x + NEURAL_STATES if spec.model == "NMSK" else x
 
 
-def load_mtg_params(path) -> dict:
-    """MTG fitting parameters from a JSON file ``{"params": {generator: {Eq 5.9 name: value}},
-    "provenance": …}`` (written by :func:`gaitlib.studies.mtg_id.save_params`; Δ^P in rad)
-    → generator → :class:`gaitlib.mtg.MTGParams`. Errors name the file and the entry."""
-    path = Path(path)
+def _params_json(path: Path, what: str, writer: str) -> dict:
+    """The parsed JSON of an identified parameter file with ``params`` and ``provenance``
+    entries; errors name the file (``what``: the kind of file; ``writer``: what writes it)."""
     if not path.is_file():
-        raise FileNotFoundError(f"MTG parameter file {path} not found: it is written by "
-                                f"gaitlib.studies.mtg_id.save_params (python -m gaitlib.studies.mtg_id)")
+        raise FileNotFoundError(f"{what} file {path} not found: it is written by {writer}")
     try:
         raw = json.loads(path.read_text())
     except json.JSONDecodeError as e:
         raise ValueError(f"{path}: not valid JSON ({e})") from None
     if "params" not in raw or "provenance" not in raw:
         raise ValueError(f"{path}: needs 'params' and 'provenance' entries")
+    return raw
+
+
+def load_mtg_params(path) -> dict:
+    """MTG fitting parameters from a JSON file ``{"params": {generator: {Eq 5.9 name: value}},
+    "provenance": …}`` (written by :func:`gaitlib.studies.mtg_id.save_params`; Δ^P in rad)
+    → generator → :class:`gaitlib.mtg.MTGParams`. Errors name the file and the entry."""
+    path = Path(path)
+    raw = _params_json(path, "MTG parameter", "gaitlib.studies.mtg_id.save_params (python -m gaitlib.studies.mtg_id)")
     out = {}
     for g in mtg.GENERATORS:
         d = raw["params"].get(g)
@@ -731,16 +737,8 @@ def load_activation_params(path) -> dict[str, float]:
     bounds (:data:`gaitlib.activation.ACTIVATION_BOUNDS`, Sec 5.3.4). Errors name the file and
     the entry."""
     path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"activation parameter file {path} not found: it is written by "
-                                f"gaitlib.studies.msk.save_activation (the Ch 5 NMSK solve's identified γ)")
-    try:
-        raw = json.loads(path.read_text())
-    except json.JSONDecodeError as e:
-        raise ValueError(f"{path}: not valid JSON ({e})") from None
-    if "params" not in raw or "provenance" not in raw:
-        raise ValueError(f"{path}: needs 'params' and 'provenance' entries")
-    d = raw["params"]
+    d = _params_json(path, "activation parameter",
+                     "gaitlib.studies.msk.save_activation (the Ch 5 NMSK solve's identified γ)")["params"]
     if set(d) != set(ACTIVATION_PARAMS):
         raise ValueError(f"{path}: params must have exactly {ACTIVATION_PARAMS}, got {sorted(d)}")
     out = {}
