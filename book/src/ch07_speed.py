@@ -211,7 +211,8 @@ if res7_c5 is not None:
     fig = pr.cot_figure(cot_c5, label="ours: NMSK DT with our Ch 5 activation parameters (Free = Ch 6 DT)")
     terms_c5 = fidelity.cot_terms(cot_c5, {**used7_c5.solutions, "NMSK DT": dt_c5})
     display(cot_c5, terms_c5)
-    display(Markdown("\n\n".join(fidelity.cot_curve_findings(cot_c5, terms_c5)
+    display(Markdown("\n\n".join(fidelity.cot_curve_findings(cot_c5, terms_c5,
+                                                             name="The curve with our Ch 5 activation parameters")
                                   + pr.torque_gain_lines(res_used, used7_c5))))
 
 # %% [markdown]

@@ -521,9 +521,11 @@ def cot_terms(cot: pd.DataFrame, solutions: dict) -> pd.DataFrame:
     return pd.DataFrame(rows).T
 
 
-def cot_curve_findings(cot: pd.DataFrame, terms: pd.DataFrame, min_points: int = 3) -> list[str]:
-    """Where the consistent curve has its minimum, and — if not at *Free* — which term of
-    Eq 5.38 moves it there: the class where (total − that term) is lowest, per term."""
+def cot_curve_findings(cot: pd.DataFrame, terms: pd.DataFrame, min_points: int = 3,
+                       name: str = "The consistent curve") -> list[str]:
+    """Where the curve (``name``, e.g. the consistent one) has its minimum, and — if not at
+    *Free* — which term of Eq 5.38 moves it there: the class where (total − that term) is
+    lowest, per term."""
     marked = cot[cot["mark"] != ""]
     out = []
     if len(marked):
@@ -533,7 +535,7 @@ def cot_curve_findings(cot: pd.DataFrame, terms: pd.DataFrame, min_points: int =
         return out
     at = terms["total"].astype(float).idxmin()
     pts = ", ".join(f"{c} {r['total']:.2f} at {r['speed (m/s)']:.2f} m/s" for c, r in terms.iterrows())
-    head = (f"**The consistent curve** ({len(terms)} of {len(cot)} speeds valid; COT in J kg⁻¹ m⁻¹: {pts}) has its "
+    head = (f"**{name}** ({len(terms)} of {len(cot)} speeds valid; COT in J kg⁻¹ m⁻¹: {pts}) has its "
             f"minimum at **{at}**" + (" — the natural speed, as the thesis and walking physiology say." if at == "Free"
                                        else ", not at the natural speed."))
     out.insert(0, head)

@@ -688,6 +688,11 @@ def mean_nrmse(scores: pd.DataFrame) -> pd.Series:
     return kind_nrmse(scores).mean(axis=1)
 
 
+def _pct(x: float) -> str:
+    """A signed whole per cent (no "-0 %")."""
+    return f"{int(round(x)) + 0:+d} %"
+
+
 def torque_gain_lines(book: StudyResult, ours: StudyResult) -> list[str]:
     """Thesis Secs 7.2–7.3 ("NMSK joint torques more accurate than MSK's by …"), per class:
     100 (1 − NMSK ÷ MSK mean torque NRMSE) against each class's own data, with the NMSK runs of
@@ -704,8 +709,8 @@ def torque_gain_lines(book: StudyResult, ours: StudyResult) -> list[str]:
         m, nb, no = (r.solutions.get(f"{k} {cls}") for r, k in ((book, "MSK"), (book, "NMSK"), (ours, "NMSK")))
         if any(x is None or marks.failure_label(x) for x in (m, nb, no)):
             continue
-        parts.append(f"{cls} {gain(nb, m, cls):+.0f} % → {gain(no, m, cls):+.0f} % (thesis {tc}: "
-                     f"{THESIS_TORQUE_GAIN_PCT_CH7[tc]:+.0f} %)")
+        parts.append(f"{cls} {_pct(gain(nb, m, cls))} → {_pct(gain(no, m, cls))} (thesis {tc}: "
+                     f"{_pct(THESIS_TORQUE_GAIN_PCT_CH7[tc])})")
     if not parts:
         return []
     return ["**NMSK torque NRMSE below MSK's** (Table 5.10's activation parameters → ours): " + "; ".join(parts) + "."]
