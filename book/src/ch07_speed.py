@@ -213,7 +213,9 @@ if res7_c5 is not None:
     display(cot_c5, terms_c5)
     display(Markdown("\n\n".join(fidelity.cot_curve_findings(cot_c5, terms_c5,
                                                              name="The curve with our Ch 5 activation parameters")
-                                  + pr.torque_gain_lines(res_used, used7_c5))))
+                                  + pr.torque_gain_lines(res_used, used7_c5)
+                                  + ["**Against the class data**, with our Ch 5 activation parameters: "
+                                     + x.lstrip("- ") for x in pr.pin_findings(pr.input_pull(used7_c5, gaits))])))
 
 # %% [markdown]
 # ## The predicted NMSK gaits against each class's data (thesis Figs 7.6–7.9)

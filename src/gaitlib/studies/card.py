@@ -1038,7 +1038,7 @@ def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict, act_caus
     rows.append(Row(7, "COT against speed is U-shaped with its minimum at the natural speed (Sec 7.2, Fig 7.5)",
                     "U, minimum at natural speed", ours, "", u_cause,
                     "Ch 6 NMSK DT, Ch 7 NMSK", _joint(vals), holds=holds))
-    rows.append(_ch7_pin(bases, runs))
+    rows.append(_ch7_pin(bases, runs, c5))
     for i in range(n0, len(rows)):  # name the reruns a row uses
         used = [n for k, n in notes.items() if _ch7_uses(rows[i].item, k)]
         if used:
@@ -1082,11 +1082,12 @@ class _Runs:
         self.solutions = {k: s for k, s in runs.items() if s is not None}
 
 
-def _ch7_pin(bases: dict, runs: dict) -> Row:
+def _ch7_pin(bases: dict, runs: dict, c5: dict | None = None) -> Row:
     """Thesis Secs 7.2–7.3: the predictions approach the speed classes' own (untracked) data.
     Ours: the NMSK cells (class × kind) closer to the class data than the time-scaled Free
     data they tracked; the cause: the pin experiment (:func:`gaitlib.studies.predictive.
-    pin_findings`, Table 7.1's data weights ÷ 10)."""
+    pin_findings`, Table 7.1's data weights ÷ 10) and, when all four are usable, the same count
+    on the NMSK runs with our Ch 5 activation parameters (``c5``, :func:`_ch7_c5`)."""
     item = "NMSK predictions closer to each class's own data than the scaled Free data they tracked (Secs 7.2–7.3)"
     gaits = {c: data_mod.load_gait_data(c) for c in cv.SPEED_CLASSES}
     nm = {k: s for k, s in runs.items() if k.startswith("NMSK ")}
@@ -1101,6 +1102,11 @@ def _ch7_pin(bases: dict, runs: dict) -> Row:
         where = _anchor("ch07_speed", "Accuracy against each class's own (untracked) data — thesis Figs 7.1–7.4")
         if lines:
             cause = lines[-1].lstrip("- ") + f" [{where}]"
+    if c5 and len(c5) == len(nm):
+        k5, n5 = pr.closer_cells(pr.input_pull(_Runs(c5), gaits))
+        cause = "; ".join(x for x in (cause if cause != "unknown" else "",
+                                      f"with our Ch 5 activation parameters in the NMSK runs: closer in {k5} of {n5} "
+                                      f"cells [{_anchor('ch07_speed', 'With our Ch 5 activation parameters')}]") if x)
     valid = _joint({k: gate(s, k) for k, s in nm.items() if s is not None and not marks_mod.failure_label(s)})
     return Row(7, item, "closer", f"{closer} of {n} unmarked cells", "", cause, "Ch 7 NMSK, 4 runs",
                valid or "valid", holds=closer > n / 2)
