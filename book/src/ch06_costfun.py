@@ -39,7 +39,9 @@
 # Ch 5 identification (as the thesis carries its own into Ch 6; the sets are named in the
 # table below). **Activation parameters (τ_act, c3, s1, s2):** the NMSK runs use the
 # thesis's identified values (Table 5.10), not ours: our Ch 5 identification drives all four
-# to their bounds (see *Chapter 5*), and `GaitSpec` has no field for an identified set yet.
+# to their bounds (see *Chapter 5*). The runs with ours (the thesis's procedure on our data,
+# `GaitSpec(activation_params="ch5")`) are shown beside them below, in *The thesis's
+# procedure on our data*.
 #
 # **The problem's reading** (Ch 2): every run here is solved in the *book's reading* — the
 # Jrk term's denominators of the HAT's horizontal position and tilt from the data, and each
