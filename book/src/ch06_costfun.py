@@ -353,3 +353,8 @@ display_anim
 
 # %%
 print("\n".join(pr.ch6_findings(res, tg, inv, free)))
+if res_c5 is not None:
+    _ch = ch6_claims.changed(claims, claims_c5)
+    print(f"- With our Ch 5 activation parameters in every NMSK run (our reading; *The thesis's procedure on our "
+          f"data* above). {ch6_claims.summary(claims_c5)} Verdicts that change: {len(_ch)} — "
+          + "; ".join(f"{c}: {r['verdict before']} → {r['verdict after']}" for c, r in _ch.iterrows()) + ".")

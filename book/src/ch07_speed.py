@@ -240,3 +240,9 @@ for c in classes:
 
 # %%
 print("\n".join(pr.ch7_findings(res_used, classes, ctrl, cot, inv, CH5_ROW)))
+if res7_c5 is not None:
+    _k, _n = pr.closer_cells(pr.input_pull(used7_c5, gaits))
+    _ok = cot_c5[cot_c5["mark"] == ""]["COT (J/kg/m)"]
+    print(f"- With our Ch 5 activation parameters in the NMSK runs (our reading; section above): COT minimum at "
+          f"{_ok.idxmin()} ({_ok.min():.2f} J/(kg·m), {len(_ok)} of {len(cot_c5)} points unmarked); closer to the "
+          f"class data than the scaled input in {_k} of {_n} cells.")
