@@ -207,6 +207,9 @@ if res7_c5 is not None:
     used7_c5 = res7_c5.with_reruns(inv7_c5)
     display(pr.readings_table({"Table 5.10's γ (book)": res, "Ch 5's γ (ours)": res7_c5},
                               columns=("mark", "status", "iterations")).loc[[f"NMSK {c}" for c in classes]])
+    if used7_c5.rerun_used:
+        print("reruns standing in (our activation parameters):", ", ".join(used7_c5.rerun_used))
+        display(res7_c5.rerun_table(inv7_c5))
     cot_c5 = pr.cot_table(used7_c5, {"Free": dt_c5})
     fig = pr.cot_figure(cot_c5, label="ours: NMSK DT with our Ch 5 activation parameters (Free = Ch 6 DT)")
     terms_c5 = fidelity.cot_terms(cot_c5, {**used7_c5.solutions, "NMSK DT": dt_c5})

@@ -857,9 +857,9 @@ def _ch6_claims(bases: dict, runs: dict, valid: dict, free, reruns: dict) -> lis
     fp_where = _anchor("ch06_costfun", "FP with the gait's phase timing")
     act_cause = _ch6_activation_cause(bases, runs)
     # the same claims with our Ch 5 activation parameters in every NMSK run (the thesis's procedure, our data)
-    c5 = {}
+    c5, c5_notes = {}, {}
     if n5 is not None:  # a run blocked at the iteration limit counts through its converged, valid rerun (the page's rule)
-        c5, _ = _with_reruns(_runs({"NMSK": n5}, "ch6", "book", activation_params="ch5"),
+        c5, c5_notes = _with_reruns(_runs({"NMSK": n5}, "ch6", "book", activation_params="ch5"),
                              _runs({"NMSK": n5}, "ch6", "book", activation_params="ch5", max_iter=3000))
         c5 = {k: v for k, v in c5.items() if v is not None and not _blocked(gate(v, k))}
     table_c5 = (ch6_claims.conclusions({**{k: v for k, v in usable.items() if not k.startswith("NMSK")}, **c5}, free,
@@ -887,7 +887,8 @@ def _ch6_claims(bases: dict, runs: dict, valid: dict, free, reruns: dict) -> lis
             if table_c5 is not None and r["claim"] in table_c5.index:
                 t = table_c5.loc[r["claim"]]
                 cause += (f"; with our Ch 5 activation parameters in every NMSK run (the thesis's procedure on our "
-                          f"data): {t['verdict']} ({t['NRMSE']}) [{c5_where}]")
+                          f"data{''.join(_rerun_note(c5_notes, n) for n in r['runs'].split(', '))}): "
+                          f"{t['verdict']} ({t['NRMSE']}) [{c5_where}]")
         if cause == "unknown" and exc and r["claim"] in start_check:
             cause = start_check[r["claim"]]
         if r["depends on metric"]:
@@ -969,7 +970,7 @@ def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict, act_caus
     th = pr.THESIS_HOURS_TABLE_7_2
     rows.append(_time_ratio_row(7, "all 4 MSK runs' compute time ÷ all 4 NMSK runs' (Sec 7.3, Table 7.2)", th, runs,
                                 pr.CH7_CLASSES, "Ch 7, 8 runs", valid))
-    c5, c5_free = _ch7_c5(bases)  # the NMSK runs with our Ch 5 activation parameters (our reading), when stored
+    c5, c5_free, c5_notes = _ch7_c5(bases)  # the NMSK runs with our Ch 5 activation parameters (our reading)
     c5_where = _anchor("ch07_speed", "With our Ch 5 activation parameters")
     # NMSK torques more accurate than MSK's per class (Sec 7.2)
     for tc, tv in pr.THESIS_TORQUE_GAIN_PCT_CH7.items():
@@ -977,15 +978,13 @@ def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict, act_caus
         a, b = runs.get(f"MSK {c}"), runs.get(f"NMSK {c}")
         ours = np.nan
         if a is not None and b is not None:
-            g = data_mod.load_gait_data(c, a.spec.source)
-            ours = 100 * (1 - _mean(pr.score(b, g), "torque") / _mean(pr.score(a, g), "torque"))
+            ours = pr.torque_gain(b, a, c)
         cause = act_cause or "unknown"
         o = c5.get(f"NMSK {c}")
         if a is not None and o is not None and not _blocked(gate(a, f"MSK {c}")):
-            g = data_mod.load_gait_data(c, a.spec.source)
-            gain = 100 * (1 - _mean(pr.score(o, g), "torque") / _mean(pr.score(a, g), "torque"))
-            cause = "; ".join(x for x in (act_cause, f"with our Ch 5 activation parameters in the NMSK run: "
-                                                     f"{gain:.1f} % [{c5_where}]") if x)
+            cause = "; ".join(x for x in (act_cause, f"with our Ch 5 activation parameters in the NMSK run"
+                                                     f"{_rerun_note(c5_notes, f'NMSK {c}')}: "
+                                                     f"{pr.torque_gain(o, a, c):.1f} % [{c5_where}]") if x)
         rows.append(Row(7, f"{c} ({tc}): NMSK torque NRMSE lower than MSK's by (Sec 7.2)", tv, ours, "%",
                         cause, f"Ch 7 MSK {c}, NMSK {c}",
                         _joint({f"MSK {c}": valid.get(f"MSK {c}", ""), f"NMSK {c}": valid.get(f"NMSK {c}", "")})))
@@ -1029,7 +1028,8 @@ def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict, act_caus
             o5 = sorted(pts5, key=lambda k: pts5[k][0])
             b5 = pr.u_breaks(pts5)
             u_cause = "" if u_cause == "unknown" else u_cause + "; "
-            u_cause += (f"with our Ch 5 activation parameters (every NMSK run, Free = Ch 6 DT): "
+            u_cause += (f"with our Ch 5 activation parameters (every NMSK run, Free = Ch 6 DT"
+                        + "".join(_rerun_note(c5_notes, k) for k in sorted(c5_notes)) + "): "
                         + ", ".join(f"{k} {pts5[k][1]:.2f}" for k in o5)
                         + f", minimum at {min(pts5, key=lambda k: pts5[k][1])}"
                         + (f", not U-shaped ({'; '.join(b5)})" if b5 else ", U-shaped") + f" [{c5_where}]")
@@ -1038,7 +1038,7 @@ def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict, act_caus
     rows.append(Row(7, "COT against speed is U-shaped with its minimum at the natural speed (Sec 7.2, Fig 7.5)",
                     "U, minimum at natural speed", ours, "", u_cause,
                     "Ch 6 NMSK DT, Ch 7 NMSK", _joint(vals), holds=holds))
-    rows.append(_ch7_pin(bases, runs, c5))
+    rows.append(_ch7_pin(bases, runs, c5, c5_notes))
     for i in range(n0, len(rows)):  # name the reruns a row uses
         used = [n for k, n in notes.items() if _ch7_uses(rows[i].item, k)]
         if used:
@@ -1048,19 +1048,25 @@ def _ch7(bases: dict, runs: dict, valid: dict, ch6: dict, valid6: dict, act_caus
     return rows
 
 
-def _ch7_c5(bases: dict) -> tuple[dict, object]:
+def _rerun_note(notes: dict, name: str) -> str:
+    """``"; <name>: its 3000-iteration rerun (…)"`` when ``name`` is represented by its rerun
+    (``notes`` of :func:`_with_reruns`), else ``""`` — every use of a rerun is named."""
+    return f"; {notes[name]}" if name in notes else ""
+
+
+def _ch7_c5(bases: dict) -> tuple[dict, object, dict]:
     """The Ch 7 NMSK runs with our Ch 5 activation parameters (:func:`gaitlib.studies.predictive.
     ch5_activation_speed_study`; a run blocked at the iteration limit through its converged,
-    valid rerun) that are stored, converged and valid, and the Ch 6 NMSK DT run with them (the
-    natural-speed point; None if not usable)."""
+    valid rerun) that are stored, converged and valid, the Ch 6 NMSK DT run with them (the
+    natural-speed point; None if not usable), and the notes naming the reruns used."""
     n5 = bases.get("NMSK")
     if n5 is None:
-        return {}, None
-    runs, _ = _with_reruns(_runs({"NMSK": n5}, "ch7", "book", activation_params="ch5"),
+        return {}, None, {}
+    runs, notes = _with_reruns(_runs({"NMSK": n5}, "ch7", "book", activation_params="ch5"),
                            _runs({"NMSK": n5}, "ch7", "book", activation_params="ch5", max_iter=3000))
     dt = _runs({"NMSK": n5}, "ch6", "book", activation_params="ch5").get("NMSK DT")
     ok = {k: v for k, v in runs.items() if v is not None and not _blocked(gate(v, k))}
-    return ok, (dt if dt is not None and not _blocked(gate(dt, "NMSK DT")) else None)
+    return ok, (dt if dt is not None and not _blocked(gate(dt, "NMSK DT")) else None), notes
 
 
 def _ch7_uses(item: str, run: str) -> bool:
@@ -1082,7 +1088,7 @@ class _Runs:
         self.solutions = {k: s for k, s in runs.items() if s is not None}
 
 
-def _ch7_pin(bases: dict, runs: dict, c5: dict | None = None) -> Row:
+def _ch7_pin(bases: dict, runs: dict, c5: dict | None = None, c5_notes: dict | None = None) -> Row:
     """Thesis Secs 7.2–7.3: the predictions approach the speed classes' own (untracked) data.
     Ours: the NMSK cells (class × kind) closer to the class data than the time-scaled Free
     data they tracked; the cause: the pin experiment (:func:`gaitlib.studies.predictive.
@@ -1105,7 +1111,9 @@ def _ch7_pin(bases: dict, runs: dict, c5: dict | None = None) -> Row:
     if c5 and len(c5) == len(nm):
         k5, n5 = pr.closer_cells(pr.input_pull(_Runs(c5), gaits))
         cause = "; ".join(x for x in (cause if cause != "unknown" else "",
-                                      f"with our Ch 5 activation parameters in the NMSK runs: closer in {k5} of {n5} "
+                                      f"with our Ch 5 activation parameters in the NMSK runs"
+                                      + "".join(_rerun_note(c5_notes or {}, k) for k in sorted(c5_notes or {}))
+                                      + f": closer in {k5} of {n5} "
                                       f"cells [{_anchor('ch07_speed', 'With our Ch 5 activation parameters')}]") if x)
     valid = _joint({k: gate(s, k) for k, s in nm.items() if s is not None and not marks_mod.failure_label(s)})
     return Row(7, item, "closer", f"{closer} of {n} unmarked cells", "", cause, "Ch 7 NMSK, 4 runs",

@@ -303,7 +303,6 @@ def ch5_changes(model: str = "MSK") -> dict[str, dict]:
     }
 
 
-
 #: The row of the Ch 5 ablation that is the book's own Ch 5 solution.
 CH5_BASE_ROW = "Ch 5, book's reading"
 
@@ -357,7 +356,7 @@ def metatarsal_findings(per_channel: pd.DataFrame, floor: pd.DataFrame, clearanc
     cols = [c for c in per_channel.columns if c not in ("target", "best change", "met by") and not c.startswith("thesis")]
     q = next((c for c in cols if c.startswith("coordinate weight")), None)
     combo = f"{METATARSAL_FREE} + {q}" if q else None
-    if METATARSAL_FREE not in cols or combo not in cols or not cols:
+    if METATARSAL_FREE not in cols or combo not in cols:
         return []
     ang = per_channel.xs("angle", level="kind")
     at = floor[np.isclose(floor["swing clearance (mm)"], clearance_mm)].set_index("metatarsal")

@@ -693,23 +693,26 @@ def _pct(x: float) -> str:
     return f"{int(round(x)) + 0:+d} %"
 
 
+def torque_gain(nmsk, msk_sol, cls: str) -> float:
+    """Thesis Secs 7.2–7.3's measure: 100 (1 − NMSK ÷ MSK mean joint-torque NRMSE), %, both runs
+    scored against speed class ``cls``'s own data (positive: the NMSK torques are closer)."""
+    g = data_mod.load_gait_data(cls, msk_sol.spec.source)
+    tn, tm = (kind_nrmse(score(x, g).assign(model="x", case="y"))["torque"].iloc[0] for x in (nmsk, msk_sol))
+    return 100 * (1 - tn / tm)
+
+
 def torque_gain_lines(book: StudyResult, ours: StudyResult) -> list[str]:
     """Thesis Secs 7.2–7.3 ("NMSK joint torques more accurate than MSK's by …"), per class:
     100 (1 − NMSK ÷ MSK mean torque NRMSE) against each class's own data, with the NMSK runs of
     ``book`` (Table 5.10's activation parameters) and of ``ours`` (another set, e.g.
     :func:`ch5_activation_speed_study`), the MSK runs of ``book`` in both; only unmarked runs
     count (:func:`gaitlib.marks.failure_label`), a class without both is skipped."""
-    def gain(n, m, cls):
-        g = data_mod.load_gait_data(cls, m.spec.source)
-        tn, tm = (kind_nrmse(score(x, g).assign(model="x", case="y"))["torque"].iloc[0] for x in (n, m))
-        return 100 * (1 - tn / tm)
-
     parts = []
     for cls, tc in ((c, THESIS_CLASS[c]) for c in CH7_CLASSES):
         m, nb, no = (r.solutions.get(f"{k} {cls}") for r, k in ((book, "MSK"), (book, "NMSK"), (ours, "NMSK")))
         if any(x is None or marks.failure_label(x) for x in (m, nb, no)):
             continue
-        parts.append(f"{cls} {_pct(gain(nb, m, cls))} → {_pct(gain(no, m, cls))} (thesis {tc}: "
+        parts.append(f"{cls} {_pct(torque_gain(nb, m, cls))} → {_pct(torque_gain(no, m, cls))} (thesis {tc}: "
                      f"{_pct(THESIS_TORQUE_GAIN_PCT_CH7[tc])})")
     if not parts:
         return []
