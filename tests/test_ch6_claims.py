@@ -124,3 +124,19 @@ def test_changed_lists_only_the_claims_whose_verdict_moves():
     t = ch6_claims.changed(before, after)
     assert list(t.index) == ["b"]
     assert t.loc["b"].tolist() == ["does not hold", "holds", "0.3 vs 0.1", "0.1 vs 0.1"]
+
+
+def test_excitation_resolution_hand_numbers():
+    """Spread, common shift and relative move worked by hand on a 4-run table: book
+    0.10/0.12/0.15/0.20 (gaps 0.02, 0.03, 0.05 → median 0.03); variant A adds 0.05 to every
+    run (shift +0.05, relative moves 0, ranks identical); variant B changes the runs by
+    0.00/+0.04/−0.04/+0.10 (median of the four changes +0.02, relative moves 0.02, 0.02,
+    0.06, 0.08 → median 0.04 > 0.03)."""
+    t = pd.DataFrame({"book": [0.10, 0.12, 0.15, 0.20], "A": [0.15, 0.17, 0.20, 0.25],
+                      "B": [0.10, 0.16, 0.11, 0.30]}, index=["DT", "SDT1", "SDT2", "SDT3"])
+    s = cc.excitation_resolution(t)
+    assert "span 0.100–0.200 (range 0.100; median gap between neighbours in the ranking 0.030)" in s
+    assert "A: beyond a common shift of +0.050, a run's score moves by a median 0.000 (largest 0.000" in s
+    assert "ranks agree at Spearman ρ = 1.00" in s
+    assert "B: beyond a common shift of +0.020, a run's score moves by a median 0.040 (largest 0.080, SDT3)" in s
+    assert s.endswith("(0.030): B (0.040); by less: A (0.000).")

@@ -254,6 +254,24 @@ with pd.option_context("display.max_colwidth", None):
     display(claims_tg[claims_tg["claim"].str.contains("excitation")][["claim", "verdict", "RMSE", "NRMSE", "ours"]])
 
 # %% [markdown]
+# ### How finely the runs rank by excitation accuracy
+#
+# The two excitation claims (SDT3 the most accurate, SP1 the least) read the order of seven
+# numbers. Each NMSK run's excitation RMSE against the EMG in three sets of usable runs that
+# differ in one thing each: the book's, the runs from the thesis's partial guess, and the
+# runs with our Ch 5 activation parameters. A change that moves every run alike leaves the
+# order as it is, so each change is read as the shift common to all runs (their median) and
+# what moves one run relative to the others, beside the gaps between neighbours in the order.
+
+# %%
+exc_variants = {"book's runs": usable_runs, "the thesis's partial guess as start": tg_usable}
+if res_c5 is not None:
+    exc_variants["our Ch 5 activation parameters"] = c5_usable
+exc_scores = ch6_claims.excitation_scores(exc_variants, free)
+display(exc_scores)
+display(Markdown(ch6_claims.excitation_resolution(exc_scores)))
+
+# %% [markdown]
 # ## The fully predictive NMSK gait (thesis Figs 6.5–6.8)
 #
 # No data term in the cost: only Jrk, Rsd, Imp, HAT (the Ch 5 HAT motion), Act and Mtb.

@@ -866,7 +866,7 @@ def _ch6_claims(bases: dict, runs: dict, valid: dict, free, reruns: dict) -> lis
                                        ch5_nmsk=n5).set_index("claim") if c5 else None)
     c5_where = _anchor("ch06_costfun", "The thesis's procedure on our data: Ch 5's activation parameters in every "
                                        "NMSK run")
-    start_check = _ch6_start_check(n5, free)
+    start_check = _ch6_start_check(n5, free, usable, c5)
     rows = []
     for _, r in table[~table["numeric"].astype(bool)].iterrows():
         # a decided claim is computed from the usable runs alone; an untested one names all
@@ -899,11 +899,14 @@ def _ch6_claims(bases: dict, runs: dict, valid: dict, free, reruns: dict) -> lis
     return rows
 
 
-def _ch6_start_check(n5, free) -> dict:
+def _ch6_start_check(n5, free, book_runs: dict | None = None, c5: dict | None = None) -> dict:
     """claim → what the Ch 6 conclusions say on the NMSK runs started from the thesis's
     partial guess (Sec 6.1; the book's reading, converged and valid runs only) for the
     excitation claims that are decided there: a second start, which tells whether a claim's
-    fate comes from the book's start (the Ch 5 solution). Empty when not stored."""
+    fate comes from the book's start (the Ch 5 solution). Where that start does not decide a
+    claim, the cause adds how finely the runs rank (:func:`gaitlib.studies.ch6_claims.
+    excitation_resolution` over ``book_runs``, the second start and ``c5``, the runs with our
+    Ch 5 activation parameters). Empty when not stored."""
     if n5 is None:
         return {}
     tg = {k: v for k, v in _runs({"NMSK": n5}, "ch6", "book", policy="thesis").items()
@@ -912,14 +915,19 @@ def _ch6_start_check(n5, free) -> dict:
         return {}
     where = _anchor("ch06_costfun", "A second start: the excitation claims on the runs from the thesis's partial guess")
     t = ch6_claims.conclusions(tg, free, ch5_nmsk=n5)
+    variants = {"book's runs": book_runs or {}, "the thesis's partial guess as start": tg,
+                **({"our Ch 5 activation parameters": c5} if c5 else {})}
+    resolution = ch6_claims.excitation_resolution(ch6_claims.excitation_scores(variants, free)) if book_runs else ""
+    res_where = _anchor("ch06_costfun", "How finely the runs rank by excitation accuracy")
     out = {}
     for _, r in t.iterrows():
         if isinstance(r["RMSE: verdict"], str) and r["verdict"] != "not tested":
             guess = f"from the thesis's partial guess (Sec 6.1; {len(tg)} valid NMSK runs)"
             out[r["claim"]] = (f"the start decides it: {guess} it holds: {r['RMSE']} [{where}]"
                                if r["RMSE: verdict"] == "holds" else
-                               f"not the start: {guess} it does not hold either: {r['RMSE']} [{where}]; what else "
-                               f"decides the ranking is not measured")
+                               f"not the start: {guess} it does not hold either: {r['RMSE']} [{where}]"
+                               + (f"; how finely the runs rank: {resolution[0].lower()}{resolution[1:]} [{res_where}]"
+                                  if resolution else ""))
     return out
 
 

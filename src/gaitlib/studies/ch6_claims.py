@@ -346,3 +346,55 @@ def summary(table: pd.DataFrame) -> str:
             f"{n['depends on the metric']} depend{'s' if n['depends on the metric'] == 1 else ''} on the metric (NRMSE "
             f"vs SD units), {n['not tested']} {'is' if n['not tested'] == 1 else 'are'} not "
             "tested (a run they need did not converge or fails a validity gate).")
+
+
+def excitation_scores(variants: dict[str, dict], gait: data_mod.GaitData, metric: str = "RMSE") -> pd.DataFrame:
+    """The excitation accuracy (``metric`` of :data:`EXC_METRICS`, mean over the muscles with
+    EMG) of each NMSK run in each of several sets of usable runs: rows the Ch 6 cost functions
+    (``NMSK <cost>``), one column per set (``variants``: label → name → solution, e.g. the two
+    starts, the two sets of activation parameters); NaN where a set has no usable run."""
+    out = {}
+    for label, runs in variants.items():
+        col = {}
+        for c in pr.CH6_COSTS:
+            sol = runs.get(f"NMSK {c}")
+            if sol is not None and getattr(sol, "excitations", None) is not None:
+                col[c] = float(pr.excitation_score(sol, gait)[EXC_METRICS[metric]].mean())
+        out[label] = pd.Series(col, dtype=float)
+    return pd.DataFrame(out).reindex([c for c in pr.CH6_COSTS]).dropna(how="all").rename_axis("cost function")
+
+
+def excitation_resolution(scores: pd.DataFrame) -> str:
+    """How finely the runs rank by excitation accuracy (:func:`excitation_scores`; the first
+    column the book's runs): the spread over the cost functions in the first column beside how
+    far changing only the start or the activation parameters (each other column) moves one
+    run's score beyond the shift common to all runs (their median change, which leaves the
+    ranking as it is), and how well the ranks agree (Spearman ρ over the runs usable in both). The
+    two excitation claims of Sec 6.2.3 decide between neighbours in that ranking."""
+    base = scores.columns[0]
+    b = scores[base].dropna()
+    parts, moves = [], {}
+    for other in scores.columns[1:]:
+        both = scores[[base, other]].dropna()
+        if len(both) < 3:
+            continue
+        shift = float((both[other] - both[base]).median())  # moves every run alike: no effect on the ranking
+        d = (both[other] - both[base] - shift).abs()
+        rho = both[base].rank().corr(both[other].rank())
+        moves[other] = float(d.median())
+        parts.append(f"{other}: beyond a common shift of {shift:+.3f}, a run's score moves by a median "
+                     f"{d.median():.3f} (largest {d.max():.3f}, {d.idxmax()}) over {len(both)} runs; ranks agree at "
+                     f"Spearman ρ = {rho:.2f}")
+    if not parts:
+        return ""
+    gap = float(np.median(np.diff(np.sort(b.to_numpy()))))
+    big = [k for k, m in moves.items() if m > gap]
+    small = [k for k, m in moves.items() if m <= gap]
+    tail = ((f" What moves a run relative to the others by more than the median gap between neighbours "
+             f"({gap:.3f}): {', '.join(f'{k} ({moves[k]:.3f})' for k in big)}" if big else
+             f" No single change moves a run relative to the others by more than the median gap between neighbours "
+             f"({gap:.3f})")
+            + (f"; by less: {', '.join(f'{k} ({moves[k]:.3f})' for k in small)}" if big and small else "") + ".")
+    return (f"Over the {len(b)} cost functions the book's runs span {b.min():.3f}–{b.max():.3f} "
+            f"(range {b.max() - b.min():.3f}; median gap between neighbours in the ranking {gap:.3f}). "
+            f"Changing one thing at a time — " + "; ".join(parts) + "." + tail)
