@@ -220,3 +220,31 @@ def test_metatarsal_findings_read_the_knees_from_the_ablation_and_the_floor():
     assert "lowers the knees by at most 0.3°" in line and "met by neither knee" in line
     assert "stay 1.4–1.5° above the free-metatarsal geometric floor" in line
     assert fidelity.metatarsal_findings(ch.drop(columns=[combo]), floor) == []
+
+
+def test_q_scan_findings_read_the_worst_channel_of_each_kind_and_every_target_at_once():
+    """A hand-made channel table: the untracked-metatarsal run and the scan at ×4 and ×16
+    (Table 5.3's Q weight ¼ → 1 and 4). Worst angle/torque/GRF by hand: ×1 4.5/3.0/20,
+    ×4 2.0/3.5/25, ×16 1.6/4.0/34; targets 1.8, 5.85, 36 → only ×16 meets all three."""
+    idx = pd.MultiIndex.from_tuples([("angle", "knee", "r", "deg"), ("angle", "hip", "r", "deg"),
+                                     ("torque", "knee", "r", "N*m"), ("grf", "y", "r", "N")],
+                                    names=["kind", "channel", "side", "unit"])
+    m = fidelity.METATARSAL_FREE
+    pc = pd.DataFrame({"Ch 5, book's reading": [4.4, 1.7, 1.6, 23.0], m: [4.5, 1.4, 3.0, 20.0],
+                       f"{m} + coordinate weight ×4": [2.0, 1.0, 3.5, 25.0],
+                       f"{m} + coordinate weight ×16": [1.6, 0.8, 4.0, 34.0],
+                       "thesis, Table 5.4": [1.1, 0.6, 1.8, 24.0], "target": [1.8, 1.8, 5.85, 36.0]}, index=idx)
+    assert fidelity.all_targets(pc) == [f"{m} + coordinate weight ×16"]
+    text = " ".join(fidelity.q_scan_findings(pc, "MSK"))
+    assert "×1: 4.50°, 3.0 N·m, 20.0 N; ×4: 2.00°, 3.5 N·m, 25.0 N; ×16: 1.60°, 4.0 N·m, 34.0 N." in text
+    assert "targets 1.8°, 5.85 N·m, 36 N" in text
+    assert f"met by: {m} + coordinate weight ×16 —" in text
+    assert fidelity.q_scan_findings(pc.drop(columns=[f"{m} + coordinate weight ×4", f"{m} + coordinate weight ×16"])) == []
+    # NMSK: without the ×16 run and with ×4's GRF at 40 N no run meets every target; the run
+    # with the lowest worst angle (×4, 2.0°) names the kinds over target (angle, GRF), and the
+    # MSK table's runs that meet every target are named
+    nm = pc.drop(columns=[f"{m} + coordinate weight ×16"]).assign(**{f"{m} + coordinate weight ×4": [2.0, 1.0, 3.5, 40.0]})
+    text = " ".join(fidelity.q_scan_findings(nm, "NMSK", msk_channels=pc))
+    assert "from Table 5.9's 0.25" in text
+    assert "No run meets every target at once; the lowest worst angle, at ×4, comes with angle 2.0°, grf 40.0 N over target." in text
+    assert text.endswith(f"meets every target at once in: {m} + coordinate weight ×16.")

@@ -609,10 +609,14 @@ def _ch5_ablation_causes(model: str = "MSK") -> dict:
         return {}
     where = _anchor("ch05_msk", CH5_ABLATION_HEADINGS[model])
     out = {}
-    for (kind, part, side, unit), r in fidelity.channel_table(ok, model).iterrows():
+    table = fidelity.channel_table(ok, model)
+    every = fidelity.all_targets(table)
+    every = (f"; every angle, torque and GRF target at once: met by {', '.join(every)}" if every else
+             "; every angle, torque and GRF target at once: met by no run")
+    for (kind, part, side, unit), r in table.iterrows():
         out[(kind, part, side)] = (f"Ch 5 ablation (book's reading, {len(ok) - 1} usable changes): lowest "
                                    f"{r[r['best change']]:.1f} {unit} ({r['best change']}), target {r['target']:.1f} "
-                                   f"{unit} met by: {r['met by']} [{where}]")
+                                   f"{unit} met by: {r['met by']}{every} [{where}]")
     return out
 
 

@@ -288,7 +288,8 @@ def ch5_changes(model: str = "MSK") -> dict[str, dict]:
     sets instead of ours (body Tables 4.15–4.16, contact Tables 4.17–4.18, MTGs Table 5.2),
     the planned metatarsal angles left untracked (:attr:`GaitSpec.track_mtp`; the geometric
     floor, :func:`kinematic_floor_table`, is lower without them) — and, the one combination,
-    that with the coordinate weight raised (the single change that lowers the angles most)."""
+    that with the coordinate weight raised (the single change that lowers the angles most) to
+    each of :data:`Q_SCAN`: how much angle accuracy the torque and GRF terms cost."""
     w = dict(gait_ocp.COST_FUNCTIONS[model][msk.ch5_spec(model).cost])
     q = f"coordinate weight ×{1 / w['Q']:g}"
     return {
@@ -299,9 +300,14 @@ def ch5_changes(model: str = "MSK") -> dict[str, dict]:
         "the thesis's parameter sets": {"body_params": "thesis", "contact_params": "default",
                                         "mtg_params": "default"},
         METATARSAL_FREE: {"track_mtp": False},
-        f"{METATARSAL_FREE} + {q}": {"track_mtp": False, "weights": (("Q", 1.0),)},
+        **{f"{METATARSAL_FREE} + coordinate weight ×{f / w['Q']:g}": {"track_mtp": False, "weights": (("Q", float(f)),)}
+           for f in Q_SCAN},
     }
 
+
+#: The coordinate (Q) weights of the Ch 5 ablation's combination rows, the metatarsal left
+#: untracked: the trade-off between the angles and the torque and GRF terms (Table 5.3: ¼).
+Q_SCAN = (1.0, 4.0, 8.0, 16.0)
 
 #: The row of the Ch 5 ablation that is the book's own Ch 5 solution.
 CH5_BASE_ROW = "Ch 5, book's reading"
@@ -378,6 +384,55 @@ def metatarsal_findings(per_channel: pd.DataFrame, floor: pd.DataFrame, clearanc
             + (f", and the solved knees stay {_span(above)}° above the free-metatarsal geometric floor: what holds "
                "them there is not the metatarsal reference." if above else "."))
     return [f"- **The metatarsal reference** (knee RMSE, book's Ch 5 → changed): {'; '.join(parts)}. {tail}"]
+
+
+def all_targets(per_channel: pd.DataFrame) -> list[str]:
+    """The runs (columns of a :func:`channel_table` over usable runs) whose every channel —
+    each angle, torque and GRF — is at or below its target."""
+    cols = [c for c in per_channel.columns if c not in ("target", "best change", "met by") and not c.startswith("thesis")]
+    return [c for c in cols if bool((per_channel[c] <= per_channel["target"]).all())]
+
+
+#: The table of each model's Ch 5 data-tracking weights.
+WEIGHT_TABLES = {"MSK": "Table 5.3", "NMSK": "Table 5.9"}
+
+
+def q_scan_findings(per_channel: pd.DataFrame, model: str = "MSK", msk_channels: pd.DataFrame | None = None) -> list[str]:
+    """The coordinate-weight scan of the Ch 5 ablation (the metatarsal untracked, the Q weight
+    at each of :data:`Q_SCAN`), read from ``per_channel`` (:func:`channel_table` of the usable
+    runs): per weight the worst angle, torque and GRF RMSE beside their targets, and which runs
+    meet every target at once; when none does, which kinds miss. For NMSK, ``msk_channels``
+    (the MSK ablation's table) adds which MSK runs meet every target: the MSK problem is the
+    NMSK one without activation dynamics and without the Mtb term. Empty when fewer than two
+    of the scan's runs are usable."""
+    w = gait_ocp.COST_FUNCTIONS[model][msk.ch5_spec(model).cost]["Q"]
+    scan = {1.0: METATARSAL_FREE, **{f / w: f"{METATARSAL_FREE} + coordinate weight ×{f / w:g}" for f in Q_SCAN}}
+    scan = {k: c for k, c in scan.items() if c in per_channel.columns}
+    if len(scan) < 2:
+        return []
+    tgt = per_channel["target"].groupby(level="kind").max()
+    worst = {k: per_channel[c].groupby(level="kind").max() for k, c in scan.items()}
+    units = {"angle": "°", "torque": " N·m", "grf": " N"}
+    steps = "; ".join(f"×{k:g}: {v['angle']:.2f}°, {v['torque']:.1f} N·m, {v['grf']:.1f} N" for k, v in worst.items())
+    met = all_targets(per_channel)
+    head = (f"- **The price of the angles** (the metatarsal untracked, the coordinate weight raised from "
+            f"{WEIGHT_TABLES[model]}'s {w:g}; worst angle, torque and GRF RMSE against targets {tgt['angle']:.1f}°, "
+            f"{tgt['torque']:.2f} N·m, {tgt['grf']:.0f} N): {steps}.")
+    if met:
+        tail = (f" Every target at once is met by: {', '.join(met)} — at {WEIGHT_TABLES[model]}'s weights the angles' "
+                "misfit is what the torque and GRF terms buy, not a limit of the model or the data.")
+    else:
+        best = min(worst, key=lambda k: worst[k]["angle"])
+        miss = [f"{kind} {worst[best][kind]:.1f}{units[kind]}" for kind in ("angle", "torque", "grf")
+                if worst[best][kind] > tgt[kind]]
+        tail = (f" No run meets every target at once; the lowest worst angle, at ×{best:g}, comes with "
+                f"{', '.join(miss)} over target.")
+    if model == "NMSK" and msk_channels is not None:
+        m_met = all_targets(msk_channels)
+        tail += (f" The MSK problem (the same generators without activation dynamics and without the Mtb term) meets "
+                 f"every target at once in: {', '.join(m_met)}." if m_met else
+                 " The MSK problem meets no more targets at once.")
+    return [head + tail]
 
 
 def _span(v: list) -> str:
