@@ -131,7 +131,12 @@ def test_nmsk_ch5_ablation_starts_each_change_from_the_msk_run_of_that_change(mo
     assert seen["MSK"][1] is None  # MSK from the data
     specs, guesses = seen["NMSK"]
     assert set(guesses) == set(specs) == set(fidelity.ch5_changes("NMSK"))
-    assert all(g == f"MSK:{k}" for k, g in guesses.items())
+    assert all(g == f"MSK:{k}" for k, g in guesses.items() if not k.endswith(", no Mtb term"))
+    nomtb = [k for k in specs if k.endswith(", no Mtb term")]
+    assert nomtb == ["metatarsal untracked + coordinate weight ×32, no Mtb term"]
+    assert guesses[nomtb[0]] == "MSK:metatarsal untracked + coordinate weight ×32"
+    assert dict(specs[nomtb[0]].weights) == {"Q": 8.0, "Mtb": 0.0} and "Mtb" not in dict(fidelity.ch5_changes("MSK")
+                                                                                         ).get(nomtb[0], {})
     assert sols[fidelity.CH5_BASE_ROW] == "NMSK:base"
 
 
@@ -248,3 +253,7 @@ def test_q_scan_findings_read_the_worst_channel_of_each_kind_and_every_target_at
     assert "from Table 5.9's 0.25" in text
     assert "No run meets every target at once; the lowest worst angle, at ×4, comes with angle 2.0°, grf 40.0 N over target." in text
     assert text.endswith(f"meets every target at once in: {m} + coordinate weight ×16.")
+    nm2 = nm.assign(**{f"{m} + coordinate weight ×4, no Mtb term": [2.2, 1.0, 3.0, 41.0]})
+    text = " ".join(fidelity.q_scan_findings(nm2, "NMSK"))
+    assert (f"Without the Mtb term ({m} + coordinate weight ×4, no Mtb term): 2.20°, 3.0 N·m, 41.0 N (with it: "
+            "2.00°, 3.5 N·m, 40.0 N) — the Mtb term is not what keeps") in text

@@ -289,7 +289,9 @@ def ch5_changes(model: str = "MSK") -> dict[str, dict]:
     the planned metatarsal angles left untracked (:attr:`GaitSpec.track_mtp`; the geometric
     floor, :func:`kinematic_floor_table`, is lower without them) — and, the one combination,
     that with the coordinate weight raised (the single change that lowers the angles most) to
-    each of :data:`Q_SCAN`: how much angle accuracy the torque and GRF terms cost."""
+    each of :data:`Q_SCAN`: how much angle accuracy the torque and GRF terms cost. NMSK adds
+    one row: the scan's run at :data:`MTB_FREE_Q` without the Mtb term (Eq 5.55), which with
+    the activation dynamics is what the NMSK problem adds to the MSK one."""
     w = dict(gait_ocp.COST_FUNCTIONS[model][msk.ch5_spec(model).cost])
     q = f"coordinate weight ×{1 / w['Q']:g}"
     return {
@@ -302,12 +304,28 @@ def ch5_changes(model: str = "MSK") -> dict[str, dict]:
         METATARSAL_FREE: {"track_mtp": False},
         **{f"{METATARSAL_FREE} + coordinate weight ×{f / w['Q']:g}": {"track_mtp": False, "weights": (("Q", float(f)),)}
            for f in Q_SCAN},
+        **({_no_mtb(f"{METATARSAL_FREE} + coordinate weight ×{MTB_FREE_Q / w['Q']:g}"):
+            {"track_mtp": False, "weights": (("Q", MTB_FREE_Q), ("Mtb", 0.0))}} if "Mtb" in w else {}),
     }
+
+
+def _no_mtb(row: str) -> str:
+    """The label of ``row`` (a Ch 5 ablation row) with the Mtb term removed (NMSK only)."""
+    return f"{row}, no Mtb term"
+
+
+def _msk_row(row: str) -> str:
+    """The MSK ablation row an NMSK row of :func:`ch5_changes` starts from: the same change
+    (the no-Mtb row: the same change with the Mtb term, which MSK does not have)."""
+    return row.removesuffix(_no_mtb(""))
 
 
 #: The coordinate (Q) weights of the Ch 5 ablation's combination rows, the metatarsal left
 #: untracked: the trade-off between the angles and the torque and GRF terms (Table 5.3: ¼).
 Q_SCAN = (1.0, 4.0, 8.0, 16.0)
+#: The Q weight at which the NMSK ablation also drops the Mtb term (Eq 5.55), one change on
+#: the scan's run of that weight: the MSK problem meets every target there (see the book).
+MTB_FREE_Q = 8.0
 
 #: The row of the Ch 5 ablation that is the book's own Ch 5 solution.
 CH5_BASE_ROW = "Ch 5, book's reading"
@@ -324,7 +342,7 @@ def ch5_ablation(model: str = "MSK", *, use_cache: bool = True, serial: bool = T
     guesses = None
     if model == "NMSK":
         _, msk_sols = ch5_ablation("MSK", use_cache=use_cache, serial=serial)
-        guesses = {k: msk_sols[k] for k in specs}
+        guesses = {k: msk_sols[_msk_row(k)] for k in specs}
     recs = gait_ocp.solve_specs(specs, guesses=guesses, use_cache=use_cache, serial=serial)
     sols = {CH5_BASE_ROW: msk.solve(model, reading="book"), **{k: r.value for k, r in recs.items()}}
     return pd.DataFrame([ablation_row(k, v) for k, v in sols.items() if v is not None]).set_index("run"), sols
@@ -401,7 +419,8 @@ def q_scan_findings(per_channel: pd.DataFrame, model: str = "MSK", msk_channels:
     """The coordinate-weight scan of the Ch 5 ablation (the metatarsal untracked, the Q weight
     at each of :data:`Q_SCAN`), read from ``per_channel`` (:func:`channel_table` of the usable
     runs): per weight the worst angle, torque and GRF RMSE beside their targets, and which runs
-    meet every target at once; when none does, which kinds miss. For NMSK, ``msk_channels``
+    meet every target at once; when none does, which kinds miss; the NMSK row without the Mtb
+    term beside the same weight with it. For NMSK, ``msk_channels``
     (the MSK ablation's table) adds which MSK runs meet every target: the MSK problem is the
     NMSK one without activation dynamics and without the Mtb term. Empty when fewer than two
     of the scan's runs are usable."""
@@ -427,6 +446,15 @@ def q_scan_findings(per_channel: pd.DataFrame, model: str = "MSK", msk_channels:
                 if worst[best][kind] > tgt[kind]]
         tail = (f" No run meets every target at once; the lowest worst angle, at ×{best:g}, comes with "
                 f"{', '.join(miss)} over target.")
+    nomtb = next((c for c in per_channel.columns if c.endswith(_no_mtb(""))), None)
+    if nomtb is not None and _msk_row(nomtb) in per_channel.columns:
+        a, b = per_channel[_msk_row(nomtb)].groupby(level="kind").max(), per_channel[nomtb].groupby(level="kind").max()
+        ok = nomtb in met
+        tail += (f" Without the Mtb term ({nomtb}): {b['angle']:.2f}°, {b['torque']:.1f} N·m, {b['grf']:.1f} N (with it: "
+                 f"{a['angle']:.2f}°, {a['torque']:.1f} N·m, {a['grf']:.1f} N) — "
+                 + ("the Mtb term is what keeps the NMSK run from the targets." if ok else
+                    "the Mtb term is not what keeps the NMSK run from the targets; of what the NMSK problem adds to "
+                    "the MSK one, that leaves the activation dynamics."))
     if model == "NMSK" and msk_channels is not None:
         m_met = all_targets(msk_channels)
         tail += (f" The MSK problem (the same generators without activation dynamics and without the Mtb term) meets "
