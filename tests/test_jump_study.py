@@ -298,3 +298,24 @@ def test_strength_retry_findings_tell_procedure_from_problem():
         retries["toe"][k] = fake((), "Infeasible_Problem_Detected", 900, 0.3)
     (line,) = J.strength_retry_findings(sols, retries)
     assert line.endswith("No procedure found a feasible point.")
+
+
+def test_friction_cap_keeps_the_keys_and_adds_two_rows_per_preflight_node():
+    """``friction_max`` (ours): absent from every existing key while unset; only for welded
+    contact; the preflight phases get the cone μF_y ∓ F_x ≥ 0 (two rows), the flight none."""
+    from gaitlib.problems import jump as J
+
+    for n in J.SPECS:
+        assert "friction_max" not in J.SPECS[n].to_dict()
+    st = J.spec("toe", torque_limits="strength")
+    capped = replace(st, friction_max=1.0)
+    assert J.cache_location(capped) != J.cache_location(st)
+    with pytest.raises(ValueError, match="friction_max"):
+        J.spec("ellipsoid", friction_max=1.0)
+    with pytest.raises(ValueError, match="friction_max"):
+        J.spec("toe", friction_max=0.0)
+    jp = J.build(replace(capped, n_intervals=3, continuation=()))
+    rows = {ph.name: [c for c in ph.path_constraints if c.name == "friction_cone"] for ph in jp.problem.phases}
+    assert len(rows["crouch"]) == len(rows["thrust"]) == 1 and not rows["flight"]
+    c = rows["crouch"][0]
+    assert c.lower == 0.0 and c.upper == np.inf

@@ -213,6 +213,9 @@ class JumpSpec:
         for IPOPT only; every frame is in N·m).
     tol, max_iter : IPOPT (Table 3.11: 1e-6, 5000).
     ipopt : further IPOPT options as ``(name, value)`` pairs.
+    friction_max : ``None`` (the thesis: a welded foot transmits any horizontal force) or μ:
+        kinematic contact only — |F_x| ≤ μ F_y at every collocation node of the preflight
+        (ours; Sec 3.4.3 reports the μ_s a jump *requires* instead of bounding it).
     torque_limits : ``"table3.5"`` (the thesis: Table 3.5's torque bounds, up to 4000 N·m)
         or ``"strength"`` (ours, the physiological version): the joint torques are also
         bounded by the body's strength — at hip, knee and ankle a path constraint
@@ -257,12 +260,17 @@ class JumpSpec:
     ipopt: tuple = ()
     print_level: int = 0
     torque_limits: str = "table3.5"
+    friction_max: float | None = None
 
     def __post_init__(self):
         if self.torque_limits not in TORQUE_LIMITS:
             raise ValueError(f"torque_limits must be one of {TORQUE_LIMITS}, got {self.torque_limits!r}")
         if self.name not in THESIS:
             raise ValueError(f"unknown jump {self.name!r}; known {tuple(THESIS)}")
+        if self.friction_max is not None and (self.contact != "kinematic" or not self.unilateral
+                                              or not self.friction_max > 0):
+            raise ValueError(f"friction_max: a positive μ for a kinematic-contact jump with unilateral=True, got "
+                             f"{self.friction_max!r} for {self.name!r}")
         n_w = 4 if self.name == "ellipsoid" else 2
         if len(self.weights) != n_w:
             raise ValueError(f"{self.name}: {n_w} weights expected (Table 3.10)")
@@ -286,11 +294,14 @@ class JumpSpec:
         return LABELS[self.name]
 
     def to_dict(self) -> dict:
-        """The spec as a dict; ``torque_limits`` is left out at its default (the thesis's
-        bounds), so the keys of the jumps stored before it existed stay."""
+        """The spec as a dict; ``torque_limits`` at its default (the thesis's bounds) and
+        ``friction_max`` while unset are left out, so the keys of the jumps stored before they
+        existed stay."""
         d = asdict(self)
         if d["torque_limits"] == "table3.5":
             d.pop("torque_limits")
+        if d["friction_max"] is None:
+            d.pop("friction_max")
         return d
 
 
@@ -554,6 +565,13 @@ def build(sp: JumpSpec) -> JumpProblem:
             else:
                 fy = lambda x, u, p, t: stance(x[qn_w], x[qdn_w], TS * x[names(False)[2]])[1][1]  # noqa: E731
             path_pre.append(ocp.PathConstraint("unilateral_fy", fy, 0.0, np.inf))
+            if sp.friction_max is not None:  # ours: |F_x| ≤ μ F_y, two smooth rows
+                fxy = (lambda x, u, p, t: stance_id(x[qn_w], x[qdn_w], u[names(False)[4]])[1]) if implicit else \
+                    (lambda x, u, p, t: stance(x[qn_w], x[qdn_w], TS * x[names(False)[2]])[1])
+                path_pre.append(ocp.PathConstraint(
+                    "friction_cone", lambda x, u, p, t: ca.vertcat(sp.friction_max * fxy(x, u, p, t)[1] - fxy(x, u, p, t)[0],
+                                                                   sp.friction_max * fxy(x, u, p, t)[1] + fxy(x, u, p, t)[0]),
+                    0.0, np.inf))
         # The thesis's preflight phase, split into crouch + thrust at a free instant for
         # the mesh only (states continuous, no constraint at the split): the thrust, a
         # few tenths of a second, gets its own intervals (GPOPS-II refined its mesh there).
