@@ -267,12 +267,12 @@ def test_strength_retry_findings_tell_procedure_from_problem():
     has jumps (the procedure failed); infeasible from every continuation: said so."""
     from types import SimpleNamespace
 
-    def fake(cont, status, it, viol, rise=0.2, obj=1.0, mu=2.0, limit=5000):
+    def fake(cont, status, it, viol, rise=0.2, obj=1.0, mu=2.0, limit=5000, cap=None):
         return SimpleNamespace(success=status == "Solve_Succeeded", status=status, stats={"iterations": it},
                                solution=SimpleNamespace(max_violation=viol, objective=obj, worst_constraint="x"),
                                jump_height={"com_rise_flight": rise}, required_friction=mu,
                                spec=SimpleNamespace(label="toe-included, kinematic contact", continuation=cont,
-                                                    max_iter=limit))
+                                                    max_iter=limit, friction_max=cap))
 
     sols = {"toe": fake((5,), "Infeasible_Problem_Detected", 2114, 1e-2, rise=0.01)}
     retries = {"toe": {((), None): fake((), "Infeasible_Problem_Detected", 2068, 1e-6, obj=3.0),
@@ -294,6 +294,10 @@ def test_strength_retry_findings_tell_procedure_from_problem():
     (line,) = J.strength_retry_findings(sols, retries)
     assert line.endswith("Converged with a 7-interval continuation stage, limit 15000 iterations: COM rise 31 cm, "
                          "required μ_s 7.0.")
+    retries["toe"][((5,), None, True)] = fake((5,), "Maximum_Iterations_Exceeded", 5000, 1e-8, rise=0.21, mu=1.0,
+                                               cap=1.0)
+    (line,) = J.strength_retry_findings(sols, retries)
+    assert "a 5-interval continuation stage, |F_x| ≤ 1 F_y, limit 5000 iterations: Maximum_Iterations_Exceeded" in line
     for k in retries["toe"]:
         retries["toe"][k] = fake((), "Infeasible_Problem_Detected", 900, 0.3)
     (line,) = J.strength_retry_findings(sols, retries)
@@ -319,3 +323,14 @@ def test_friction_cap_keeps_the_keys_and_adds_two_rows_per_preflight_node():
     assert len(rows["crouch"]) == len(rows["thrust"]) == 1 and not rows["flight"]
     c = rows["crouch"][0]
     assert c.lower == 0.0 and c.upper == np.inf
+
+
+def test_retry_specs_keep_the_stored_procedures_and_cap_friction_at_the_thesis_mu():
+    from gaitlib.problems import jump as P
+    st = P.spec("toe", torque_limits="strength")
+    got = [J.retry_spec(st, r) for r in J.STRENGTH_RETRIES]
+    assert got[:3] == [replace(st, continuation=()), replace(st, continuation=(7,)),
+                       replace(st, continuation=(7,), max_iter=15000)]
+    assert [g.friction_max for g in got] == [None, None, None, 1.0, 1.0]  # Sec 3.4.3: "1 … satisfactory"
+    assert J.retry_spec(P.spec("toeless", torque_limits="strength"), J.STRENGTH_RETRIES[3]).friction_max == 1.4
+    assert J.retry_spec(P.spec("ellipsoid", torque_limits="strength"), J.STRENGTH_RETRIES[3]).friction_max is None

@@ -316,15 +316,21 @@ def strength_findings(sols: dict[str, JumpSolution], valid: dict[str, bool]) -> 
 
 #: Other procedures tried for a strength-limited jump that did not converge with its own,
 #: as (mesh continuation :attr:`JumpSpec.continuation`, IPOPT iteration limit or None for the
-#: spec's): no continuation (the full mesh from the box-limited start's guess); a 7-interval
-#: stage instead of the 5-interval one; the same with three times the iterations.
-STRENGTH_RETRIES = (((), None), ((7,), None), ((7,), 15000))
+#: spec's, the welded foot's friction capped): no continuation (the full mesh from the
+#: box-limited start's guess); a 7-interval stage instead of the 5-interval one; the same with
+#: three times the iterations; the spec's own continuation with |F_x| ≤ μ F_y
+#: (:attr:`JumpSpec.friction_max`, μ the static friction Sec 3.4.3 calls satisfactory for
+#: that welded model, :data:`THESIS`) — whether the unbounded friction of a welded foot is
+#: what keeps IPOPT from converging; and that with three times the iterations.
+STRENGTH_RETRIES = (((), None, False), ((7,), None, False), ((7,), 15000, False), ((5,), None, True),
+                    ((5,), 15000, True))
 
 
 def retry_spec(sp: JumpSpec, retry: tuple) -> JumpSpec:
     """``sp`` with one procedure of :data:`STRENGTH_RETRIES`."""
-    c, it = retry
-    return replace(sp, continuation=c, **({} if it is None else {"max_iter": it}))
+    c, it, cap = retry
+    return replace(sp, continuation=c, **({} if it is None else {"max_iter": it}),
+                   **({"friction_max": THESIS[sp.name]["mu_s"]} if cap and sp.contact == "kinematic" else {}))
 
 
 def strength_retries(sols: dict[str, JumpSolution], use_cache: bool = True) -> dict[str, dict[tuple, JumpSolution]]:
@@ -343,7 +349,7 @@ def strength_retry_table(sols: dict[str, JumpSolution], retries: dict) -> pd.Dat
         for _, s in {"own": sols[n], **per}.items():
             c = s.spec.continuation
             rows.append({"jump": s.spec.label, "continuation (intervals)": ", ".join(map(str, c)) or "none",
-                         "iteration limit": s.spec.max_iter,
+                         "iteration limit": s.spec.max_iter, "friction cap μ": s.spec.friction_max,
                          "IPOPT status": s.status, "iterations": s.stats["iterations"], "objective": s.solution.objective,
                          "max violation": s.solution.max_violation, "worst constraint": s.solution.worst_constraint,
                          "COM rise in flight (cm)": 100 * s.jump_height["com_rise_flight"],
@@ -358,6 +364,7 @@ def strength_retry_findings(sols: dict[str, JumpSolution], retries: dict) -> lis
     def lab(s, own=False):
         c = s.spec.continuation
         t = f"a {', '.join(map(str, c))}-interval continuation stage" if c else "no continuation"
+        t += f", |F_x| ≤ {s.spec.friction_max:g} F_y" if s.spec.friction_max is not None else ""
         return t + (" (the spec's own)" if own else f", limit {s.spec.max_iter} iterations")
 
     out = []
