@@ -251,7 +251,7 @@ def test_q_scan_findings_read_the_worst_channel_of_each_kind_and_every_target_at
     nm = pc.drop(columns=[f"{m} + coordinate weight ×16"]).assign(**{f"{m} + coordinate weight ×4": [2.0, 1.0, 3.5, 40.0]})
     text = " ".join(fidelity.q_scan_findings(nm, "NMSK", msk_channels=pc))
     assert "from Table 5.9's 0.25" in text
-    assert "No run meets every target at once; the lowest worst angle, at ×4, comes with angle 2.0°, grf 40.0 N over target." in text
+    assert "No run meets every target at once; the lowest worst angle, at ×4, comes with angle 2.0°, GRF 40.0 N over target." in text
     assert text.endswith(f"meets every target at once in: {m} + coordinate weight ×16.")
     nm2 = nm.assign(**{f"{m} + coordinate weight ×4, no Mtb term": [2.2, 1.0, 3.0, 41.0]})
     text = " ".join(fidelity.q_scan_findings(nm2, "NMSK"))

@@ -442,7 +442,7 @@ def q_scan_findings(per_channel: pd.DataFrame, model: str = "MSK", msk_channels:
                 "misfit is what the torque and GRF terms buy, not a limit of the model or the data.")
     else:
         best = min(worst, key=lambda k: worst[k]["angle"])
-        miss = [f"{kind} {worst[best][kind]:.1f}{units[kind]}" for kind in ("angle", "torque", "grf")
+        miss = [f"{kind.replace('grf', 'GRF')} {worst[best][kind]:.1f}{units[kind]}" for kind in ("angle", "torque", "grf")
                 if worst[best][kind] > tgt[kind]]
         tail = (f" No run meets every target at once; the lowest worst angle, at ×{best:g}, comes with "
                 f"{', '.join(miss)} over target.")
