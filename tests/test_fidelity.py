@@ -121,15 +121,20 @@ def test_nmsk_ch5_ablation_starts_each_change_from_the_msk_run_of_that_change(mo
 
     def fake_solve_specs(specs, guesses=None, **kw):
         model = next(iter(specs.values())).model
-        seen[model] = (dict(specs), guesses)
+        seen.setdefault(model, []).append((dict(specs), guesses))
         return {k: type("R", (), {"value": f"{model}:{k}"})() for k in specs}
 
     monkeypatch.setattr(gait_ocp, "solve_specs", fake_solve_specs)
     monkeypatch.setattr(msk, "solve", lambda model, **kw: f"{model}:base")
     monkeypatch.setattr(fidelity, "ablation_row", lambda k, v: {"run": k, "solution": v})
     table, sols = fidelity.ch5_ablation("NMSK")
-    assert seen["MSK"][1] is None  # MSK from the data
-    specs, guesses = seen["NMSK"]
+    assert seen["MSK"][0][1] is None  # MSK from the data
+    (specs, guesses), (specs2, guesses2) = seen["NMSK"]
+    # the second start: the ×32 problem again, from the NMSK ×16 run
+    two = fidelity.second_start("metatarsal untracked + coordinate weight ×32")
+    assert two == "metatarsal untracked + coordinate weight ×32, from the NMSK ×16 run"
+    assert specs2 == {two: specs["metatarsal untracked + coordinate weight ×32"]}
+    assert guesses2 == {two: "NMSK:metatarsal untracked + coordinate weight ×16"} and sols[two] == f"NMSK:{two}"
     assert set(guesses) == set(specs) == set(fidelity.ch5_changes("NMSK"))
     assert all(g == f"MSK:{k}" for k, g in guesses.items() if not k.endswith(", no Mtb term"))
     nomtb = [k for k in specs if k.endswith(", no Mtb term")]
@@ -256,4 +261,15 @@ def test_q_scan_findings_read_the_worst_channel_of_each_kind_and_every_target_at
     nm2 = nm.assign(**{f"{m} + coordinate weight ×4, no Mtb term": [2.2, 1.0, 3.0, 41.0]})
     text = " ".join(fidelity.q_scan_findings(nm2, "NMSK"))
     assert (f"Without the Mtb term ({m} + coordinate weight ×4, no Mtb term): 2.20°, 3.0 N·m, 41.0 N (with it: "
-            "2.00°, 3.5 N·m, 40.0 N) — the Mtb term is not what keeps") in text
+            "2.00°, 3.5 N·m, 40.0 N) — from the same start, the Mtb term is not what keeps") in text
+    # the second start: the ×4 row again from another run; its objective beside the first start's
+    two = fidelity.second_start("metatarsal untracked + coordinate weight ×32")
+    nm3 = nm.rename(columns={f"{m} + coordinate weight ×4": f"{m} + coordinate weight ×32"}).assign(
+        **{two: [1.7, 0.9, 3.9, 37.0]})
+    text = " ".join(fidelity.q_scan_findings(nm3, "NMSK", objectives={two: 0.08, f"{m} + coordinate weight ×32": 0.11}))
+    assert (f"The start matters: {two} (objective 0.0800 vs 0.1100 from the MSK run): 1.70°, 3.9 N·m, 37.0 N (from "
+            "the MSK run of the same change: 2.00°, 3.5 N·m, 40.0 N); still over target: GRF 37.0 N.") in text
+    text = " ".join(fidelity.q_scan_findings(nm2, "NMSK", objectives={f"{m} + coordinate weight ×4": 0.10,
+                                                                      f"{m} + coordinate weight ×4, no Mtb term": 0.12}))
+    assert "— its objective (0.1200) exceeds that of the run with the term (0.1000)" in text
+    assert "not what keeps" not in text

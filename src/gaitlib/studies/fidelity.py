@@ -309,6 +309,17 @@ def ch5_changes(model: str = "MSK") -> dict[str, dict]:
     }
 
 
+#: NMSK rows of the Ch 5 ablation solved once more from a second start: row → the NMSK row
+#: whose solution is the start (instead of the MSK run of the same change): does the start
+#: decide what the NMSK run reaches?
+SECOND_STARTS = {f"{METATARSAL_FREE} + coordinate weight ×32": f"{METATARSAL_FREE} + coordinate weight ×16"}
+
+
+def second_start(row: str) -> str:
+    """The label of ``row`` solved from its :data:`SECOND_STARTS` start."""
+    return f"{row}, from the NMSK ×{SECOND_STARTS[row].rsplit('×', 1)[1]} run"
+
+
 def _no_mtb(row: str) -> str:
     """The label of ``row`` (a Ch 5 ablation row) with the Mtb term removed (NMSK only)."""
     return f"{row}, no Mtb term"
@@ -345,6 +356,13 @@ def ch5_ablation(model: str = "MSK", *, use_cache: bool = True, serial: bool = T
         guesses = {k: msk_sols[_msk_row(k)] for k in specs}
     recs = gait_ocp.solve_specs(specs, guesses=guesses, use_cache=use_cache, serial=serial)
     sols = {CH5_BASE_ROW: msk.solve(model, reading="book"), **{k: r.value for k, r in recs.items()}}
+    if model == "NMSK":  # the second start: the scan's run of the next lower weight, NMSK's own
+        chained = {second_start(k): (specs[k], sols.get(src)) for k, src in SECOND_STARTS.items() if k in specs}
+        chained = {k: v for k, v in chained.items() if v[1] is not None}
+        if chained:
+            rc = gait_ocp.solve_specs({k: v[0] for k, v in chained.items()}, guesses={k: v[1] for k, v in chained.items()},
+                                      use_cache=use_cache, serial=serial)
+            sols.update({k: r.value for k, r in rc.items()})
     return pd.DataFrame([ablation_row(k, v) for k, v in sols.items() if v is not None]).set_index("run"), sols
 
 
@@ -415,12 +433,15 @@ def all_targets(per_channel: pd.DataFrame) -> list[str]:
 WEIGHT_TABLES = {"MSK": "Table 5.3", "NMSK": "Table 5.9"}
 
 
-def q_scan_findings(per_channel: pd.DataFrame, model: str = "MSK", msk_channels: pd.DataFrame | None = None) -> list[str]:
+def q_scan_findings(per_channel: pd.DataFrame, model: str = "MSK", msk_channels: pd.DataFrame | None = None,
+                    objectives: dict | None = None) -> list[str]:
     """The coordinate-weight scan of the Ch 5 ablation (the metatarsal untracked, the Q weight
     at each of :data:`Q_SCAN`), read from ``per_channel`` (:func:`channel_table` of the usable
     runs): per weight the worst angle, torque and GRF RMSE beside their targets, and which runs
     meet every target at once; when none does, which kinds miss; the NMSK row without the Mtb
-    term beside the same weight with it. For NMSK, ``msk_channels``
+    term beside the same weight with it, and each :data:`SECOND_STARTS` row beside the same
+    problem from the MSK start (``objectives``: row → objective, e.g. the ablation table's
+    column). For NMSK, ``msk_channels``
     (the MSK ablation's table) adds which MSK runs meet every target: the MSK problem is the
     NMSK one without activation dynamics and without the Mtb term. Empty when fewer than two
     of the scan's runs are usable."""
@@ -450,11 +471,25 @@ def q_scan_findings(per_channel: pd.DataFrame, model: str = "MSK", msk_channels:
     if nomtb is not None and _msk_row(nomtb) in per_channel.columns:
         a, b = per_channel[_msk_row(nomtb)].groupby(level="kind").max(), per_channel[nomtb].groupby(level="kind").max()
         ok = nomtb in met
+        ja, jb = (objectives or {}).get(_msk_row(nomtb)), (objectives or {}).get(nomtb)
+        worse = ja is not None and jb is not None and jb > ja
         tail += (f" Without the Mtb term ({nomtb}): {b['angle']:.2f}°, {b['torque']:.1f} N·m, {b['grf']:.1f} N (with it: "
                  f"{a['angle']:.2f}°, {a['torque']:.1f} N·m, {a['grf']:.1f} N) — "
-                 + ("the Mtb term is what keeps the NMSK run from the targets." if ok else
-                    "the Mtb term is not what keeps the NMSK run from the targets; of what the NMSK problem adds to "
-                    "the MSK one, that leaves the activation dynamics."))
+                 + (f"its objective ({jb:.4f}) exceeds that of the run with the term ({ja:.4f}), although it has one "
+                    "term fewer: a worse local optimum, so this row does not measure the Mtb term's part." if worse else
+                    "the Mtb term is what keeps the NMSK run from the targets." if ok else
+                    "from the same start, the Mtb term is not what keeps the NMSK run from the targets."))
+    for row in SECOND_STARTS:
+        two = second_start(row)
+        if row in per_channel.columns and two in per_channel.columns:
+            a, b = per_channel[row].groupby(level="kind").max(), per_channel[two].groupby(level="kind").max()
+            obj = ""
+            if objectives is not None and row in objectives and two in objectives:
+                obj = f" (objective {objectives[two]:.4f} vs {objectives[row]:.4f} from the MSK run)"
+            over = [f"{k.replace('grf', 'GRF')} {b[k]:.1f}{units[k]}" for k in ("angle", "torque", "grf") if b[k] > tgt[k]]
+            tail += (f" The start matters: {two}{obj}: {b['angle']:.2f}°, {b['torque']:.1f} N·m, {b['grf']:.1f} N "
+                     f"(from the MSK run of the same change: {a['angle']:.2f}°, {a['torque']:.1f} N·m, {a['grf']:.1f} N)"
+                     + (f"; still over target: {', '.join(over)}." if over else " — every target met."))
     if model == "NMSK" and msk_channels is not None:
         m_met = all_targets(msk_channels)
         tail += (f" The MSK problem (the same generators without activation dynamics and without the Mtb term) meets "
