@@ -273,3 +273,6 @@ def test_q_scan_findings_read_the_worst_channel_of_each_kind_and_every_target_at
                                                                       f"{m} + coordinate weight ×4, no Mtb term": 0.12}))
     assert "— its objective (0.1200) exceeds that of the run with the term (0.1000)" in text
     assert "not what keeps" not in text
+    # objectives within 1 %: no claim that the start matters
+    text = " ".join(fidelity.q_scan_findings(nm3, "NMSK", objectives={two: 0.1100, f"{m} + coordinate weight ×32": 0.1101}))
+    assert f"From a second start: {two} (objective" in text and "The start matters" not in text

@@ -560,18 +560,16 @@ def build(sp: JumpSpec) -> JumpProblem:
         path_pre = [com_band(False)] + pcs
         if sp.unilateral:
             stance_id = model.function("stance_id")
-            if implicit:
-                fy = lambda x, u, p, t: stance_id(x[qn_w], x[qdn_w], u[names(False)[4]])[1][1]  # noqa: E731
+            if implicit:  # the welded foot's (F_x, F_y)
+                fxy = lambda x, u, p, t: stance_id(x[qn_w], x[qdn_w], u[names(False)[4]])[1]  # noqa: E731
             else:
-                fy = lambda x, u, p, t: stance(x[qn_w], x[qdn_w], TS * x[names(False)[2]])[1][1]  # noqa: E731
-            path_pre.append(ocp.PathConstraint("unilateral_fy", fy, 0.0, np.inf))
+                fxy = lambda x, u, p, t: stance(x[qn_w], x[qdn_w], TS * x[names(False)[2]])[1]  # noqa: E731
+            path_pre.append(ocp.PathConstraint("unilateral_fy", lambda x, u, p, t: fxy(x, u, p, t)[1], 0.0, np.inf))
             if sp.friction_max is not None:  # ours: |F_x| ≤ μ F_y, two smooth rows
-                fxy = (lambda x, u, p, t: stance_id(x[qn_w], x[qdn_w], u[names(False)[4]])[1]) if implicit else \
-                    (lambda x, u, p, t: stance(x[qn_w], x[qdn_w], TS * x[names(False)[2]])[1])
-                path_pre.append(ocp.PathConstraint(
-                    "friction_cone", lambda x, u, p, t: ca.vertcat(sp.friction_max * fxy(x, u, p, t)[1] - fxy(x, u, p, t)[0],
-                                                                   sp.friction_max * fxy(x, u, p, t)[1] + fxy(x, u, p, t)[0]),
-                    0.0, np.inf))
+                def cone(x, u, p, t):
+                    f = fxy(x, u, p, t)
+                    return ca.vertcat(sp.friction_max * f[1] - f[0], sp.friction_max * f[1] + f[0])
+                path_pre.append(ocp.PathConstraint("friction_cone", cone, 0.0, np.inf))
         # The thesis's preflight phase, split into crouch + thrust at a free instant for
         # the mesh only (states continuous, no constraint at the split): the thrust, a
         # few tenths of a second, gets its own intervals (GPOPS-II refined its mesh there).
