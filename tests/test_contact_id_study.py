@@ -1,6 +1,7 @@
 """Ch 4 contact identification study (gaitlib.studies.contact_id): approach (a)'s problem
 and multistart, the (b)/(c) specs, and the identified-parameter file round trip."""
 
+import dataclasses
 import json
 from types import SimpleNamespace
 
@@ -277,3 +278,24 @@ def test_start_params_and_the_multistart_keeps_the_lowest_valid(monkeypatch):
     assert best.starts.loc["neutral", "kept"] and not best.starts.loc["thesis (c)", "kept"]
     valid.update({"neutral": False, "ch4_child": False})
     assert ci.optimal_control_multistart().stats["start"] == "thesis (c)"
+
+
+def test_each_c_ablation_change_is_one_change_on_the_book_reading_spec():
+    base = ci.spec_c()
+    assert base.jerk_ranges == "data" and base.swing_load_max == pytest.approx(0.01 * 41.4 * 9.81, abs=1e-3)
+    specs = ci.c_ablation_specs()
+    assert set(specs) == set(ci.c_changes())
+    for name, change in ci.c_changes().items():
+        spec = specs[name]
+        differs = {f.name for f in dataclasses.fields(base) if getattr(spec, f.name) != getattr(base, f.name)}
+        assert differs == set(change), name
+    # Eq 4.13's tracking weights are 1/4 (Table 4.8): "×4" sets 1
+    w = dict(gait_ocp.COST_FUNCTIONS["SK"][base.cost])
+    assert w["GRF"] == w["Q"] == w["Trq"] == 0.25
+    assert dict(specs["GRF weight ×4"].weights) == {"GRF": 1.0}
+
+
+def test_c_ablation_targets_are_one_and_a_half_times_sec_4_4_2():
+    # Sec 4.4.2: "3.37 N and 2.71 N" tangential, "9.94 N and 10.72 N" normal (right, left)
+    assert ci.C_TARGET_FACTOR * ci.THESIS_RMSE["c"][("grf_y", "l")] == pytest.approx(16.08)
+    assert ci.C_TARGET_FACTOR * ci.THESIS_RMSE["c"][("grf_x", "r")] == pytest.approx(5.055)

@@ -55,7 +55,7 @@ from __future__ import annotations
 import datetime as _dt
 import json
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -85,6 +85,8 @@ __all__ = [
     "rmse_table", "rmse_beside_thesis", "solver_table", "geometry_table", "contact_table",
     "body_table", "at_bounds", "friction_ratios", "residual_rms", "grf_fit", "dynamic_consistency", "grf_error_by_phase",
     "save_identified", "identified_vs_result", "THESIS_RANKING", "ranking", "findings",
+    "C_TARGET_FACTOR", "C_BASE_ROW", "c_changes", "c_ablation_specs", "c_ablation", "c_ablation_table",
+    "c_ablation_findings",
 ]
 
 
@@ -841,6 +843,100 @@ def reading_findings(b: ApproachResult, readings: pd.DataFrame) -> list[str]:
         out.append(f"{lab}: in the thesis's reading a swinging foot carries up to {t['swing load (N)']:.0f} N "
                    f"({t['gates']}); in the book's {o['swing load (N)']:.1f} N ({o['gates']}). Mean GRF RMSE "
                    f"{t['mean GRF RMSE (N)']:.1f} N → {o['mean GRF RMSE (N)']:.1f} N; k_v book / thesis: {ratios}.")
+    return out
+
+
+#: The Fidelity II target for (c)'s GRF rows: each within this factor of the thesis's Sec 4.4.2
+#: value (:data:`THESIS_RMSE`, labelled reference).
+C_TARGET_FACTOR = 1.5
+#: The base row of the (c) ablation: the book's (c).
+C_BASE_ROW = "(c), book's reading"
+
+
+def c_changes() -> dict[str, dict]:
+    """The (c) ablation's changes, each a set of :class:`~gaitlib.problems.gait.GaitSpec`
+    fields applied alone to (c) in the book's reading (:func:`spec_c`): each tracking weight
+    of Eq 4.13 (Table 4.8's ¼ → 1), the Jrk denominators of the HAT's horizontal position and
+    tilt as printed (the reference's, so 1), the swinging foot unbounded (as printed) and the
+    mesh (40 × 5 instead of 20 × 5)."""
+    w = dict(gait_ocp.COST_FUNCTIONS["SK"][spec_c().cost])
+    return {
+        f"GRF weight ×{1 / w['GRF']:g}": {"weights": (("GRF", 1.0),)},
+        f"coordinate weight ×{1 / w['Q']:g}": {"weights": (("Q", 1.0),)},
+        f"torque weight ×{1 / w['Trq']:g}": {"weights": (("Trq", 1.0),)},
+        "Jrk denominators as printed": {"jerk_ranges": None},
+        "swinging foot unbounded (as printed)": {"swing_load_max": None},
+        "mesh 40 × 5": {"n_intervals": 40},
+    }
+
+
+def c_ablation_specs() -> dict[str, gait_ocp.GaitSpec]:
+    """Row → the spec of each :func:`c_changes` entry."""
+    base = spec_c()
+    return {k: replace(base, **ch) for k, ch in c_changes().items()}
+
+
+def c_ablation(b: ApproachResult | None = None, *, use_cache: bool = True, root=None,
+               progress: bool = False) -> tuple[pd.DataFrame, dict[str, ApproachResult]]:
+    """Each :func:`c_changes` entry applied alone to approach (c), warm-started from (b)'s
+    solution ``b`` as (c) is (:func:`optimal_control_body`; (b) solved or reloaded when not
+    given). Returns (:func:`c_ablation_table`, the results by row, the book's (c) first as
+    :data:`C_BASE_ROW`)."""
+    b = b if b is not None else optimal_control_multistart(use_cache=use_cache, root=root)
+    runs = {C_BASE_ROW: optimal_control_body(warm=b, use_cache=use_cache, root=root)}
+    for k, sp in c_ablation_specs().items():
+        runs[k] = _result_from_gait("c", solve_stage(sp, {}, b.solution, use_cache, root, progress))
+    return c_ablation_table(runs), runs
+
+
+def c_ablation_table(runs: dict[str, ApproachResult]) -> pd.DataFrame:
+    """One row per (c) ablation run: status, iterations, objective, the validity gates, each
+    foot's GRF RMSE (N) beside its target (:data:`C_TARGET_FACTOR` × the thesis's Sec 4.4.2
+    value), whether all four meet it, the worst angle (deg) and torque (N·m) RMSE, and the
+    vertical floor the run's own kinematics put under the GRF error (:func:`dynamic_consistency`)."""
+    rows = []
+    th = THESIS_RMSE["c"]
+    for k, r in runs.items():
+        rm = r.rmse.set_index("channel")
+        row = {"run": k, "status": r.stats["status"], "iterations": r.stats["iterations"],
+               "objective": r.stats["objective"], "gates": validity.label(r)}
+        met = True
+        for q in ("grf_x", "grf_y"):
+            for s in cv.SIDES:
+                v = float(rm.loc[f"{q}_{s}", "rmse"])
+                row[f"{q} {s.upper()} (N)"] = v
+                met &= v <= C_TARGET_FACTOR * th[(q, s)]
+        row["GRF targets met"] = bool(met)
+        kinds = rm.groupby("kind")["rmse"].max()
+        row["worst angle RMSE (deg)"] = float(kinds.get("angle", np.nan))
+        row["worst torque RMSE (N·m)"] = float(kinds.get("torque", np.nan))
+        row["vertical floor per foot (N)"] = float(dynamic_consistency({"c": r}).iloc[0]["floor per foot, y (N)"])
+        rows.append(row)
+    return pd.DataFrame(rows).set_index("run")
+
+
+def c_ablation_findings(table: pd.DataFrame) -> list[str]:
+    """What the (c) ablation measured, every number from ``table`` (:func:`c_ablation_table`):
+    the targets, which run meets all four GRF targets (converged and valid only), and for
+    each run its vertical errors beside its kinematics' floor."""
+    th = THESIS_RMSE["c"]
+    tgt = {(q, s): C_TARGET_FACTOR * th[(q, s)] for q in ("grf_x", "grf_y") for s in cv.SIDES}
+    ok = table[table["status"].isin(validity.CONVERGED_STATUSES) & (table["gates"] == "valid")]
+    out = [f"Targets ({C_TARGET_FACTOR:g} × the thesis's Sec 4.4.2 values): grf_x R/L "
+           f"{tgt[('grf_x', 'r')]:.1f} / {tgt[('grf_x', 'l')]:.1f} N, grf_y R/L {tgt[('grf_y', 'r')]:.1f} / "
+           f"{tgt[('grf_y', 'l')]:.1f} N."]
+    bad = table.index[~table.index.isin(ok.index)]
+    if len(bad):
+        out.append("Not converged or not valid (no number used): "
+                   + "; ".join(f"{k} ({table.loc[k, 'status']}, {table.loc[k, 'gates']})" for k in bad) + ".")
+    met = ok.index[ok["GRF targets met"]]
+    out.append("Every GRF target at once: " + (", ".join(
+        f"{k} (grf_y {ok.loc[k, 'grf_y R (N)']:.1f} / {ok.loc[k, 'grf_y L (N)']:.1f} N, worst angle "
+        f"{ok.loc[k, 'worst angle RMSE (deg)']:.1f}°)" for k in met) if len(met) else "no run") + ".")
+    for k, r in ok.iterrows():
+        out.append(f"{k}: grf_y R/L {r['grf_y R (N)']:.1f} / {r['grf_y L (N)']:.1f} N, of which its kinematics "
+                   f"force at least {r['vertical floor per foot (N)']:.1f} N per foot; worst angle "
+                   f"{r['worst angle RMSE (deg)']:.1f}°, worst torque {r['worst torque RMSE (N·m)']:.1f} N·m.")
     return out
 
 
