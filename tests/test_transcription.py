@@ -130,3 +130,36 @@ def test_q_term_leaves_the_planned_metatarsal_angles_out_only_when_asked():
     from dataclasses import replace
 
     assert replace(base, track_mtp=None).key() == base.key() != replace(base, track_mtp=False).key()
+
+
+def test_fourier_order_option_generates_the_left_leg_and_keeps_every_existing_key():
+    """GaitSpec.fourier_order: unset keeps the key (the thesis's order 5, Eqs 4.1–4.3); the
+    highest order the 51-sample data carry puts the right leg's samples, shifted half a cycle
+    (the data's opposite foot contact, 50 %), on the left leg; five harmonics do not: they ring
+    below zero in the vertical force's swing, which no contact model produces."""
+    from dataclasses import replace
+
+    import numpy as np
+
+    from gaitlib import data as data_mod
+    from gaitlib.problems import gait as gp_mod
+
+    base = gp_mod.GaitSpec(model="SK")
+    assert "fourier_order" not in base.to_dict()
+    exact = replace(base, fourier_order=gp_mod.EXACT_FOURIER_ORDER)
+    assert replace(base, fourier_order=None).key() == base.key() != exact.key()
+    assert gp_mod.GaitSpec.from_dict(exact.to_dict()) == exact
+    for bad in (0, 26, 2.5):
+        with pytest.raises(ValueError, match="fourier_order"):
+            gp_mod.GaitSpec(model="SK", fourier_order=bad)
+    with pytest.raises(ValueError, match="effects"):
+        gp_mod.GaitSpec(model="SK", fourier_order=25, effects=(("left_shift", 0.01),))
+    g5 = data_mod.load_gait_data("Free", fourier_order=gp_mod.FOURIER_ORDER)
+    g25 = data_mod.load_gait_data("Free", fourier_order=gp_mod.EXACT_FOURIER_ORDER)
+    assert g5.left_shift == g25.left_shift == 0.5
+    r = g25.mean["grf_y_r"].to_numpy()
+    shifted = np.roll(r[:-1], -25)  # x(t + 0.5) on the 50 distinct samples of the cycle
+    l25, l5 = g25.mean["grf_y_l"].to_numpy()[:-1], g5.mean["grf_y_l"].to_numpy()[:-1]
+    assert np.sqrt(np.mean((l25 - shifted) ** 2)) < 0.02 * np.ptp(r)  # ≈ 0.3 N of a ≈ 500 N range
+    assert l25.min() > -1.0 and r.min() >= 0.0
+    assert l5.min() < -10.0  # the order-5 series rings below zero in swing (N)

@@ -228,7 +228,13 @@ for _name, _w in _T62_NMSK.items():
 
 #: Spec options that are left out of :meth:`GaitSpec.to_dict` (hence of every cache key)
 #: while unset: added after the store was written, they must not change existing keys.
-KEY_STABLE_OPTIONS = ("swing_load_max", "derivatives", "jerk_ranges", "track_mtp", "activation_params")
+KEY_STABLE_OPTIONS = ("swing_load_max", "derivatives", "jerk_ranges", "track_mtp", "activation_params",
+                      "fourier_order")
+#: The Fourier order of the left leg generated from the right (thesis Eqs 4.1–4.3: 5).
+FOURIER_ORDER = 5
+#: The highest order a cycle of the data's 51 samples (50 distinct) carries: the left leg is
+#: then the right leg's samples shifted (to the least-squares fit's round-off).
+EXACT_FOURIER_ORDER = 25
 
 #: How the Jrk term (Eq 4.11) normalises the jerk of each coordinate (:class:`GaitSpec`
 #: ``jerk_ranges``; :func:`reference`).
@@ -325,6 +331,13 @@ class GaitSpec:
         two metatarsal angles. Their reference is not measured: it is the thesis's planned
         trajectory (Table 4.6), so ``False`` leaves the metatarsal joints to the dynamics — an
         ablation of the Fidelity II study (:func:`gaitlib.studies.fidelity.ch5_changes`).
+    fourier_order : ``None`` (the thesis's Eqs 4.1–4.3: :data:`FOURIER_ORDER`, 5) or the order
+        of the least-squares Fourier series that generates the left leg's data from the right
+        leg's (:func:`gaitlib.data.fourier_shift`); :data:`EXACT_FOURIER_ORDER` reproduces the
+        right leg's samples shifted. Five harmonics round the vertical GRF's loading and
+        unloading and ring below zero in swing; an ablation of the Fidelity II study
+        (:func:`gaitlib.studies.contact_id.c_changes`). Not with ``effects`` (the effects
+        assume the thesis's generation).
     """
 
     model: str = "SK"
@@ -359,8 +372,15 @@ class GaitSpec:
     jerk_ranges: str | None = None
     track_mtp: bool | None = None
     activation_params: str | None = None
+    fourier_order: int | None = None
 
     def __post_init__(self):
+        if self.fourier_order is not None:
+            if not (isinstance(self.fourier_order, int) and 1 <= self.fourier_order <= EXACT_FOURIER_ORDER):
+                raise ValueError(f"fourier_order must be None or an integer in [1, {EXACT_FOURIER_ORDER}], "
+                                 f"got {self.fourier_order!r}")
+            if self.effects:
+                raise ValueError("fourier_order cannot be combined with effects (they assume the thesis's order 5)")
         if self.jerk_ranges not in (None,) + JERK_RANGES:
             raise ValueError(f"jerk_ranges must be None or one of {JERK_RANGES}, got {self.jerk_ranges!r}")
         if self.derivatives not in (None, "graph", "nodes"):
@@ -874,8 +894,9 @@ COST_TERMS = {"Jrk": goal_jrk, "Rsd": goal_rsd, "Imp": goal_imp, "HAT": goal_hat
 def build(spec: GaitSpec) -> GaitProblem:
     """Turn a :class:`GaitSpec` into an :class:`ocp.Problem` with mesh, options, guess."""
     model = ChildModel()
-    gait_class = data_mod.load_gait_data(spec.speed_class, spec.source)
-    gait = (data_mod.time_scaled(data_mod.load_gait_data(spec.track_class, spec.source), gait_class)
+    order = spec.fourier_order or FOURIER_ORDER
+    gait_class = data_mod.load_gait_data(spec.speed_class, spec.source, fourier_order=order)
+    gait = (data_mod.time_scaled(data_mod.load_gait_data(spec.track_class, spec.source, fourier_order=order), gait_class)
             if spec.track_class else gait_class)
     p_body = params_mod.body_params(spec.body_params, model)
     p_contact = params_mod.contact_params(spec.contact_params)
