@@ -129,7 +129,7 @@ def test_nmsk_ch5_ablation_starts_each_change_from_the_msk_run_of_that_change(mo
     monkeypatch.setattr(fidelity, "ablation_row", lambda k, v: {"run": k, "solution": v})
     table, sols = fidelity.ch5_ablation("NMSK")
     assert seen["MSK"][0][1] is None  # MSK from the data
-    (specs, guesses), (specs2, guesses2) = seen["NMSK"]
+    (specs, guesses), (specs2, guesses2), *trade = seen["NMSK"]
     # the second start: the ×32 problem again, from the NMSK ×16 run
     two = fidelity.second_start("metatarsal untracked + coordinate weight ×32")
     assert two == "metatarsal untracked + coordinate weight ×32, from the NMSK ×16 run"
@@ -143,6 +143,14 @@ def test_nmsk_ch5_ablation_starts_each_change_from_the_msk_run_of_that_change(mo
     assert dict(specs[nomtb[0]].weights) == {"Q": 8.0, "Mtb": 0.0} and "Mtb" not in dict(fidelity.ch5_changes("MSK")
                                                                                          ).get(nomtb[0], {})
     assert sols[fidelity.CH5_BASE_ROW] == "NMSK:base"
+    # the trade-off rows, one solve each, in order, each from the NMSK row it names
+    assert [next(iter(sp)) for sp, _ in trade] == list(fidelity.TRADE_OFF)
+    first = "metatarsal untracked + coordinate weight ×32 + GRF weight ×2"
+    assert fidelity.TRADE_OFF[first][1] == two
+    for (sp, g), (k, (weights, src)) in zip(trade, fidelity.TRADE_OFF.items()):
+        assert g == {k: f"NMSK:{src}"} and dict(sp[k].weights) == dict(weights) and sp[k].track_mtp is False
+    # Table 5.9's weights are 1/4: ×32 on Q is 8, ×2 on GRF is 1/2
+    assert dict(fidelity.TRADE_OFF[first][0]) == {"Q": 8.0, "GRF": 0.5}
 
 
 def _row(status="Solve_Succeeded", obj=0.3, gates="valid", angle=10.0, torque=12.0, grf=60.0, swing=4.0, ds=27.0):

@@ -315,6 +315,21 @@ def ch5_changes(model: str = "MSK") -> dict[str, dict]:
 SECOND_STARTS = {f"{METATARSAL_FREE} + coordinate weight ×32": f"{METATARSAL_FREE} + coordinate weight ×16"}
 
 
+_Q32 = f"{METATARSAL_FREE} + coordinate weight ×32"
+_Q32_GRF2 = f"{_Q32} + GRF weight ×2"
+#: NMSK rows along the angle–GRF trade-off: the metatarsal untracked and both the coordinate
+#: and the GRF weight raised (Table 5.9: ¼ each), each solved from an NMSK row of the
+#: ablation: row → (weights, the row whose solution is the start). In order: a row's start
+#: comes before it. They ask whether one NMSK run meets every angle, torque and GRF target at
+#: once where the coordinate weight alone trades one for the other.
+TRADE_OFF = {
+    _Q32_GRF2: ((("Q", 8.0), ("GRF", 0.5)), f"{_Q32}, from the NMSK ×16 run"),
+    f"{_Q32} + GRF weight ×1.5": ((("Q", 8.0), ("GRF", 0.375)), _Q32_GRF2),
+    f"{METATARSAL_FREE} + coordinate weight ×64 + GRF weight ×2": ((("Q", 16.0), ("GRF", 0.5)), _Q32_GRF2),
+    f"{METATARSAL_FREE} + coordinate weight ×64 + GRF weight ×4": ((("Q", 16.0), ("GRF", 1.0)), _Q32_GRF2),
+}
+
+
 def second_start(row: str) -> str:
     """The label of ``row`` solved from its :data:`SECOND_STARTS` start."""
     return f"{row}, from the NMSK ×{SECOND_STARTS[row].rsplit('×', 1)[1]} run"
@@ -347,7 +362,8 @@ def ch5_ablation(model: str = "MSK", *, use_cache: bool = True, serial: bool = T
     (the base row: the book's Ch 5 solution), every run started as the book's Ch 5 solve of
     ``model`` starts (:func:`gaitlib.studies.msk.solve`): MSK from the data; NMSK from the MSK
     solution of the same change (the MSK ablation's run, solved or reloaded first); NMSK then
-    solves each :data:`SECOND_STARTS` row again from its NMSK start. Returns (one
+    solves each :data:`SECOND_STARTS` row again from its NMSK start, then each
+    :data:`TRADE_OFF` row from its NMSK start, in order. Returns (one
     :func:`ablation_row` per run, the solutions by row)."""
     base = msk.ch5_spec(model, reading="book")
     specs = {k: replace(base, **ch) for k, ch in ch5_changes(model).items()}
@@ -364,6 +380,11 @@ def ch5_ablation(model: str = "MSK", *, use_cache: bool = True, serial: bool = T
             rc = gait_ocp.solve_specs({k: v[0] for k, v in chained.items()}, guesses={k: v[1] for k, v in chained.items()},
                                       use_cache=use_cache, serial=serial)
             sols.update({k: r.value for k, r in rc.items()})
+        for k, (weights, src) in TRADE_OFF.items():  # one at a time: a row may start the next
+            if sols.get(src) is not None:
+                rc = gait_ocp.solve_specs({k: replace(base, track_mtp=False, weights=weights)}, guesses={k: sols[src]},
+                                          use_cache=use_cache, serial=serial)
+                sols[k] = rc[k].value
     return pd.DataFrame([ablation_row(k, v) for k, v in sols.items() if v is not None]).set_index("run"), sols
 
 
@@ -496,6 +517,15 @@ def q_scan_findings(per_channel: pd.DataFrame, model: str = "MSK", msk_channels:
             tail += (f" {lead}: {two}{obj}: {b['angle']:.2f}°, {b['torque']:.1f} N·m, {b['grf']:.1f} N "
                      f"(from the MSK run of the same change: {a['angle']:.2f}°, {a['torque']:.1f} N·m, {a['grf']:.1f} N)"
                      + (f"; still over target: {', '.join(over)}." if over else " — every target met."))
+    front = [k for k in TRADE_OFF if k in per_channel.columns]
+    if front:
+        parts = []
+        for k in front:
+            b = worst_of(k)
+            parts.append(f"{k.removeprefix(METATARSAL_FREE + ' + ')} (from {TRADE_OFF[k][1]}): {b['angle']:.2f}°, "
+                         f"{b['torque']:.1f} N·m, {b['grf']:.1f} N" + (" — every target met" if k in met else ""))
+        tail += (" Raising the GRF weight with the coordinate weight (the metatarsal untracked; each started from an "
+                 "NMSK run): " + "; ".join(parts) + ".")
     if model == "NMSK" and msk_channels is not None:
         m_met = all_targets(msk_channels)
         tail += (f" The MSK problem (the same generators without activation dynamics and without the Mtb term) meets "
