@@ -372,8 +372,10 @@ t511.rename(columns={"ours": marks.run_label("ours (NMSK)", marks.failure_label(
 # drops the Mtb term (Eq 5.55) from the ×32 run. As the book's NMSK solve starts from the
 # book's MSK solution, each run starts from the MSK ablation's run of the same change (the
 # no-Mtb row from the MSK ×32 run); one more row solves the ×32 problem again from a second
-# start, the NMSK ×16 run (`fidelity.SECOND_STARTS`). Only runs that converge and pass the
-# validity gates count.
+# start, the NMSK ×16 run (`fidelity.SECOND_STARTS`). The coordinate weight alone trades the
+# angles for the GRFs; four more rows raise the GRF weight with it (×2 and ×1.5 at ×32, ×2
+# and ×4 at ×64), each started from an NMSK run: the second start, then its GRF ×2 run
+# (`fidelity.TRADE_OFF`). Only runs that converge and pass the validity gates count.
 
 # %%
 try:

@@ -522,10 +522,10 @@ def q_scan_findings(per_channel: pd.DataFrame, model: str = "MSK", msk_channels:
         parts = []
         for k in front:
             b = worst_of(k)
-            parts.append(f"{k.removeprefix(METATARSAL_FREE + ' + ')} (from {TRADE_OFF[k][1]}): {b['angle']:.2f}°, "
-                         f"{b['torque']:.1f} N·m, {b['grf']:.1f} N" + (" — every target met" if k in met else ""))
+            parts.append(f"{k.removeprefix(METATARSAL_FREE + ' + ')} (from {TRADE_OFF[k][1]}): {b['angle']:.3f}°, "
+                         f"{b['torque']:.2f} N·m, {b['grf']:.2f} N" + (" — every target met" if k in met else ""))
         tail += (" Raising the GRF weight with the coordinate weight (the metatarsal untracked; each started from an "
-                 "NMSK run): " + "; ".join(parts) + ".")
+                 "NMSK run; three decimals, as the targets are met or missed by less than 1 %): " + "; ".join(parts) + ".")
     if model == "NMSK" and msk_channels is not None:
         m_met = all_targets(msk_channels)
         tail += (f" The MSK problem (the same generators without activation dynamics and without the Mtb term) meets "
