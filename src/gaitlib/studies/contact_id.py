@@ -581,7 +581,9 @@ def left_leg_table(results: dict[str, ApproachResult], speed_class: str = "Free"
 
     First row ``data``: the RMS difference of the two curves and the generated vertical
     force's minimum (the measured curve's is ≥ 0). Then one row per approach: its left-foot
-    RMSE against each curve (on its own samples, as :func:`rmse_table`)."""
+    RMSE against each curve (on its own samples, as :func:`rmse_table`), and how far its own
+    left vertical force is from its right one shifted by the data's left shift (RMS, N; 0
+    for a gait as symmetric as the shifted data)."""
     g5 = data_mod.load_gait_data(speed_class, fourier_order=gait_ocp.FOURIER_ORDER)
     gx = data_mod.load_gait_data(speed_class, fourier_order=gait_ocp.EXACT_FOURIER_ORDER)
     chans = ("grf_x_l", "grf_y_l")
@@ -598,6 +600,9 @@ def left_leg_table(results: dict[str, ApproachResult], speed_class: str = "Free"
             sim = res.grf[ch].to_numpy()
             for lab, g in (("generated", g5), ("shifted", gx)):
                 row[f"{ch} vs {lab} (N)"] = float(np.sqrt(np.mean((sim - np.interp(t, g.time, g.mean[ch])) ** 2)))
+        T = g5.cycle_time
+        right = np.interp((t + g5.left_shift * T) % T, t, res.grf["grf_y_r"].to_numpy(), period=T)
+        row["own grf_y_l vs own grf_y_r shifted (N)"] = float(np.sqrt(np.mean((res.grf["grf_y_l"].to_numpy() - right) ** 2)))
         rows.append(row)
     return pd.DataFrame(rows).set_index("run")
 
