@@ -345,6 +345,7 @@ def _ch4() -> list[Row]:
     where = _anchor("ch04_contact", "Why the GRF fits differ from the thesis's: where the error is")
     jerk = _jerk_causes("SK")
     a_cause = _ch4_a_cause(table) if "a" in res else ""
+    cabl = _ch4c_ablation_causes(res.get("b"))
     rows = []
     for k, th in ci.THESIS_RMSE.items():
         if k == "c_wide":
@@ -362,6 +363,8 @@ def _ch4() -> list[Row]:
                 cause = (f"the {foot} foot carries {p['mean simulated force in swing (N)']:.0f} N in the data's swing: "
                          f"{p['share of squared error in swing (%)']:.0f} % of its squared error [{where}]")
             jk = ("torque", qty[4:], side) if qty.startswith("tau_") else ("grf", qty[4:], side)
+            if cause == "unknown" and k == "c" and (qty, side) in cabl:
+                cause = cabl[(qty, side)]
             if cause == "unknown" and k != "a" and jk in jerk:  # (a) has no Jrk term (trajectory optimisation)
                 cause = jerk[jk]
             if cause == "unknown" and k == "a" and a_cause:
@@ -384,6 +387,45 @@ def _ch4() -> list[Row]:
                         _total_mass(res["c"].p_body, masses, ci.P_BODY_NAMES), "kg", "unknown", names["c"],
                         valid["c"]))
     return rows
+
+
+#: The Ch 4 page's section of the (c) ablation (the card links to it).
+CH4C_ABLATION_HEADING = "What (c)'s GRF error depends on: one change at a time"
+
+
+def _ch4c_ablation_causes(b) -> dict:
+    """(quantity, side) → the (c) ablation's answer for that GRF channel (:func:`gaitlib.
+    studies.contact_id.c_ablation`: one change at a time on (c), warm-started from (b)): the
+    lowest RMSE a converged, valid run reaches, which runs meet the target, and the floor the
+    book's (c) kinematics put under the vertical error; empty when (b) or the ablation is not
+    stored or the book's (c) is not usable."""
+    if b is None:
+        return {}
+    try:
+        with cache.only("the card reads stored solutions only"):
+            table, _ = ci.c_ablation(b)
+    except cache.NotCached:
+        return {}
+    ok = table[table["status"].isin(validity.CONVERGED_STATUSES) & (table["gates"] == "valid")]
+    if ci.C_BASE_ROW not in ok.index or len(ok) < 2:
+        return {}
+    where = _anchor("ch04_contact", CH4C_ABLATION_HEADING)
+    every = list(ok.index[ok["GRF targets met"]])
+    every = f"; every GRF target at once: met by {', '.join(every) if every else 'no run'}"
+    floor = float(ok.loc[ci.C_BASE_ROW, "vertical floor per foot (N)"])
+    out = {}
+    for q in ("grf_x", "grf_y"):
+        for s in cv.SIDES:
+            col = f"{q} {s.upper()} (N)"
+            tgt = ci.C_TARGET_FACTOR * ci.THESIS_RMSE["c"][(q, s)]
+            best = ok[col].idxmin()
+            met = [k for k in ok.index if ok.loc[k, col] <= tgt]
+            text = (f"(c) ablation ({len(ok) - 1} usable changes): lowest {ok.loc[best, col]:.1f} N ({best}), "
+                    f"target {tgt:.1f} N met by: {', '.join(met) if met else 'none'}{every}")
+            if q == "grf_y":
+                text += f"; the book's (c) kinematics force at least {floor:.1f} N per foot (total-force mismatch)"
+            out[(q, s)] = f"{text} [{where}]"
+    return out
 
 
 def _ch4_a_cause(table: pd.DataFrame) -> str:
