@@ -85,8 +85,8 @@ __all__ = [
     "rmse_table", "rmse_beside_thesis", "solver_table", "geometry_table", "contact_table",
     "body_table", "at_bounds", "friction_ratios", "residual_rms", "grf_fit", "dynamic_consistency", "grf_error_by_phase",
     "save_identified", "identified_vs_result", "THESIS_RANKING", "ranking", "findings",
-    "C_TARGET_FACTOR", "C_BASE_ROW", "c_changes", "c_ablation_specs", "c_ablation", "c_ablation_table",
-    "c_ablation_findings", "left_leg_table",
+    "C_TARGET_FACTOR", "C_BASE_ROW", "C_GRF_SCAN", "c_changes", "c_ablation_specs", "c_ablation", "c_ablation_table",
+    "c_ablation_findings", "left_leg_table", "LEFT_SHIFTED_ROW", "left_leg_findings",
 ]
 
 
@@ -607,6 +607,35 @@ def left_leg_table(results: dict[str, ApproachResult], speed_class: str = "Free"
     return pd.DataFrame(rows).set_index("run")
 
 
+#: The (c) ablation's row that tracks the left leg as the right leg's samples shifted.
+LEFT_SHIFTED_ROW = "left leg: the right leg's samples shifted"
+
+
+def left_leg_findings(left: pd.DataFrame, ablation: pd.DataFrame | None = None) -> list[str]:
+    """What the left leg's generation does to (c)'s left-foot GRF error, every number from
+    ``left`` (:func:`left_leg_table`) and, when given and usable, the (c) ablation's row
+    :data:`LEFT_SHIFTED_ROW` (``ablation``: :func:`c_ablation_table`)."""
+    d = left.loc["data: generated − shifted"]
+    c = left.loc[APPROACHES["c"]]
+    out = [f"The generated left leg differs from the right leg's samples shifted by {d['grf_y_l vs generated (N)']:.1f} N "
+           f"(vertical) and {d['grf_x_l vs generated (N)']:.1f} N (horizontal) RMS; its vertical force dips to "
+           f"{d['generated grf_y_l minimum (N)']:.1f} N in swing. (c)'s left foot scores grf_y "
+           f"{c['grf_y_l vs generated (N)']:.1f} N against it and {c['grf_y_l vs shifted (N)']:.1f} N against the shifted "
+           f"curve (grf_x {c['grf_x_l vs generated (N)']:.1f} vs {c['grf_x_l vs shifted (N)']:.1f} N), without a re-solve."]
+    if ablation is not None and LEFT_SHIFTED_ROW in ablation.index:
+        r = ablation.loc[LEFT_SHIFTED_ROW]
+        if r["status"] in validity.CONVERGED_STATUSES and r["gates"] == "valid":
+            base = ablation.loc[C_BASE_ROW]
+            out.append(f"Re-solved tracking the shifted curve ((c) ablation): grf_y L {r['grf_y L (N)']:.1f} N (book's (c) "
+                       f"{base['grf_y L (N)']:.1f} N), grf_x L {r['grf_x L (N)']:.1f} N ({base['grf_x L (N)']:.1f} N).")
+        else:
+            out.append(f"Re-solved tracking the shifted curve: {r['status']}, {r['gates']} — no number used.")
+    out.append(f"(c)'s own left and right vertical forces, half a cycle apart, differ by "
+               f"{c['own grf_y_l vs own grf_y_r shifted (N)']:.1f} N RMS, although the tracked data are the right leg "
+               "shifted and the two legs' parameters the same: the solution is not a symmetric gait.")
+    return out
+
+
 def residual_rms(res: ApproachResult) -> dict:
     """RMS of the pelvis residual loads over the cycle (R_x, R_y N; R_z N·m)."""
     return {r: float(np.sqrt(np.mean(res.residuals[r].to_numpy() ** 2))) for r in cv.RESIDUALS}
@@ -886,13 +915,22 @@ C_TARGET_FACTOR = 1.5
 C_BASE_ROW = "(c), book's reading"
 
 
+#: The GRF weights of the (c) ablation's scan beyond Table 4.8's ¼ → 1 (×16, ×64).
+C_GRF_SCAN = (4.0, 16.0)
+
+
 def c_changes() -> dict[str, dict]:
     """The (c) ablation's changes, each a set of :class:`~gaitlib.problems.gait.GaitSpec`
-    fields applied alone to (c) in the book's reading (:func:`spec_c`): each tracking weight
-    of Eq 4.13 (Table 4.8's ¼ → 1), the Jrk denominators of the HAT's horizontal position and
-    tilt as printed (the reference's, so 1), the swinging foot unbounded (as printed) and the
-    mesh (40 × 5 instead of 20 × 5)."""
+    fields applied to (c) in the book's reading (:func:`spec_c`). One at a time: each tracking
+    weight of Eq 4.13 (Table 4.8's ¼ → 1), the Jrk denominators of the HAT's horizontal
+    position and tilt as printed (the reference's, so 1), the swinging foot unbounded (as
+    printed), the mesh (40 × 5 instead of 20 × 5), and the left leg's data generated from the
+    right with every harmonic the data carry (:data:`LEFT_SHIFTED_ROW`: the right leg's
+    samples shifted) instead of Eqs 4.1–4.3's five. Then the GRF weight raised further
+    (:data:`C_GRF_SCAN`: the vertical error's trade-off against the other terms), and its first
+    step combined with the shifted left leg."""
     w = dict(gait_ocp.COST_FUNCTIONS["SK"][spec_c().cost])
+    exact = gait_ocp.EXACT_FOURIER_ORDER
     return {
         f"GRF weight ×{1 / w['GRF']:g}": {"weights": (("GRF", 1.0),)},
         f"coordinate weight ×{1 / w['Q']:g}": {"weights": (("Q", 1.0),)},
@@ -900,7 +938,10 @@ def c_changes() -> dict[str, dict]:
         "Jrk denominators as printed": {"jerk_ranges": None},
         "swinging foot unbounded (as printed)": {"swing_load_max": None},
         "mesh 40 × 5": {"n_intervals": 40},
-        "left leg: the right leg's samples shifted": {"fourier_order": gait_ocp.EXACT_FOURIER_ORDER},
+        LEFT_SHIFTED_ROW: {"fourier_order": exact},
+        **{f"GRF weight ×{f / w['GRF']:g}": {"weights": (("GRF", f),)} for f in C_GRF_SCAN},
+        f"GRF weight ×{C_GRF_SCAN[0] / w['GRF']:g} + {LEFT_SHIFTED_ROW}": {"weights": (("GRF", C_GRF_SCAN[0]),),
+                                                                         "fourier_order": exact},
     }
 
 
@@ -957,8 +998,8 @@ def c_ablation_findings(table: pd.DataFrame) -> list[str]:
     tgt = {(q, s): C_TARGET_FACTOR * th[(q, s)] for q in ("grf_x", "grf_y") for s in cv.SIDES}
     ok = table[table["status"].isin(validity.CONVERGED_STATUSES) & (table["gates"] == "valid")]
     out = [f"Targets ({C_TARGET_FACTOR:g} × the thesis's Sec 4.4.2 values): grf_x R/L "
-           f"{tgt[('grf_x', 'r')]:.1f} / {tgt[('grf_x', 'l')]:.1f} N, grf_y R/L {tgt[('grf_y', 'r')]:.1f} / "
-           f"{tgt[('grf_y', 'l')]:.1f} N."]
+           f"{tgt[('grf_x', 'r')]:.3f} / {tgt[('grf_x', 'l')]:.3f} N, grf_y R/L {tgt[('grf_y', 'r')]:.2f} / "
+           f"{tgt[('grf_y', 'l')]:.2f} N."]
     bad = table.index[~table.index.isin(ok.index)]
     if len(bad):
         out.append("Not converged or not valid (no number used): "
@@ -967,6 +1008,14 @@ def c_ablation_findings(table: pd.DataFrame) -> list[str]:
     out.append("Every GRF target at once: " + (", ".join(
         f"{k} (grf_y {ok.loc[k, 'grf_y R (N)']:.1f} / {ok.loc[k, 'grf_y L (N)']:.1f} N, worst angle "
         f"{ok.loc[k, 'worst angle RMSE (deg)']:.1f}°)" for k in met) if len(met) else "no run") + ".")
+    if len(ok) and not len(met):
+        ratio = pd.DataFrame({f"{q} {s_.upper()}": ok[f"{q} {s_.upper()} (N)"] / tgt[(q, s_)] for (q, s_) in tgt})
+        worst = ratio.max(axis=1)
+        k = worst.idxmin()
+        over = [f"{c} {ok.loc[k, c + ' (N)']:.3f} N vs {tgt[(c.split()[0], c.split()[1].lower())]:.3f} N"
+                for c in ratio.columns if ratio.loc[k, c] > 1.0]
+        out.append(f"Closest to every target: {k}, its worst channel {100 * (worst[k] - 1):.1f} % over "
+                   f"({'; '.join(over)}).")
     for k, r in ok.iterrows():
         out.append(f"{k}: grf_y R/L {r['grf_y R (N)']:.1f} / {r['grf_y L (N)']:.1f} N, of which its kinematics "
                    f"force at least {r['vertical floor per foot (N)']:.1f} N per foot; worst angle "
