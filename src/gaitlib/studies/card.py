@@ -420,8 +420,8 @@ def _ch4c_ablation_causes(b) -> dict:
             tgt = ci.C_TARGET_FACTOR * ci.THESIS_RMSE["c"][(q, s)]
             best = ok[col].idxmin()
             met = [k for k in ok.index if ok.loc[k, col] <= tgt]
-            text = (f"(c) ablation ({len(ok) - 1} usable changes): lowest {ok.loc[best, col]:.1f} N ({best}), "
-                    f"target {tgt:.1f} N met by: {', '.join(met) if met else 'none'}{every}")
+            text = (f"(c) ablation ({len(ok) - 1} usable changes): lowest {ok.loc[best, col]:.2f} N ({best}), "
+                    f"target {tgt:.2f} N met by: {', '.join(met) if met else 'none'}{every}")
             if q == "grf_y":
                 text += f"; the book's (c) kinematics force at least {floor:.1f} N per foot (total-force mismatch)"
             out[(q, s)] = f"{text} [{where}]"
