@@ -163,3 +163,26 @@ def test_fourier_order_option_generates_the_left_leg_and_keeps_every_existing_ke
     assert np.sqrt(np.mean((l25 - shifted) ** 2)) < 0.02 * np.ptp(r)  # ≈ 0.3 N of a ≈ 500 N range
     assert l25.min() > -1.0 and r.min() >= 0.0
     assert l5.min() < -10.0  # the order-5 series rings below zero in swing (N)
+
+
+def test_build_reads_the_data_with_default_arguments_unless_fourier_order_is_set(monkeypatch):
+    """A gap diagnosis on a user's data set substitutes gaitlib.data.load_gait_data for its
+    default arguments only (gaitlib.studies.gap.own_data): build() must call it so."""
+    from gaitlib import data as data_mod
+    from gaitlib.problems import gait as gp_mod
+
+    calls = []
+
+    class Stop(Exception):
+        pass
+
+    def spy(*a, **k):
+        calls.append(k)
+        raise Stop
+
+    monkeypatch.setattr(data_mod, "load_gait_data", spy)
+    for order, expected in ((None, {}), (25, {"fourier_order": 25})):
+        calls.clear()
+        with pytest.raises(Stop):
+            gp_mod.build(gp_mod.GaitSpec(model="SK", n_intervals=2, degree=2, fourier_order=order))
+        assert calls == [expected]

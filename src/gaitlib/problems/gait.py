@@ -894,9 +894,11 @@ COST_TERMS = {"Jrk": goal_jrk, "Rsd": goal_rsd, "Imp": goal_imp, "HAT": goal_hat
 def build(spec: GaitSpec) -> GaitProblem:
     """Turn a :class:`GaitSpec` into an :class:`ocp.Problem` with mesh, options, guess."""
     model = ChildModel()
-    order = spec.fourier_order or FOURIER_ORDER
-    gait_class = data_mod.load_gait_data(spec.speed_class, spec.source, fourier_order=order)
-    gait = (data_mod.time_scaled(data_mod.load_gait_data(spec.track_class, spec.source, fourier_order=order), gait_class)
+    # the default call unless the spec asks for another order (a gap diagnosis on a user's
+    # data set substitutes load_gait_data for its default arguments: gaitlib.studies.gap.own_data)
+    order = {"fourier_order": spec.fourier_order} if spec.fourier_order else {}
+    gait_class = data_mod.load_gait_data(spec.speed_class, spec.source, **order)
+    gait = (data_mod.time_scaled(data_mod.load_gait_data(spec.track_class, spec.source, **order), gait_class)
             if spec.track_class else gait_class)
     p_body = params_mod.body_params(spec.body_params, model)
     p_contact = params_mod.contact_params(spec.contact_params)
