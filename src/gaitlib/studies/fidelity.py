@@ -522,8 +522,10 @@ def q_scan_findings(per_channel: pd.DataFrame, model: str = "MSK", msk_channels:
         parts = []
         for k in front:
             b = worst_of(k)
+            over = [kind.replace("grf", "GRF") for kind in ("angle", "torque", "grf") if b[kind] > tgt[kind]]
             parts.append(f"{k.removeprefix(METATARSAL_FREE + ' + ')} (from {TRADE_OFF[k][1]}): {b['angle']:.3f}°, "
-                         f"{b['torque']:.2f} N·m, {b['grf']:.2f} N" + (" — every target met" if k in met else ""))
+                         f"{b['torque']:.2f} N·m, {b['grf']:.2f} N"
+                         + (" — every target met" if k in met else f" — over target: {', '.join(over)}"))
         tail += (" Raising the GRF weight with the coordinate weight (the metatarsal untracked; each started from an "
                  "NMSK run; three decimals, as the targets are met or missed by less than 1 %): " + "; ".join(parts) + ".")
     if model == "NMSK" and msk_channels is not None:
