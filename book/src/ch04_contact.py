@@ -263,7 +263,7 @@ for r in (c, cw):
 
 # %%
 left = ci.left_leg_table(res)
-left
+mark_approaches(left)
 
 # %%
 cabl, cabl_runs = ci.c_ablation(b)

@@ -527,10 +527,12 @@ def dynamic_consistency(results: dict[str, ApproachResult]) -> pd.DataFrame:
     achieved quadratic-mean RMSE of the two feet (N), per direction.
     """
     m = ChildModel()
-    gait = data_mod.load_gait_data("Free")
     f = m.function("inverse_dynamics_grf")
     rows = []
     for k, res in results.items():
+        # the data the result tracked (a left leg generated with another order: its own)
+        order = getattr(getattr(res.solution, "spec", None), "fourier_order", None)
+        gait = data_mod.load_gait_data("Free", **({"fourier_order": order} if order else {}))
         t, Q, QD, QDD = _kinematics(res)
         n = t.size
         _, F = f.map(n)(Q, QD, QDD, np.tile(res.p_body[:, None], n), np.zeros((6, n)))
@@ -953,7 +955,7 @@ def c_ablation_specs() -> dict[str, gait_ocp.GaitSpec]:
 
 def c_ablation(b: ApproachResult | None = None, *, use_cache: bool = True, root=None,
                progress: bool = False) -> tuple[pd.DataFrame, dict[str, ApproachResult]]:
-    """Each :func:`c_changes` entry applied alone to approach (c), warm-started from (b)'s
+    """Each :func:`c_changes` entry applied to approach (c), warm-started from (b)'s
     solution ``b`` as (c) is (:func:`optimal_control_body`; (b) solved or reloaded when not
     given). Returns (:func:`c_ablation_table`, the results by row, the book's (c) first as
     :data:`C_BASE_ROW`)."""
