@@ -174,3 +174,19 @@ def test_time_split_is_iterations_times_time_per_iteration():
     b = {"iterations": 50, "solve_time_s": 140.0, "build_time_s": 10.0}
     assert card_mod._time_split(a, b, "NMSK FP", "MSK FP") == (
         "NMSK FP 150 s in 50 iterations, MSK FP 100 s in 100: iterations ×0.50, time per iteration ×3.00")
+
+
+def test_time_ratio_row_sums_the_runs_and_splits_the_ratio():
+    """Two MSK runs (100 s / 100 it, 200 s / 100 it) against two NMSK runs (150 s / 50 it each):
+    ratio 300 / 300 = 1, split ×2 the iterations (200 / 100) at ×0.5 the time each (1.5 / 3)."""
+    from types import SimpleNamespace
+
+    def run(t, it):
+        return SimpleNamespace(stats={"iterations": it, "solve_time_s": t - 1.0, "build_time_s": 1.0})
+
+    runs = {"MSK a": run(100, 100), "MSK b": run(200, 100), "NMSK a": run(150, 50), "NMSK b": run(150, 50)}
+    th = {"MSK": {"a": 2.0, "b": 4.0}, "NMSK": {"a": 1.0, "b": 1.0}}
+    row = card._time_ratio_row(6, "x", th, runs, ("a", "b"), "s", {k: "valid" for k in runs})
+    assert row.thesis == 3.0 and row.ours == pytest.approx(1.0)
+    assert row.cause == ("MSK 300 s in 200 iterations, NMSK 300 s in 100: iterations ×2.00, time per iteration "
+                         "×0.50 (sums over the runs)")
