@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from types import SimpleNamespace
 from dataclasses import replace
 
 import numpy as np
@@ -270,9 +271,9 @@ def test_strength_retry_findings_tell_procedure_from_problem():
     def fake(cont, status, it, viol, rise=0.2, obj=1.0, mu=2.0, limit=5000, cap=None):
         return SimpleNamespace(success=status == "Solve_Succeeded", status=status, stats={"iterations": it},
                                solution=SimpleNamespace(max_violation=viol, objective=obj, worst_constraint="x"),
-                               jump_height={"com_rise_flight": rise}, required_friction=mu,
+                               jump_height={"com_rise_flight": rise, "takeoff_vy": 2.1}, required_friction=mu,
                                spec=SimpleNamespace(label="toe-included, kinematic contact", continuation=cont,
-                                                    max_iter=limit, friction_max=cap))
+                                                    max_iter=limit, friction_max=cap, start_from=None, ipopt=()))
 
     sols = {"toe": fake((5,), "Infeasible_Problem_Detected", 2114, 1e-2, rise=0.01)}
     retries = {"toe": {((), None): fake((), "Infeasible_Problem_Detected", 2068, 1e-6, obj=3.0),
@@ -292,8 +293,8 @@ def test_strength_retry_findings_tell_procedure_from_problem():
             "violation 2.0e-11; COM rise 30 cm, required μ_s 7.4)") in line
     retries["toe"][((7,), 15000)] = fake((7,), "Solve_Succeeded", 9000, 1e-9, rise=0.31, mu=7.0, limit=15000)
     (line,) = J.strength_retry_findings(sols, retries)
-    assert line.endswith("Converged with a 7-interval continuation stage, limit 15000 iterations: COM rise 31 cm, "
-                         "required μ_s 7.0.")
+    assert line.endswith("Converged: with a 7-interval continuation stage, limit 15000 iterations, COM rise 31 cm, "
+                         "take-off v_y 2.10 m/s, required μ_s 7.0 (objective 1.00).")
     retries["toe"][((5,), None, True)] = fake((5,), "Maximum_Iterations_Exceeded", 5000, 1e-8, rise=0.21, mu=1.0,
                                                cap=1.0)
     (line,) = J.strength_retry_findings(sols, retries)
@@ -331,6 +332,56 @@ def test_retry_specs_keep_the_stored_procedures_and_cap_friction_at_the_thesis_m
     got = [J.retry_spec(st, r) for r in J.STRENGTH_RETRIES]
     assert got[:3] == [replace(st, continuation=()), replace(st, continuation=(7,)),
                        replace(st, continuation=(7,), max_iter=15000)]
-    assert [g.friction_max for g in got] == [None, None, None, 1.0, 1.0]  # Sec 3.4.3: "1 … satisfactory"
+    assert [g.friction_max for g in got] == [None, None, None, 1.0, 1.0, None, None, None, 1.0]  # Sec 3.4.3: "1 …"
+    assert got[5] == replace(st, ipopt=J.PIVTOL)  # the spec's own procedure, MUMPS's pivot tolerance raised
+    assert got[6] == replace(st, continuation=(), start_from="toeless")
+    assert got[7] == replace(st, continuation=(), start_from="toeless", ipopt=J.PIVTOL)
+    assert J.retry_spec(P.spec("toeless", torque_limits="strength"), J.STRENGTH_RETRIES[6]) is None  # not from itself
     assert J.retry_spec(P.spec("toeless", torque_limits="strength"), J.STRENGTH_RETRIES[3]).friction_max == 1.4
     assert J.retry_spec(P.spec("ellipsoid", torque_limits="strength"), J.STRENGTH_RETRIES[3]).friction_max is None
+
+
+def test_start_from_keeps_the_keys_and_puts_the_missing_toe_flat():
+    """``start_from`` (ours): absent from every existing key while unset, another jump only;
+    the toeless solution's states and controls carry over by name, the metatarsal ones at 0."""
+    from gaitlib.problems import jump as P
+
+    for n in P.SPECS:
+        assert "start_from" not in P.SPECS[n].to_dict()
+    st = P.spec("toe", torque_limits="strength")
+    assert P.cache_location(replace(st, start_from="toeless")) != P.cache_location(st)
+    with pytest.raises(ValueError, match="start_from"):
+        P.spec("toe", start_from="toe")
+    with pytest.raises(ValueError, match="start_from"):
+        P.spec("toe", start_from="heel")
+    toe = P.build(replace(st, n_intervals=3, continuation=())).problem
+    t = np.linspace(0.0, 1.0, 4)
+    phases = {ph.name: SimpleNamespace(
+        states=pd.DataFrame({c: 0.1 * (k + 1) + t for k, c in enumerate(ph.states)}, index=t),
+        controls=pd.DataFrame({c: -t for c in ph.controls}, index=t), t0=0.0, tf=1.0)
+        for ph in P.build(replace(P.spec("toeless"), n_intervals=3, continuation=())).problem.phases}
+    g = P.guess_across(SimpleNamespace(phases=phases), toe)
+    for ph in toe.phases:
+        pg = g.phases[ph.name]
+        assert list(pg.states.columns) == list(ph.states) and list(pg.controls.columns) == list(ph.controls)
+        for c in ph.states:
+            src = phases[ph.name].states
+            expect = src[c].to_numpy() if c in src else np.zeros(4)
+            assert np.array_equal(pg.states[c].to_numpy(), expect), c
+        assert (pg.states[[c for c in ph.states if c.endswith("mtp")]] == 0).all().all()
+    assert not g.parameters
+
+
+def test_stand_in_is_a_converged_valid_retry_of_the_same_problem():
+    """Of a failed jump's retries: only converged, valid ones without a friction cap the spec
+    lacks stand in; the lowest objective wins; none → no stand-in."""
+    def fake(obj, ok=True, cap=None):
+        return SimpleNamespace(success=ok, solution=SimpleNamespace(objective=obj),
+                               spec=SimpleNamespace(friction_max=cap))
+
+    own = {"toe": fake(0.0, ok=False)}
+    a, b, capped, failed = fake(20.0), fake(25.0), fake(5.0, cap=1.0), fake(1.0, ok=False)
+    retries = {"toe": {1: a, 2: b, 3: capped, 4: failed}}
+    assert J.strength_stand_ins(own, retries, lambda s: True) == {"toe": a}
+    assert J.strength_stand_ins(own, retries, lambda s: s is b) == {"toe": b}
+    assert J.strength_stand_ins(own, retries, lambda s: False) == {}

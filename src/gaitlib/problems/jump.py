@@ -116,6 +116,7 @@ __all__ = [
     "joint_bounds",
     "spec",
     "build",
+    "guess_across",
     "initial_guess",
     "solve",
     "meshes",
@@ -229,6 +230,12 @@ class JumpSpec:
         the ``"strength_peak"`` solution on the continuation's first (coarsest) mesh
         (solved, or reloaded from the cache): part of the procedure, recorded in
         ``solution.info["continuation"]``.
+    start_from : ``None`` (the mesh continuation above) or the name of another jump of
+        :data:`SPECS` (ours, a procedure): start the full mesh from that jump's solution with
+        this spec's ``torque_limits`` (reloaded from the cache, or solved) instead of the
+        continuation — its states and controls per phase, the coordinates it lacks (the
+        toeless jump has no metatarsal joint) at 0, the static parameters at their defaults.
+        Recorded in ``solution.info["continuation"]``.
     """
 
     name: str = "toe"
@@ -261,8 +268,11 @@ class JumpSpec:
     print_level: int = 0
     torque_limits: str = "table3.5"
     friction_max: float | None = None
+    start_from: str | None = None
 
     def __post_init__(self):
+        if self.start_from is not None and (self.start_from not in SPECS or self.start_from == self.name):
+            raise ValueError(f"start_from: another jump of {tuple(SPECS)}, got {self.start_from!r} for {self.name!r}")
         if self.torque_limits not in TORQUE_LIMITS:
             raise ValueError(f"torque_limits must be one of {TORQUE_LIMITS}, got {self.torque_limits!r}")
         if self.name not in THESIS:
@@ -295,13 +305,14 @@ class JumpSpec:
 
     def to_dict(self) -> dict:
         """The spec as a dict; ``torque_limits`` at its default (the thesis's bounds) and
-        ``friction_max`` while unset are left out, so the keys of the jumps stored before they
-        existed stay."""
+        ``friction_max`` and ``start_from`` while unset are left out, so the keys of the jumps
+        stored before they existed stay."""
         d = asdict(self)
         if d["torque_limits"] == "table3.5":
             d.pop("torque_limits")
-        if d["friction_max"] is None:
-            d.pop("friction_max")
+        for k in ("friction_max", "start_from"):
+            if d[k] is None:
+                d.pop(k)
         return d
 
 
@@ -881,7 +892,8 @@ class JumpSolution:
                 "n_constraints": s.info.get("n_constraints"),
                 "mesh": f"{self.spec.n_intervals} x {self.spec.degree} LGR per phase",
                 "continuation": " → ".join(
-                    f"{c['n_intervals']}{' (' + c['torque_limits'] + ')' if 'torque_limits' in c else ''}: "
+                    f"{'the ' + c['start_from'] + ' jump, ' if 'start_from' in c else ''}{c['n_intervals']}"
+                    f"{' (' + c['torque_limits'] + ')' if 'torque_limits' in c else ''}: "
                     f"{c['status']} ({c['iterations']} it, "
                     f"{c['solve_time']:.1f} s)" for c in s.info.get("continuation", [])) or "–",
                 "from_cache": self.from_cache}
@@ -1018,8 +1030,16 @@ def solve(sp: JumpSpec | str, guess: ocp.Guess | ocp.Solution | None = None, *,
 def _solve_continued(sp: JumpSpec, guess, root=None) -> ocp.Solution:
     """Solve ``sp`` from ``guess``, or, without one, through its mesh continuation
     (:attr:`JumpSpec.continuation`: each coarser mesh warm-starts the next)."""
-    record = []
-    steps = [n for n in sp.continuation if n < sp.n_intervals] if guess is None else []
+    record, start = [], None
+    steps = [n for n in sp.continuation if n < sp.n_intervals] if guess is None and sp.start_from is None else []
+    if sp.start_from is not None and guess is None:  # from another jump's solution (see JumpSpec)
+        src = solve(replace(SPECS[sp.start_from], torque_limits=sp.torque_limits), use_cache=True, root=root)
+        record.append({"start_from": sp.start_from, "n_intervals": src.spec.n_intervals,
+                       "torque_limits": sp.torque_limits, "status": src.status, "iterations": src.solution.iterations,
+                       "solve_time": src.solution.solve_time, "build_time": src.solution.build_time,
+                       "objective": src.solution.objective,
+                       **src.jump_height, "required_friction": src.required_friction})
+        start = src.solution
     if sp.torque_limits == "strength" and guess is None and steps:  # from the box-limited jump (see JumpSpec)
         pre = solve(replace(sp, torque_limits="strength_peak", n_intervals=steps[0], continuation=()),
                     use_cache=True, root=root)
@@ -1037,7 +1057,26 @@ def _solve_continued(sp: JumpSpec, guess, root=None) -> ocp.Solution:
                        "required_friction": coarse.required_friction})
         guess = c
     jp = build(sp)
+    if start is not None:
+        guess = guess_across(start, jp.problem)
     tx = ocp.transcribe(jp.problem, jp.mesh, jp.options)
     sol = tx.solve(jp.guess if guess is None else guess)
     sol.info["continuation"] = record
     return sol
+
+
+def guess_across(sol: ocp.Solution, problem: ocp.Problem) -> ocp.Guess:
+    """A guess for ``problem`` from a solution of another jump model (:attr:`JumpSpec.start_from`):
+    per phase of the same name, the states and controls both have, those ``sol`` lacks at 0
+    (for the toeless → toe-included model: the metatarsal angle, rate, torque and their
+    derivatives, i.e. the foot flat on its toe); names ``problem`` lacks are dropped; the
+    static parameters keep their defaults."""
+    phases = {}
+    for ph in problem.phases:
+        ps = sol.phases.get(ph.name)
+        if ps is None:
+            continue
+        st = ps.states.reindex(columns=list(ph.states), fill_value=0.0)
+        co = ps.controls.reindex(columns=list(ph.controls), fill_value=0.0)
+        phases[ph.name] = ocp.PhaseGuess(time=None, states=st, controls=co, t0=ps.t0, tf=ps.tf)
+    return ocp.Guess(phases=phases)

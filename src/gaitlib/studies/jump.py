@@ -20,7 +20,8 @@ __all__ = ["solve_all", "results_table", "stats_table", "plot_channels", "animat
            "JumpSpec", "JumpSolution", "joint_bounds", "spec", "solve", "build", "cache_location",
            "THESIS_HEIGHT_ORDER", "AT_BOUND", "torques_at_bound", "findings", "HUMAN_JUMP_RISE_M", "strength_specs",
            "solve_strength", "strength_use", "strength_table", "strength_findings",
-           "STRENGTH_RETRIES", "retry_spec", "strength_retries", "strength_retry_table", "strength_retry_findings"]
+           "STRENGTH_RETRIES", "PIVTOL", "retry_spec", "retry_label", "strength_stand_ins", "strength_retries",
+           "strength_retry_table", "strength_retry_findings"]
 
 
 def solve_all(names=("toeless", "toe", "ellipsoid"), use_cache: bool = False,
@@ -279,18 +280,26 @@ def strength_table(sols: dict[str, JumpSolution], gates: dict[str, str] | None =
     return pd.DataFrame(rows).T
 
 
-def strength_findings(sols: dict[str, JumpSolution], valid: dict[str, bool]) -> list[str]:
+def strength_findings(sols: dict[str, JumpSolution], valid: dict[str, bool],
+                      stand_ins: dict[str, JumpSolution] | None = None) -> list[str]:
     """The strength-limited jumps' sentences, computed: per jump convergence, validity and COM
     rise against :data:`HUMAN_JUMP_RISE_M`; the thesis's claims (toes raise the jump; the
     compliant contact raises it further and needs less friction) read on converged, valid
-    jumps only. ``valid``: name → whether the jump passes the validity gates."""
+    jumps only. ``valid``: name → whether the jump passes the validity gates. ``stand_ins``
+    (:func:`strength_stand_ins`): a jump whose own procedure did not converge is read through
+    its stand-in, and its sentence names the procedure."""
     lo, hi = HUMAN_JUMP_RISE_M
+    stand_ins = stand_ins or {}
     ok = {n: s for n, s in sols.items() if s.success and valid.get(n, False)}
+    ok.update(stand_ins)
     out = []
     for n, s in sols.items():
-        r = s.jump_height["com_rise_flight"]
-        state = ("converged, valid" if n in ok else
+        state = ("converged, valid" if s.success and valid.get(n, False) else
                  ("did NOT converge (" + s.status + ")") if not s.success else "converged, fails a validity gate")
+        if n in stand_ins:
+            s = stand_ins[n]
+            state += f" with its own procedure; with {retry_label(s)}: converged, valid"
+        r = s.jump_height["com_rise_flight"]
         out.append(f"**{s.spec.label}** ({state}): COM rise in flight {100 * r:.0f} cm — "
                    + ("inside" if lo <= r <= hi else "outside")
                    + f" the {100 * lo:.0f}–{100 * hi:.0f} cm of human standing jumps; take-off v_y "
@@ -316,29 +325,72 @@ def strength_findings(sols: dict[str, JumpSolution], valid: dict[str, bool]) -> 
 
 #: Other procedures tried for a strength-limited jump that did not converge with its own,
 #: as (mesh continuation :attr:`JumpSpec.continuation`, IPOPT iteration limit or None for the
-#: spec's, the welded foot's friction capped): no continuation (the full mesh from the
-#: box-limited start's guess); a 7-interval stage instead of the 5-interval one; the same with
-#: three times the iterations; the spec's own continuation with |F_x| ≤ μ F_y
-#: (:attr:`JumpSpec.friction_max`, μ the static friction Sec 3.4.3 calls satisfactory for
-#: that welded model, :data:`THESIS`) — whether the unbounded friction of a welded foot is
-#: what keeps IPOPT from converging; and that with three times the iterations.
-STRENGTH_RETRIES = (((), None, False), ((7,), None, False), ((7,), 15000, False), ((5,), None, True),
-                    ((5,), 15000, True))
+#: spec's, the welded foot's friction capped, the jump whose strength-limited solution starts
+#: the full mesh (:attr:`JumpSpec.start_from`) or None, further IPOPT options): no
+#: continuation (the full mesh from the box-limited start's guess); a 7-interval stage
+#: instead of the 5-interval one; the same with three times the iterations; the spec's own
+#: continuation with |F_x| ≤ μ F_y (:attr:`JumpSpec.friction_max`, μ the static friction
+#: Sec 3.4.3 calls satisfactory for that welded model, :data:`THESIS`) — whether the
+#: unbounded friction of a welded foot is what keeps IPOPT from converging; and that with
+#: three times the iterations. Then the linear algebra and the start, one change at a time:
+#: the spec's own procedure with MUMPS's pivot tolerance raised from IPOPT's 1e-6 to
+#: :data:`PIVTOL` (more stable pivoting, so a more reliable inertia of the KKT matrix); the
+#: full mesh started from the toeless jump's strength-limited solution (metatarsal joint at
+#: 0: the foot flat on its toe); that start with the raised pivot tolerance; and that with
+#: the friction cap.
+PIVTOL = (("mumps_pivtol", 1e-2),)
+STRENGTH_RETRIES = (((), None, False, None, ()), ((7,), None, False, None, ()), ((7,), 15000, False, None, ()),
+                    ((5,), None, True, None, ()), ((5,), 15000, True, None, ()),
+                    ((5,), None, False, None, PIVTOL), ((), None, False, "toeless", ()),
+                    ((), None, False, "toeless", PIVTOL), ((), None, True, "toeless", PIVTOL))
 
 
-def retry_spec(sp: JumpSpec, retry: tuple) -> JumpSpec:
-    """``sp`` with one procedure of :data:`STRENGTH_RETRIES`."""
-    c, it, cap = retry
+def retry_spec(sp: JumpSpec, retry: tuple) -> JumpSpec | None:
+    """``sp`` with one procedure of :data:`STRENGTH_RETRIES`; None when the procedure would
+    start ``sp`` from its own model's solution."""
+    c, it, cap, start, ipopt = retry
+    if start == sp.name:
+        return None
     return replace(sp, continuation=c, **({} if it is None else {"max_iter": it}),
-                   **({"friction_max": THESIS[sp.name]["mu_s"]} if cap and sp.contact == "kinematic" else {}))
+                   **({"friction_max": THESIS[sp.name]["mu_s"]} if cap and sp.contact == "kinematic" else {}),
+                   **({"start_from": start} if start else {}), **({"ipopt": sp.ipopt + ipopt} if ipopt else {}))
 
 
 def strength_retries(sols: dict[str, JumpSolution], use_cache: bool = True) -> dict[str, dict[tuple, JumpSolution]]:
     """For every strength-limited jump in ``sols`` that did not converge: name → {procedure of
     :data:`STRENGTH_RETRIES`: the same spec solved with it} — whether the failure is the
     procedure's or the problem's. Cached like every jump."""
-    return {n: {r: solve(retry_spec(s.spec, r), use_cache=use_cache) for r in STRENGTH_RETRIES}
+    return {n: {r: solve(retry_spec(s.spec, r), use_cache=use_cache) for r in STRENGTH_RETRIES
+                if retry_spec(s.spec, r) is not None}
             for n, s in sols.items() if not s.success}
+
+
+def strength_stand_ins(sols: dict[str, JumpSolution], retries: dict, valid: dict[str, bool]) -> dict[str, JumpSolution]:
+    """Name → the stand-in of each strength-limited jump of ``sols`` that did not converge:
+    of its :func:`strength_retries` that solve the same problem (a different procedure, not
+    the friction cap) and converged and pass the validity gates (``valid``: solution → bool),
+    the one with the lowest objective — the result its claims are read on, named wherever it
+    is used (:func:`retry_label`)."""
+    out = {}
+    for n, per in retries.items():
+        ok = [s for s in per.values() if s.success and s.spec.friction_max == sols[n].spec.friction_max and valid(s)]
+        if ok:
+            out[n] = min(ok, key=lambda x: x.solution.objective)
+    return out
+
+
+def retry_label(s: JumpSolution, own: bool = False) -> str:
+    """The procedure of a strength-limited jump in words (continuation or start, friction cap,
+    iteration limit, IPOPT options)."""
+    sp = s.spec
+    c = sp.continuation
+    if sp.start_from is not None:
+        t = f"the full mesh started from the {LABELS[sp.start_from]} jump's solution (same torque limits)"
+    else:
+        t = f"a {', '.join(map(str, c))}-interval continuation stage" if c else "no continuation"
+    t += f", |F_x| ≤ {sp.friction_max:g} F_y" if sp.friction_max is not None else ""
+    t += "".join(f", {k} {v:g}" for k, v in sp.ipopt)
+    return t + (" (the spec's own)" if own else f", limit {sp.max_iter} iterations")
 
 
 def strength_retry_table(sols: dict[str, JumpSolution], retries: dict) -> pd.DataFrame:
@@ -348,8 +400,11 @@ def strength_retry_table(sols: dict[str, JumpSolution], retries: dict) -> pd.Dat
     for n, per in retries.items():
         for _, s in {"own": sols[n], **per}.items():
             c = s.spec.continuation
-            rows.append({"jump": s.spec.label, "continuation (intervals)": ", ".join(map(str, c)) or "none",
+            rows.append({"jump": s.spec.label,
+                         "start": (f"{s.spec.start_from} solution" if s.spec.start_from else
+                                   ", ".join(map(str, c)) + "-interval stage" if c else "full mesh"),
                          "iteration limit": s.spec.max_iter, "friction cap μ": s.spec.friction_max,
+                         "IPOPT options": ", ".join(f"{k} {v:g}" for k, v in s.spec.ipopt),
                          "IPOPT status": s.status, "iterations": s.stats["iterations"], "objective": s.solution.objective,
                          "max violation": s.solution.max_violation, "worst constraint": s.solution.worst_constraint,
                          "COM rise in flight (cm)": 100 * s.jump_height["com_rise_flight"],
@@ -361,12 +416,7 @@ def strength_retry_findings(sols: dict[str, JumpSolution], retries: dict) -> lis
     """One sentence per jump of :func:`strength_retries`: the status of each procedure and,
     where one ended at a feasible point (largest violation ≤ 1e-6) without converging, its
     COM rise and required friction."""
-    def lab(s, own=False):
-        c = s.spec.continuation
-        t = f"a {', '.join(map(str, c))}-interval continuation stage" if c else "no continuation"
-        t += f", |F_x| ≤ {s.spec.friction_max:g} F_y" if s.spec.friction_max is not None else ""
-        return t + (" (the spec's own)" if own else f", limit {s.spec.max_iter} iterations")
-
+    lab = retry_label
     out = []
     for n, per in retries.items():
         runs = {"own": sols[n], **per}
@@ -375,9 +425,10 @@ def strength_retry_findings(sols: dict[str, JumpSolution], retries: dict) -> lis
         line = f"**{sols[n].spec.label}** — " + "; ".join(parts) + "."
         conv = [s for s in per.values() if s.success]
         if conv:
-            s = min(conv, key=lambda x: x.solution.objective)
-            line += (f" Converged with {lab(s)}: COM rise {100 * s.jump_height['com_rise_flight']:.0f} cm, required "
-                     f"μ_s {s.required_friction:.1f}.")
+            line += " Converged: " + "; ".join(
+                f"with {lab(s)}, COM rise {100 * s.jump_height['com_rise_flight']:.0f} cm, take-off v_y "
+                f"{s.jump_height['takeoff_vy']:.2f} m/s, required μ_s {s.required_friction:.1f} (objective "
+                f"{s.solution.objective:.2f})" for s in sorted(conv, key=lambda x: x.solution.objective)) + "."
         elif feas:
             s = min(feas, key=lambda x: x.solution.objective)
             line += (f" With {lab(s)} it stopped at a feasible point (largest "
