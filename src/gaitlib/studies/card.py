@@ -514,12 +514,24 @@ def _ch5(bases: dict) -> list[Row]:
     valid = gate(s, "NMSK") if s is not None else ""
     ap = s.stats.get("activation_parameters", {}) if s is not None else {}
 
+    syn = msk.synergy_cost_table(s) if ap else None
     for k, tv in msk.THESIS_TABLE_5_10["identified"].items():
         ours = ap.get(k, np.nan)
         cause = "unknown"
         lo, hi = activation.ACTIVATION_BOUNDS[k]
         if np.isfinite(ours) and min(abs(ours - lo), abs(ours - hi)) <= 1e-3 * (hi - lo):
-            cause = (f"at its bound {lo if abs(ours - lo) < abs(ours - hi) else hi:g} (bounds {lo:g}–{hi:g}) "
+            why = "Eq 5.55 has no term comparing excitations with EMG, so only the effort terms move γ"
+            if k in ("s1", "s2") and syn is not None:
+                c = syn["Act cost / A²"]
+                # at (0.5, 0.5) both partial derivatives of |w|² are +1 with s1, s2 at their upper
+                # bounds: a local minimum of 1/|w|² on the box (a KKT point); (0, 0) is the global one
+                why += (f"; the least Act cost per squared ankle-extensor activation (1/|w|², Eq 5.54) is "
+                        f"{c['ours']:.2f} at ours, {c['initial (Table 5.10)']:.2f} at Table 5.10's initial guess (a "
+                        f"stationary point, the largest), {c['thesis, Table 5.10']:.2f} at the thesis's values and "
+                        f"{c['corner (0, 0): GAM only']:.2f} with GAM only"
+                        + ("; ours, GAM weight 0, is a local minimum on the bounds"
+                           if all(abs(ap[x] - 0.5) <= 1e-3 for x in ("s1", "s2")) else ""))
+            cause = (f"at its bound {lo if abs(ours - lo) < abs(ours - hi) else hi:g} (bounds {lo:g}–{hi:g}): {why} "
                      f"[{_anchor('ch05_msk', 'Table 5.10: activation parameters')}]")
         rows.append(Row(5, f"NMSK identified {k} (Table 5.10)", tv, ours, "s" if k == "tau_act" else "1", cause,
                         s.name if s is not None else "", valid))
