@@ -247,7 +247,9 @@ for r in (c, cw):
 # tracking weight of Eq 4.13 from Table 4.8's ¼ to 1, the Jrk denominators of the HAT as
 # printed (1), the swinging foot unbounded as printed, the 40 × 5 mesh, and the left leg
 # tracked as the right leg's samples shifted (below); then the GRF weight raised further
-# (×16, ×64; `ci.C_GRF_SCAN`) and ×16 with the shifted left leg. Rows that track the shifted
+# (×16, ×64; `ci.C_GRF_SCAN`) and ×16 and ×32 with the shifted left leg (`ci.C_GRF_LEFT`).
+# These rows are ours (ablations); the book's (c) keeps Table 4.8's weights and Eqs 4.1–4.3's
+# left leg. Rows that track the shifted
 # left leg are scored against it. The last column
 # is the floor each run's own kinematics put under its vertical error (the total-force
 # mismatch above). A run that did not converge or fails a gate supplies no number to the
