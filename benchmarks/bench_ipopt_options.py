@@ -4,6 +4,7 @@
     .venv/bin/python benchmarks/bench_ipopt_options.py            # MSK DT Free 20 × 5, ≈ 10 min
     .venv/bin/python benchmarks/bench_ipopt_options.py --quick    # 4 × 3 mesh (checks the script)
     .venv/bin/python benchmarks/bench_ipopt_options.py --model NMSK --only default "bound_push/frac 1e-6" "mu_init 1e-2"
+    .venv/bin/python benchmarks/bench_ipopt_options.py --only default "mumps_pivtol 1e-4" "mumps_pivtol 1e-2" --stem ipopt_options_mumps
 
 The problem of ``gaitlib run gait --model MSK --cost DT --speed Free`` (the book's Ch 5 MSK
 data-tracking solve's spec, from its data-based guess), built once on the per-node path with
@@ -51,6 +52,8 @@ VARIANTS = (
     ("δ_c always 1e-8", {"perturb_always_cd": "yes", "jacobian_regularization_value": 1e-8}),
     ("curvature test (no inertia)", {"neg_curv_test_tol": 1e-12}),
     ("mu_oracle loqo, adaptive", {"mu_strategy": "adaptive", "mu_oracle": "loqo"}),
+    ("mumps_pivtol 1e-4", {"mumps_pivtol": 1e-4}),
+    ("mumps_pivtol 1e-2", {"mumps_pivtol": 1e-2}),
 )
 
 _ITER = re.compile(r"^\s*(\d+)(r?)\s+(-?\d\.\d+e[+-]\d+)\s+\S+\s+\S+\s+\S+\s+\S+\s+(\S+)\s+\S+\s+\S+")
@@ -79,6 +82,8 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--only", nargs="*", help="variant names (default: all)")
     ap.add_argument("--model", default="MSK", choices=["SK", "MSK", "NMSK"], help="gait model (default MSK)")
+    ap.add_argument("--stem", help="results file stem (default ipopt_options[_model][_quick]): a subset of "
+                                   "variants written beside the full run instead of over it")
     args = ap.parse_args(argv)
     from gaitlib import conventions as cv, ocp
     from gaitlib.problems import gait as gait_ocp
@@ -143,7 +148,8 @@ def _write(args, spec, build_s, rows):
     md += md_table(["variant", "options", "status", "iterations", "solve_s", "ms_per_iteration", "objective",
                     "max_violation", "inertia_corrections", "median_lg_dw", "max_lg_dw", "restoration_iterations",
                     "rms_vs_default_deg", "load_at_start"], rows)
-    stem = "ipopt_options" + ("" if args.model == "MSK" else f"_{args.model.lower()}") + ("_quick" if args.quick else "")
+    stem = args.stem or ("ipopt_options" + ("" if args.model == "MSK" else f"_{args.model.lower()}")
+                         + ("_quick" if args.quick else ""))
     write_report(OUT, stem, doc, md)
 
 
