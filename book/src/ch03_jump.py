@@ -375,10 +375,16 @@ strong_stand_ins = jump.strength_stand_ins(strong, strong_retries, lambda s: val
 display(Markdown("\n\n".join(jump.strength_findings(strong, {n: validity.check(s).passed for n, s in strong.items()},
                                                       strong_stand_ins))))
 
+# %% [markdown]
+# The strength-limited jumps' torques; a jump whose own procedure did not converge is shown
+# through its stand-in, named in its column's title.
+
 # %%
-fig = jump.plot_channels(strong, "torques")
+shown = {**strong, **strong_stand_ins}
+fig = jump.plot_channels(shown, "torques", titles={n: f"{strong[n].spec.label}\n(its stand-in, above)"
+                                                   for n in strong_stand_ins})
 for k, ax in enumerate(fig.axes):
-    marks.mark_axes(ax, marks.failure_label(list(strong.values())[k % len(strong)]))
+    marks.mark_axes(ax, marks.failure_label(list(shown.values())[k % len(shown)]))
 plt.show()
 
 # %% [markdown]

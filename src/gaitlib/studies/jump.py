@@ -86,12 +86,13 @@ DISPLAY = {
 PHASE_COLORS = {"crouch": "tab:blue", "thrust": "tab:orange", "flight": "tab:green"}
 
 
-def plot_channels(sols: dict[str, JumpSolution], kind: str, figsize_per=(3.4, 2.0)):
+def plot_channels(sols: dict[str, JumpSolution], kind: str, figsize_per=(3.4, 2.0), titles: dict | None = None):
     """One figure in the layout of thesis Figs 3.3–3.8: one column per jump, one row per
     channel of ``kind`` (a key of :data:`FIGURES`), each phase in its colour
     (:data:`PHASE_COLORS`; the kinematic models' crouch + thrust are the thesis's
     preflight phase), the body weight as a dashed line on F_y. A failed solve's column is
-    titled "FAILED: <IPOPT status>" in red. Degrees and cm appear only here."""
+    titled "FAILED: <IPOPT status>" in red. ``titles``: name → column title in place of the
+    jump's label (e.g. a stand-in named as such). Degrees and cm appear only here."""
     import matplotlib.pyplot as plt
 
     channels, title = FIGURES[kind]
@@ -119,7 +120,8 @@ def plot_channels(sols: dict[str, JumpSolution], kind: str, figsize_per=(3.4, 2.
             ax.tick_params(labelsize=7)
             if i == 0:
                 ok = s.success
-                ax.set_title(s.spec.label + ("" if ok else f"\nFAILED: {s.status}"), fontsize=8.5,
+                ax.set_title((titles or {}).get(name, s.spec.label) + ("" if ok else f"\nFAILED: {s.status}"),
+                             fontsize=8.5,
                              color="k" if ok else "tab:red")
         axes[-1, jcol].set_xlabel("time (s)", fontsize=8)
     handles, labels = [], []
