@@ -67,6 +67,7 @@ __all__ = [
     "Goal",
     "Guess",
     "Linkage",
+    "MUMPS_MEM_PERCENT",
     "Named",
     "Parameter",
     "Periodic",
@@ -403,6 +404,11 @@ def _default_compiled() -> bool:
     return os.environ.get(COMPILE_ENV, "0") not in ("", "0")
 
 
+#: MUMPS's working space above its own estimate, % (IPOPT's default 1000: ten times the
+#: estimate, allocated and released at every factorisation; see :class:`SolverOptions`).
+MUMPS_MEM_PERCENT = 100
+
+
 @dataclass(frozen=True)
 class SolverOptions:
     """How to solve: IPOPT settings and NLP graph type (separate from the problem).
@@ -450,6 +456,12 @@ class SolverOptions:
     ipopt : mapping
         Further IPOPT options, applied last (e.g. ``{"nlp_scaling_method": "none"}``).
 
+    With MUMPS, ``mumps_mem_percent`` is :data:`MUMPS_MEM_PERCENT` instead of IPOPT's 1000:
+    MUMPS's working space, allocated at every factorisation, is its estimate plus this
+    percentage (IPOPT enlarges it and factorises again should MUMPS report too little). It
+    changes the time, not the result: the same pivots and numbers, so IPOPT's path is the
+    same to the last bit (benchmarks/README.md, "MUMPS's working space").
+
     Fixed for determinism: ``mu_strategy="monotone"`` (IPOPT's default; "adaptive" was 3×
     slower here), no timing-dependent options. Use one BLAS thread
     (``OPENBLAS_NUM_THREADS=1``) — with more, IPOPT took a different path on 2 cores.
@@ -487,6 +499,8 @@ class SolverOptions:
             "mu_strategy": "monotone",
             "sb": "yes",
         }
+        if self.linear_solver == "mumps":
+            ipopt["mumps_mem_percent"] = MUMPS_MEM_PERCENT
         ipopt.update(dict(self.ipopt))
         opts = {"ipopt": ipopt, "print_time": False, "error_on_fail": False}
         if self.graph == "mx":
