@@ -15,7 +15,7 @@ import pandas as pd
 import pytest
 from scipy.integrate import solve_ivp
 
-from gaitlib.collocation import Mesh, differentiation_matrix, lgr_points, lgr_scheme, lgr_weights
+from gaitlib.collocation import Mesh, differentiation_matrix, integral_form, lgr_points, lgr_scheme, lgr_weights
 from gaitlib.ocp import (
     EndpointConstraint,
     Goal,
@@ -402,3 +402,52 @@ def test_interpolate_and_stats():
     assert sol.iterations >= 1 and sol.solve_time > 0 and sol.build_time > 0
     assert sol.time_per_iteration == pytest.approx(sol.solve_time / sol.iterations)
     assert sol.info["n_variables"] == 2 * 31 + 30
+
+
+# ======================================================================================
+# Defects in integral form: the same equations, x_j − x_0 = ∫ f over [τ_0, τ_j]
+# ======================================================================================
+@pytest.mark.parametrize("scheme,kw", [("lgr", dict(degree=3)), ("lgr", dict(degree=5)),
+                                       ("lgr", dict(degree=4, lgr_side="right")), ("trapezoidal", {}),
+                                       ("hermite-simpson", {})])
+def test_integral_form_integrates_the_interpolant_exactly(scheme, kw):
+    """Row j of the integral form is x(τ_j) − x(0) − Σ_l M_jl x'(τ_l): zero for every state
+    polynomial the scheme represents exactly (LGR d points: degree ≤ d; trapezoidal: 1;
+    Hermite–Simpson: 3), checked against the polynomial's own values."""
+    sch = Mesh(1, scheme, **kw).interval
+    Ai, M = integral_form(sch)
+    n = sch.m
+    assert np.array_equal(Ai, np.hstack([-np.ones((n, 1)), np.eye(n)]))
+    np.testing.assert_allclose(np.linalg.solve(sch.A[:, 1:], sch.A), Ai, atol=1e-12)
+    deg = {"lgr": kw.get("degree", 5), "trapezoidal": 1, "hermite-simpson": 3}[scheme]
+    rng = np.random.default_rng(deg)
+    for _ in range(3):
+        p = np.polynomial.Polynomial(rng.normal(size=deg + 1))
+        x, dx = p(sch.nodes), p.deriv()(sch.nodes[sch.colloc])
+        np.testing.assert_allclose(x[1:] - x[0], M @ dx, atol=1e-11)
+
+
+def test_integral_defects_are_the_differential_ones_mapped_interval_by_interval():
+    rng = np.random.default_rng(1)
+    for kw in (dict(scheme="lgr", degree=5), dict(scheme="hermite-simpson")):
+        diff, integ = Mesh(3, **kw), Mesh(3, defect_form="integral", **kw)
+        X = rng.normal(size=(2, diff.n_state_nodes))
+        F = rng.normal(size=(2, diff.n_colloc_nodes))
+        d0 = np.asarray(diff.defects(ca.DM(X), ca.DM(F), 0.7))
+        d1 = np.asarray(integ.defects(ca.DM(X), ca.DM(F), 0.7))
+        nd = diff.interval.n_defects
+        Ahat = diff.interval.A[:, 1:]
+        for i in range(3):
+            blk = slice(i * nd, (i + 1) * nd)
+            np.testing.assert_allclose(d1[:, blk], np.linalg.solve(Ahat, d0[:, blk].T).T, atol=1e-12)
+    assert "integral defects" in Mesh(20, defect_form="integral").describe()
+    with pytest.raises(ValueError, match="defect_form"):
+        Mesh(4, defect_form="spectral")
+
+
+@pytest.mark.parametrize("mesh", [Mesh(8, "lgr", 4, defect_form="integral"),
+                                  Mesh(40, "hermite-simpson", defect_form="integral")],
+                         ids=lambda m: m.describe())
+def test_double_integrator_integral_form(mesh):
+    sol = solve(Problem(double_integrator()), mesh, SolverOptions())
+    assert sol.success and sol.objective == pytest.approx(12.0, abs=1e-8)

@@ -59,9 +59,12 @@ import casadi as ca
 import numpy as np
 
 SCHEMES = ("lgr", "trapezoidal", "hermite-simpson")
+DEFECT_FORMS = ("differential", "integral")
 
 __all__ = [
     "SCHEMES",
+    "DEFECT_FORMS",
+    "integral_form",
     "Mesh",
     "Scheme",
     "differentiation_matrix",
@@ -225,6 +228,21 @@ def make_scheme(name: str, degree: int = 5, lgr_side: str = "left") -> Scheme:
     raise ValueError(f"unknown scheme {name!r}; choose from {SCHEMES}")
 
 
+def integral_form(sch: Scheme) -> tuple[np.ndarray, np.ndarray]:
+    """The scheme's defects in integral form: (Â⁻¹A, Â⁻¹B) with Â = A[:, 1:].
+
+    Since A·1 = 0 (a constant state has no defect), Â⁻¹A = [−1 | I] exactly; it is returned
+    as such, so each row reads x_j − x_0 − h Σ_l (Â⁻¹B)_{jl} f_l with unit coefficients."""
+    A, B = np.asarray(sch.A, float), np.asarray(sch.B, float)
+    Ahat = A[:, 1:]
+    if Ahat.shape[0] != Ahat.shape[1]:
+        raise ValueError(f"{sch.name}: the integral form needs as many defects as later nodes")
+    if not np.allclose(np.linalg.solve(Ahat, A[:, 0]), -1.0, atol=1e-10):
+        raise ValueError(f"{sch.name}: A·1 = 0 expected")
+    Ai = np.hstack([-np.ones((Ahat.shape[0], 1)), np.eye(Ahat.shape[0])])
+    return Ai, np.linalg.solve(Ahat, B)
+
+
 # --------------------------------------------------------------------------------------
 # Mesh
 # --------------------------------------------------------------------------------------
@@ -246,6 +264,12 @@ class Mesh:
     hs_control_midpoints : {"interpolate", "free"}
         Hermite–Simpson only: constrain midpoint controls to the mean of the ends
         (Moco's default) or leave them free.
+    defect_form : {"differential", "integral"}
+        How each interval's defects are written. ``"differential"`` (default): X Aᵀ − h F Bᵀ
+        with the scheme's A and B. ``"integral"``: the same equations multiplied by Â⁻¹, Â
+        being A without its first column (invertible for every scheme here; A·1 = 0), i.e.
+        x_j − x_0 − h Σ_l (Â⁻¹B)_{jl} f_l = 0 for each later node j of the interval: the
+        same feasible set, another scaling of the rows (GPOPS-II offers both forms).
 
     Examples
     --------
@@ -260,6 +284,7 @@ class Mesh:
     fractions: tuple[float, ...] | None = None
     lgr_side: str = "left"
     hs_control_midpoints: str = "interpolate"
+    defect_form: str = "differential"
 
     def __post_init__(self):
         if self.n_intervals < 1:
@@ -268,6 +293,8 @@ class Mesh:
             raise ValueError(f"unknown scheme {self.scheme!r}; choose from {SCHEMES}")
         if self.hs_control_midpoints not in ("interpolate", "free"):
             raise ValueError("hs_control_midpoints must be 'interpolate' or 'free'")
+        if self.defect_form not in DEFECT_FORMS:
+            raise ValueError(f"defect_form must be one of {DEFECT_FORMS}, got {self.defect_form!r}")
         if self.fractions is not None:
             f = np.asarray(self.fractions, dtype=float)
             if f.shape != (self.n_intervals,) or np.any(f <= 0):
@@ -353,12 +380,15 @@ class Mesh:
         """
         sch = self.interval
         nd = sch.n_defects
+        Ai, Bi = sch.A, sch.B
+        if self.defect_form == "integral":
+            Ai, Bi = integral_form(sch)
         A = np.zeros((self.n_intervals * nd, self.n_state_nodes))
         B = np.zeros((self.n_intervals * nd, self.n_colloc_nodes))
         for i in range(self.n_intervals):
             rows = slice(i * nd, (i + 1) * nd)
-            A[rows, self.state_index[i]] += sch.A
-            B[rows, self.colloc_index[i]] += self.widths[i] * sch.B
+            A[rows, self.state_index[i]] += Ai
+            B[rows, self.colloc_index[i]] += self.widths[i] * Bi
         return A, B
 
     @cached_property
@@ -411,6 +441,8 @@ class Mesh:
 
     def describe(self) -> str:
         extra = f", d={self.degree}, {self.lgr_side}" if self.scheme == "lgr" else ""
+        if self.defect_form != "differential":
+            extra += f", {self.defect_form} defects"
         return (
             f"{self.scheme}{extra}: {self.n_intervals} intervals, "
             f"{self.n_state_nodes} state nodes, {self.n_colloc_nodes} collocation nodes"

@@ -229,7 +229,7 @@ for _name, _w in _T62_NMSK.items():
 #: Spec options that are left out of :meth:`GaitSpec.to_dict` (hence of every cache key)
 #: while unset: added after the store was written, they must not change existing keys.
 KEY_STABLE_OPTIONS = ("swing_load_max", "derivatives", "jerk_ranges", "track_mtp", "activation_params",
-                      "fourier_order")
+                      "fourier_order", "defects")
 #: The Fourier order of the left leg generated from the right (thesis Eqs 4.1–4.3: 5).
 FOURIER_ORDER = 5
 #: The highest order a cycle of the data's 51 samples (50 distinct) carries: the left leg is
@@ -338,6 +338,10 @@ class GaitSpec:
         unloading and ring below zero in swing; an ablation of the Fidelity II study
         (:func:`gaitlib.studies.contact_id.c_changes`). Not with ``effects`` (the effects
         assume the thesis's generation).
+    defects : ``None`` (the differential form, X Aᵀ − h F Bᵀ, as GPOPS-II by default) or
+        ``"integral"``: the same defects multiplied by the inverse of their end columns
+        (:func:`gaitlib.collocation.integral_form`) — the same problem, other row scaling,
+        another path for IPOPT (``benchmarks/bench_fatrop.py``, ``bench_ipopt_options.py``).
     """
 
     model: str = "SK"
@@ -373,6 +377,7 @@ class GaitSpec:
     track_mtp: bool | None = None
     activation_params: str | None = None
     fourier_order: int | None = None
+    defects: str | None = None
 
     def __post_init__(self):
         if self.fourier_order is not None:
@@ -1164,7 +1169,7 @@ def build(spec: GaitSpec) -> GaitProblem:
         periodic=periodic, data=data_frame,
     )
     problem = Problem(phases=(phase,), parameters=tuple(params), name=f"gait_{spec.model}_{spec.cost}".replace(".", ""))
-    mesh = Mesh(spec.n_intervals, spec.scheme, spec.degree)
+    mesh = Mesh(spec.n_intervals, spec.scheme, spec.degree, defect_form=spec.defects or "differential")
     options = SolverOptions(tol=spec.tol, max_iter=spec.max_iter, hessian=spec.hessian,
                             **({"derivatives": spec.derivatives} if spec.derivatives else {}))
     return GaitProblem(spec, model, ref, problem, mesh, options, guess, p_body, p_contact, t_stim,
