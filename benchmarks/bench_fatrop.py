@@ -28,9 +28,10 @@ rewritten into that form here, from the same symbols, data and bounds
   equivalent set of equations (a non-singular linear map of each interval's defects): the
   same feasible set and optimum, another scaling of the rows.
 
-Three solves per problem, the same initial point and data, IPOPT with gaitlib's options:
-``ipopt``: gaitlib's own NLP (what the book solves); ``ipopt (stage-wise)``: the rewritten
-NLP; ``fatrop``: the rewritten NLP, FATROP with the same tolerance and iteration limit. Each
+Four solves per problem, the same initial point and data, IPOPT with gaitlib's options:
+``ipopt``: gaitlib's own NLP (what the book solves); ``ipopt (integral form)``: gaitlib's
+NLP with ``Mesh(defect_form="integral")`` (the rewrite's rows, without the copy of x(0));
+``ipopt (stage-wise)``: the rewritten NLP; ``fatrop``: the rewritten NLP, FATROP with the same tolerance and iteration limit. Each
 reports status, iterations, solve wall time, time per iteration, objective (of the one
 objective expression, so comparable) and the largest constraint violation of gaitlib's own
 constraints at the returned point. Writes ``benchmarks/results/fatrop.json`` and ``.md``.
@@ -54,6 +55,7 @@ import casadi as ca  # noqa: E402
 import numpy as np  # noqa: E402
 
 from gaitlib import ocp  # noqa: E402
+from gaitlib.collocation import integral_form  # noqa: E402
 from gaitlib.problems import gait as gait_ocp  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "results"
@@ -78,11 +80,8 @@ def stagewise(tr: ocp.Transcription):
         raise NotImplementedError("stage-wise rewrite: LGR collocation with the left convention only")
     sch = mesh.interval
     nx, nu, N = lay.nx, lay.nu, mesh.n_intervals
-    A, B = np.asarray(sch.A, float), np.asarray(sch.B, float)
-    m = A.shape[1] - 1  # state nodes per interval minus one
-    Ahat = A[:, 1:]
-    M = np.linalg.solve(Ahat, B)  # X_{k,1..m} = X_{k,0} + h·dur·F Mᵀ
-    assert np.allclose(-np.linalg.solve(Ahat, A[:, 0]), 1.0), "A·1 = 0 expected"
+    _, M = integral_form(sch)  # X_{k,1..m} = X_{k,0} + h·dur·F Mᵀ
+    m = M.shape[0]  # state nodes per interval minus one
     for i in range(N):  # each interval: state nodes i*m .. i*m+m, collocation nodes i*m .. i*m+m-1
         assert list(mesh.state_index[i]) == list(range(i * m, i * m + m + 1))
         assert list(mesh.colloc_index[i]) == list(range(i * m, i * m + m))
@@ -214,6 +213,16 @@ def run_one(model: str, n_intervals: int, max_iter: int, fatrop_max_iter: int | 
     record("ipopt", st["return_status"], st["iter_count"], time.perf_counter() - t, build_ipopt,
            np.asarray(r["x"]).ravel(), r["f"], {"n_variables": tr.n_variables, "n_constraints": tr.n_constraints})
 
+    # gaitlib's own NLP with the defects in integral form (the rewrite's rows, without its copy of x(0))
+    t = time.perf_counter()
+    tri = ocp.transcribe(gp.problem, replace(gp.mesh, defect_form="integral"), opts)
+    b = time.perf_counter() - t
+    t = time.perf_counter()
+    r = tri.solver(x0=w0, lbx=tri.lbw, ubx=tri.ubw, lbg=tri.lbg, ubg=tri.ubg, p=pvec)
+    st = tri.solver.stats()
+    record("ipopt (integral form)", st["return_status"], st["iter_count"], time.perf_counter() - t, b,
+           np.asarray(r["x"]).ravel(), r["f"], {"n_variables": tri.n_variables, "n_constraints": tri.n_constraints})
+
     t = time.perf_counter()
     nlp, perm_w, lbx, ubx, lbg, ubg, dims, x_of_w = stagewise(tr)
     rewrite_s = time.perf_counter() - t
@@ -251,8 +260,12 @@ def run_one(model: str, n_intervals: int, max_iter: int, fatrop_max_iter: int | 
     r = fs(x0=x0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg, p=pvec)
     solve_s = time.perf_counter() - t
     st = fs.stats()
-    record("fatrop", st.get("return_status", "?"), st.get("iter_count", 0), solve_s, b, back(r["x"]), r["f"],
-           {**extra_dims, "fatrop_time_total": st.get("fatrop", {}).get("time_total"),
+    it = int(st.get("iter_count", 0))
+    limit = fopts["fatrop"]["max_iter"]
+    status = ("Solve_Succeeded" if st.get("success") else
+              "Maximum_Iterations_Exceeded" if it >= limit else f"failed (FATROP return flag {st.get('return_status')})")
+    record("fatrop", status, it, solve_s, b, back(r["x"]), r["f"],
+           {**extra_dims, "max_iter": limit, "fatrop_time_total": st.get("fatrop", {}).get("time_total"),
             "fatrop_compute_sd_time": st.get("fatrop", {}).get("compute_sd_time")})
     return rows
 
@@ -264,22 +277,28 @@ def main(argv=None):
     ap.add_argument("--max-iter", type=int, default=1000)
     ap.add_argument("--fatrop-max-iter", type=int, default=None,
                     help="FATROP's iteration limit (default --max-iter): its time per iteration is the floor")
+    ap.add_argument("--fatrop-log", action="store_true", help="print FATROP's iteration log (stdout)")
     ap.add_argument("--quick", action="store_true", help="SK on 4 intervals (checks the script)")
     args = ap.parse_args(argv)
+    global PRINT_LEVEL
+    PRINT_LEVEL = 5 if args.fatrop_log else 0
     if args.quick:
         args.models, args.intervals, args.fatrop_max_iter = ["SK"], 4, 5
+    started = datetime.now(timezone.utc).isoformat(timespec="seconds")
+    load_start = list(os.getloadavg())
     rows = []
     for mdl in args.models:
         rows += run_one(mdl, args.intervals, args.max_iter, args.fatrop_max_iter)
     if args.quick:
         return rows
-    meta = {"date": datetime.now(timezone.utc).isoformat(timespec="seconds"), "platform": platform.platform(),
-            "cpu": _cpu(), "casadi": ca.__version__, "python": sys.version.split()[0],
+    meta = {"measured": started, "machine": {"cpu": _cpu(), "cores": os.cpu_count(), "platform": platform.platform()},
+            "load_average_start": load_start, "casadi": ca.__version__, "python": sys.version.split()[0],
             "command": "python benchmarks/bench_fatrop.py " + " ".join(argv if argv is not None else sys.argv[1:])}
     (OUT / "fatrop.json").write_text(json.dumps({"meta": meta, "rows": rows}, indent=1, default=str) + "\n")
     cols = ["model", "cost", "mesh", "solver", "status", "iterations", "build_s", "solve_s", "ms_per_iteration",
             "objective", "max_violation", "n_variables", "n_constraints"]
-    lines = [f"# FATROP vs IPOPT + MUMPS on the natural-gait problems ({meta['date']}, {meta['cpu']})", "",
+    lines = [f"# FATROP vs IPOPT + MUMPS on the natural-gait problems ({started}, {_cpu()}; load average "
+             f"at start {load_start[0]:.2f})", "",
              f"`{meta['command']}`; casadi {meta['casadi']}, one BLAS thread. Method: the module docstring of "
              "`benchmarks/bench_fatrop.py`.", "",
              "| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]

@@ -185,3 +185,25 @@ def test_mumps_orderings_parses_mumps_analysis_reports():
     assert a[0]["kkt_n"] == 2540 and a[0]["kkt_nnz_lower"] == 21574
     with pytest.raises(ValueError, match="RINFOG|flops"):
         mo.parse_analyses(log.replace("RINFOG(1)", "RINFOG(9)"))
+
+
+def test_fatrop_findings_compare_time_per_iteration_and_the_floor():
+    """bench_fatrop.py's rows in sentences: FATROP's time per iteration against IPOPT's and
+    the time at IPOPT's iteration count, computed by hand here."""
+    rows = [
+        {"model": "SK", "mesh": "20 x 5", "solver": "ipopt", "status": "Solve_Succeeded", "iterations": 500,
+         "solve_s": 40.0, "ms_per_iteration": 80.0, "objective": 0.2, "max_violation": 1e-8},
+        {"model": "SK", "mesh": "20 x 5", "solver": "ipopt (integral form)", "status": "Solve_Succeeded",
+         "iterations": 400, "solve_s": 44.0, "ms_per_iteration": 110.0, "objective": 0.19, "max_violation": 1e-8},
+        {"model": "SK", "mesh": "20 x 5", "solver": "fatrop", "status": "Maximum_Iterations_Exceeded",
+         "iterations": 21, "solve_s": 42.0, "ms_per_iteration": 2000.0, "objective": 7.0, "max_violation": 300.0,
+         "N": 20, "stage_nx": 66, "stage_nu": 242, "stage_ng": 187},
+    ]
+    (line,) = perf.fatrop_findings({"rows": rows})
+    assert "500 iterations, 40.0 s (80 ms per iteration)" in line
+    assert "20 stages (66 states, 242 controls and 187 constraints per stage)" in line
+    assert "2000 ms per iteration, 25.0× IPOPT's" in line
+    assert "that is 1000 s against IPOPT's 40 s" in line  # 2.0 s × 500 iterations
+    assert "integral form: Solve_Succeeded in 400 iterations, 44.0 s (110 ms per iteration), objective 0.1900 " \
+           "against 0.2000" in line
+    assert list(perf.fatrop_table({"rows": rows}).columns[:4]) == ["model", "mesh", "solver", "status"]

@@ -369,6 +369,30 @@ display(avail)
 display(lin)
 
 # %% [markdown]
+# ## A structure-exploiting solver: FATROP
+#
+# FATROP, which ships in the pinned casadi wheel, solves an optimal control problem by a
+# Riccati recursion over its stages with dense stage blocks, instead of MUMPS's sparse
+# factorisation of the whole KKT system. It takes only an NLP laid out stage by stage, each
+# stage closing its gap explicitly, x_{k+1} = Φ_k(x_k, u_k). `bench_fatrop.py` rewrites the
+# book's LGR problems into that layout from the same symbols, data and bounds: a stage is a
+# mesh interval; its state is the interval's first state node plus a constant copy of x(0)
+# (which carries the periodicity to the last stage); its "controls" are the interval's
+# controls and interior state nodes; the defects are multiplied by the inverse of their end
+# columns (the *integral form*, an equivalent set of equations) so that the last one is the
+# explicit gap. The tests (`tests/test_bench_fatrop.py`) check that the rewrite is the same
+# equations at any point and that FATROP accepts its layout. FATROP runs a fixed number of
+# iterations here: its time per iteration is the measurement. Beside it, IPOPT on the
+# integral form of gaitlib's own NLP (`GaitSpec(defects="integral")`) and on the rewrite.
+
+# %%
+fat = perf.load_optional("fatrop")
+if fat is not None:
+    print(perf.measured_on(fat))
+    display(perf.fatrop_table(fat))
+    print("\n".join(perf.fatrop_findings(fat)))
+
+# %% [markdown]
 # ## What we found
 #
 # Computed from the stored results above (nothing in this paragraph is typed by hand):

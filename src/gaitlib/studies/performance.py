@@ -48,7 +48,7 @@ __all__ = ["results_dir", "load", "load_optional", "fit_power_law", "scaling_tab
            "thesis_times_by_chapter", "thesis_times_figure", "LINEAR_GROWTH", "LINEAR_TOLERANCE",
            "MSK_SOLVE_TARGET_S", "CONVERGED", "THESIS_MESH_NODES", "MUMPS_AUTO_ORDERING",
            "SAME_OBJECTIVE_RTOL", "msk_profile_findings", "eval_floor_findings", "compiled_solve_finding",
-           "thesis_times_findings", "mumps_orderings_findings", "findings"]
+           "thesis_times_findings", "mumps_orderings_findings", "fatrop_table", "fatrop_findings", "findings"]
 
 #: Runs of the scaling benchmark whose time per iteration is a measurement (the solver ran
 #: to the end: converged or stopped by its own criterion), as opposed to "timeout"/"error".
@@ -779,6 +779,53 @@ def mumps_orderings_findings(res: dict) -> list[str]:
                       f"IPOPT's default (MUMPS's automatic choice: {', '.join(used)}). ")
                    + ("No ordering MUMPS offers grows linearly or slower." if g["exponent"].min() > LINEAR_GROWTH else
                       "At least one ordering grows no faster than linearly."))
+    return out
+
+
+FATROP_COLUMNS = ["model", "mesh", "solver", "status", "iterations", "solve_s", "ms_per_iteration", "objective",
+                  "max_violation", "n_variables", "n_constraints"]
+
+
+def fatrop_table(res: dict) -> pd.DataFrame:
+    """``bench_fatrop.py``'s rows: one per model, mesh and solver (IPOPT on gaitlib's NLP, on
+    its integral form, on the stage-wise rewrite; FATROP on the rewrite)."""
+    df = pd.DataFrame(res["rows"])
+    return df[[c for c in FATROP_COLUMNS if c in df.columns]]
+
+
+def fatrop_findings(res: dict) -> list[str]:
+    """``bench_fatrop.py`` in sentences, per model: FATROP's time per iteration against
+    IPOPT's on the same problem, what that means at IPOPT's iteration count (a floor: FATROP
+    would need at least as many iterations to be as fast), and the IPOPT runs on the
+    integral form and on the stage-wise rewrite beside the book's differential form."""
+    out = []
+    for (model, mesh), g in pd.DataFrame(res["rows"]).groupby(["model", "mesh"], sort=False):
+        r = g.set_index("solver")
+        if "ipopt" not in r.index:
+            continue
+        ip = r.loc["ipopt"]
+        line = (f"• {model} {mesh}: IPOPT + MUMPS on gaitlib's NLP, {ip['status']} in {int(ip['iterations'])} "
+                f"iterations, {ip['solve_s']:.1f} s ({ip['ms_per_iteration']:.0f} ms per iteration).")
+        if "fatrop" in r.index:
+            fa = r.loc["fatrop"]
+            if int(fa["iterations"]) > 0:
+                ratio = fa["ms_per_iteration"] / ip["ms_per_iteration"]
+                floor = fa["ms_per_iteration"] * ip["iterations"] / 1e3
+                line += (f" FATROP on the same problem laid out in {int(fa['N'])} stages ({int(fa['stage_nx'])} "
+                         f"states, {int(fa['stage_nu'])} controls and {int(fa['stage_ng'])} constraints per "
+                         f"stage): {fa['status']} after {int(fa['iterations'])} iterations, "
+                         f"{fa['ms_per_iteration']:.0f} ms per iteration, {ratio:.1f}× IPOPT's; at IPOPT's "
+                         f"iteration count that is {floor:.0f} s against IPOPT's {ip['solve_s']:.0f} s.")
+            else:
+                line += f" FATROP: {fa['status']}."
+        for name, what in (("ipopt (integral form)", "its defects in integral form"),
+                           ("ipopt (stage-wise)", "the stage-wise rewrite")):
+            if name in r.index:
+                o = r.loc[name]
+                line += (f" IPOPT on {what}: {o['status']} in {int(o['iterations'])} iterations, "
+                         f"{o['solve_s']:.1f} s ({o['ms_per_iteration']:.0f} ms per iteration), objective "
+                         f"{o['objective']:.4f} against {ip['objective']:.4f}.")
+        out.append(line)
     return out
 
 
