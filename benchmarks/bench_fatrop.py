@@ -207,21 +207,18 @@ def run_one(model: str, n_intervals: int, max_iter: int, fatrop_max_iter: int | 
                      "objective": float(obj), "max_violation": _violation(tr, wsol, pvec), **(extra or {})})
         print(json.dumps(rows[-1]), flush=True)
 
-    t = time.perf_counter()
-    r = tr.solver(x0=w0, lbx=tr.lbw, ubx=tr.ubw, lbg=tr.lbg, ubg=tr.ubg, p=pvec)
-    st = tr.solver.stats()
-    record("ipopt", st["return_status"], st["iter_count"], time.perf_counter() - t, build_ipopt,
-           np.asarray(r["x"]).ravel(), r["f"], {"n_variables": tr.n_variables, "n_constraints": tr.n_constraints})
+    def solve_transcription(name, trx, build_s):
+        t = time.perf_counter()
+        r = trx.solver(x0=w0, lbx=trx.lbw, ubx=trx.ubw, lbg=trx.lbg, ubg=trx.ubg, p=pvec)
+        st = trx.solver.stats()
+        record(name, st["return_status"], st["iter_count"], time.perf_counter() - t, build_s,
+               np.asarray(r["x"]).ravel(), r["f"], {"n_variables": trx.n_variables, "n_constraints": trx.n_constraints})
 
+    solve_transcription("ipopt", tr, build_ipopt)
     # gaitlib's own NLP with the defects in integral form (the rewrite's rows, without its copy of x(0))
     t = time.perf_counter()
     tri = ocp.transcribe(gp.problem, replace(gp.mesh, defect_form="integral"), opts)
-    b = time.perf_counter() - t
-    t = time.perf_counter()
-    r = tri.solver(x0=w0, lbx=tri.lbw, ubx=tri.ubw, lbg=tri.lbg, ubg=tri.ubg, p=pvec)
-    st = tri.solver.stats()
-    record("ipopt (integral form)", st["return_status"], st["iter_count"], time.perf_counter() - t, b,
-           np.asarray(r["x"]).ravel(), r["f"], {"n_variables": tri.n_variables, "n_constraints": tri.n_constraints})
+    solve_transcription("ipopt (integral form)", tri, time.perf_counter() - t)
 
     t = time.perf_counter()
     nlp, perm_w, lbx, ubx, lbg, ubg, dims, x_of_w = stagewise(tr)
