@@ -42,7 +42,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import sys
 import time
 from dataclasses import replace
@@ -57,6 +56,7 @@ import numpy as np  # noqa: E402
 from gaitlib import ocp  # noqa: E402
 from gaitlib.collocation import integral_form  # noqa: E402
 from gaitlib.problems import gait as gait_ocp  # noqa: E402
+from report import machine_info, write_report  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "results"
 PRINT_LEVEL = 0
@@ -288,25 +288,23 @@ def main(argv=None):
         rows += run_one(mdl, args.intervals, args.max_iter, args.fatrop_max_iter)
     if args.quick:
         return rows
-    meta = {"measured": started, "machine": {"cpu": _cpu(), "cores": os.cpu_count(), "platform": platform.platform()},
-            "load_average_start": load_start, "casadi": ca.__version__, "python": sys.version.split()[0],
+    machine = machine_info()
+    meta = {"measured": started, "machine": machine, "load_average_start": load_start, "casadi": ca.__version__,
+            "python": sys.version.split()[0],
             "command": "python benchmarks/bench_fatrop.py " + " ".join(argv if argv is not None else sys.argv[1:])}
-    (OUT / "fatrop.json").write_text(json.dumps({"meta": meta, "rows": rows}, indent=1, default=str) + "\n")
     cols = ["model", "cost", "mesh", "solver", "status", "iterations", "build_s", "solve_s", "ms_per_iteration",
             "objective", "max_violation", "n_variables", "n_constraints"]
-    lines = [f"# FATROP vs IPOPT + MUMPS on the natural-gait problems ({started}, {_cpu()}; load average "
+    lines = [f"# FATROP vs IPOPT + MUMPS on the natural-gait problems ({started}, {machine['cpu']}; load average "
              f"at start {load_start[0]:.2f})", "",
              f"`{meta['command']}`; casadi {meta['casadi']}, one BLAS thread. Method: the module docstring of "
              "`benchmarks/bench_fatrop.py`.", "",
              "| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
     for r in rows:
         lines.append("| " + " | ".join(_fmt(r.get(c, "")) for c in cols) + " |")
-    st = [r for r in rows if r["solver"] != "ipopt"]
-    if st:
-        lines += ["", "Stage dimensions (FATROP's dense blocks): "
-                  + "; ".join(f"{r['model']}: N = {r['N']}, nx = {r['stage_nx']}, nu = {r['stage_nu']}, "
-                              f"ng = {r['stage_ng']}" for r in st if r["solver"] == "fatrop")]
-    (OUT / "fatrop.md").write_text("\n".join(lines) + "\n")
+    lines += ["", "Stage dimensions (FATROP's dense blocks): "
+              + "; ".join(f"{r['model']}: N = {r['N']}, nx = {r['stage_nx']}, nu = {r['stage_nu']}, "
+                          f"ng = {r['stage_ng']}" for r in rows if r["solver"] == "fatrop")]
+    write_report(OUT, "fatrop", {"meta": meta, "rows": rows}, lines)
     return rows
 
 
@@ -314,16 +312,6 @@ def _fmt(v):
     if isinstance(v, float):
         return f"{v:.4g}" if abs(v) < 1e4 else f"{v:.3e}"
     return str(v)
-
-
-def _cpu() -> str:
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
 
 
 if __name__ == "__main__":

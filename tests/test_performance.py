@@ -207,3 +207,13 @@ def test_fatrop_findings_compare_time_per_iteration_and_the_floor():
     assert "integral form: Solve_Succeeded in 400 iterations, 44.0 s (110 ms per iteration), objective 0.1900 " \
            "against 0.2000" in line
     assert list(perf.fatrop_table({"rows": rows}).columns[:4]) == ["model", "mesh", "solver", "status"]
+
+
+def test_defect_form_findings_pair_the_forms_per_problem():
+    rows = [{"problem": "MSK DT", "form": f, "mesh": "20 x 5", "status": "Solve_Succeeded", "iterations": it,
+             "solve_s": t, "ms_per_iteration": 1e3 * t / it, "objective": o}
+            for f, it, t, o in (("differential", 500, 50.0, 0.11), ("integral", 400, 60.0, 0.10))]
+    rows.append({**rows[0], "problem": "lonely"})
+    (line,) = perf.defect_form_findings({"rows": rows})
+    assert line.startswith("• MSK DT (20 x 5): differential Solve_Succeeded, 500 iterations, 50.0 s (100 ms each)")
+    assert "integral Solve_Succeeded, 400 iterations, 60.0 s (150 ms each), objective 0.1000 — 1.20× the time." in line

@@ -393,6 +393,18 @@ if fat is not None:
     print("\n".join(perf.fatrop_findings(fat)))
 
 # %% [markdown]
+# The integral form of the defects, measured on its own: `bench_defect_form.py` solves the
+# CLI's MSK DT Free and the book's natural-gait problems in both forms (per-node derivatives,
+# compiled, from the same guess). Its rows are denser (each reads all of its interval's
+# dynamics), so an iteration costs more; whether it needs fewer iterations is what is measured.
+
+# %%
+dform = perf.load_optional("defect_form")
+if dform is not None:
+    print(perf.measured_on(dform))
+    print("\n".join(perf.defect_form_findings(dform)))
+
+# %% [markdown]
 # ## What we found
 #
 # Computed from the stored results above (nothing in this paragraph is typed by hand):

@@ -48,7 +48,7 @@ __all__ = ["results_dir", "load", "load_optional", "fit_power_law", "scaling_tab
            "thesis_times_by_chapter", "thesis_times_figure", "LINEAR_GROWTH", "LINEAR_TOLERANCE",
            "MSK_SOLVE_TARGET_S", "CONVERGED", "THESIS_MESH_NODES", "MUMPS_AUTO_ORDERING",
            "SAME_OBJECTIVE_RTOL", "msk_profile_findings", "eval_floor_findings", "compiled_solve_finding",
-           "thesis_times_findings", "mumps_orderings_findings", "fatrop_table", "fatrop_findings", "findings"]
+           "thesis_times_findings", "mumps_orderings_findings", "fatrop_table", "fatrop_findings", "defect_form_findings", "findings"]
 
 #: Runs of the scaling benchmark whose time per iteration is a measurement (the solver ran
 #: to the end: converged or stopped by its own criterion), as opposed to "timeout"/"error".
@@ -826,6 +826,24 @@ def fatrop_findings(res: dict) -> list[str]:
                          f"{o['solve_s']:.1f} s ({o['ms_per_iteration']:.0f} ms per iteration), objective "
                          f"{o['objective']:.4f} against {ip['objective']:.4f}.")
         out.append(line)
+    return out
+
+
+def defect_form_findings(res: dict) -> list[str]:
+    """``bench_defect_form.py`` in sentences: per problem, the integral form's iterations,
+    solve time and objective against the differential form's (the book's); a lower
+    objective is another local optimum reached, not a property of the form."""
+    out = []
+    for prob, g in pd.DataFrame(res["rows"]).groupby("problem", sort=False):
+        r = g.set_index("form")
+        if not {"differential", "integral"} <= set(r.index):
+            continue
+        d, i = r.loc["differential"], r.loc["integral"]
+        out.append(f"• {prob} ({d['mesh']}): differential {d['status']}, {int(d['iterations'])} iterations, "
+                   f"{d['solve_s']:.1f} s ({d['ms_per_iteration']:.0f} ms each), objective {d['objective']:.4f}; "
+                   f"integral {i['status']}, {int(i['iterations'])} iterations, {i['solve_s']:.1f} s "
+                   f"({i['ms_per_iteration']:.0f} ms each), objective {i['objective']:.4f} — "
+                   f"{i['solve_s'] / d['solve_s']:.2f}× the time.")
     return out
 
 
