@@ -378,3 +378,20 @@ def test_gap_validate_checks_its_sets_before_any_solve(capsys, monkeypatch, tmp_
                        "--cache", str(tmp_path / "c")], capsys)
     assert rc == 2 and "unknown set(s) nope" in _one_line(err, "gap-validate")
     assert not (tmp_path / "v").exists()
+
+
+@pytest.mark.parametrize("flag,want", [([], None), (["--defects", "differential"], None),
+                                       (["--defects", "integral"], "integral")])
+def test_run_gait_defects_reach_the_spec_and_keep_the_default_key(flag, want, capsys, monkeypatch, tmp_path):
+    seen = []
+
+    def spy(spec, *a, **k):
+        seen.append(spec)
+        raise ZeroDivisionError("stop here")
+
+    monkeypatch.setattr(gait_ocp, "solve_cached", spy)
+    _run(["run", "gait", "--out", str(tmp_path / "o"), "--cache", str(tmp_path / "c"), *flag], capsys)
+    (spec,) = seen
+    assert spec.defects == want
+    if want is None:  # the default form is the unset option: the stored solutions' keys
+        assert "defects" not in spec.to_dict()

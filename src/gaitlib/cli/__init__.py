@@ -55,7 +55,7 @@ import sys
 from pathlib import Path
 
 from .. import blas
-from .common import EXIT_FAILED, CLIError, Output, _add_output_options, _int_options, _Parser, check_cache, int_at_least
+from .common import EXIT_FAILED, CLIError, Output, _add_output_options, _defects_option, _int_options, _Parser, check_cache, int_at_least
 
 #: gaitlib.ocp.COMPILE_ENV (tests/test_compiled.py checks they agree)
 COMPILE_ENV = "GAITLIB_COMPILE"
@@ -91,6 +91,8 @@ def _cmd_run(args) -> int:
     kw = dict(n_intervals=args.intervals, degree=args.degree, scheme=args.scheme, max_iter=args.max_iter)
     if args.derivatives:
         kw["derivatives"] = args.derivatives
+    if args.defects == "integral":
+        kw["defects"] = "integral"
     if args.free_contact is not None:
         kw["free_contact"] = args.free_contact
     spec = gait.natural_gait_spec(args.model, args.cost, args.speed, **kw)
@@ -135,6 +137,8 @@ def _cmd_sweep(args) -> int:
     kw = dict(n_intervals=args.intervals, degree=args.degree, max_iter=args.max_iter)
     if args.derivatives:
         kw["derivatives"] = args.derivatives
+    if args.defects == "integral":
+        kw["defects"] = "integral"
     specs = {f"{args.model}_{c}_{s}": gait_ocp.GaitSpec(model=args.model, cost=c, speed_class=s, **kw)
              for c in costs for s in speeds}
     root = check_cache(args.cache, not args.no_cache)
@@ -221,6 +225,7 @@ def _add_sweep_parser(sub) -> None:
     w.add_argument("--costs", required=True, help="comma-separated cost functions, e.g. DT,SDT1,SP1")
     w.add_argument("--speeds", default="Free", help="comma-separated speed classes, e.g. VerySlow,Slow,Free")
     _int_options(w, (20, 5))
+    _defects_option(w)
     w.add_argument("--scheduler", default=None,
                    help="address (tcp://host:port) or scheduler file of an existing dask cluster "
                         "(default: a LocalCluster over the machine's cores)")
@@ -258,6 +263,7 @@ def build_parser() -> argparse.ArgumentParser:
                                                  "Eq5.55 for NMSK; also DT, SDT1..3, SP1..3, FP)")
     r.add_argument("--speed", default="Free", help="speed class (VerySlow, Slow, Free, Fast, VeryFast)")
     _int_options(r, (20, 5))
+    _defects_option(r)
     r.add_argument("--scheme", default="lgr", choices=["lgr", "trapezoidal", "hermite-simpson"])
     fc = r.add_mutually_exclusive_group()
     fc.add_argument("--free-contact", dest="free_contact", action="store_true", default=None,

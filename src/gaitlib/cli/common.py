@@ -164,6 +164,13 @@ def _add_output_options(p, cache: bool = True):
         p.add_argument("--no-cache", action="store_true", help="solve even if cached solutions exist")
 
 
+def _defects_option(p):
+    p.add_argument("--defects", choices=("differential", "integral"), default=None,
+                   help="the collocation defects' form: 'differential' (the default, as GPOPS-II) or 'integral' "
+                        "(the same equations times the inverse of their end columns: another row scaling, "
+                        "another IPOPT path; a separate cache entry)")
+
+
 def _int_options(p, mesh, max_iter: int = 1000):
     p.add_argument("--intervals", type=int_at_least(1), default=mesh[0],
                    help=f"mesh intervals (default {mesh[0]}; thesis: 20)")
