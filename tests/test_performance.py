@@ -214,6 +214,8 @@ def test_defect_form_findings_pair_the_forms_per_problem():
              "solve_s": t, "ms_per_iteration": 1e3 * t / it, "objective": o}
             for f, it, t, o in (("differential", 500, 50.0, 0.11), ("integral", 400, 60.0, 0.10))]
     rows.append({**rows[0], "problem": "lonely"})
-    (line,) = perf.defect_form_findings({"rows": rows})
+    rows += [{**rows[0], "problem": "stuck"}, {**rows[1], "problem": "stuck", "status": "Maximum_Iterations_Exceeded"}]
+    line, stuck = perf.defect_form_findings({"rows": rows})
+    assert stuck.endswith("no time ratio: the integral form did not converge.") and "× the time" not in stuck
     assert line.startswith("• MSK DT (20 x 5): differential Solve_Succeeded, 500 iterations, 50.0 s (100 ms each)")
     assert "integral Solve_Succeeded, 400 iterations, 60.0 s (150 ms each), objective 0.1000 — 1.20× the time." in line

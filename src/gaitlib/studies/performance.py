@@ -832,7 +832,8 @@ def fatrop_findings(res: dict) -> list[str]:
 def defect_form_findings(res: dict) -> list[str]:
     """``bench_defect_form.py`` in sentences: per problem, the integral form's iterations,
     solve time and objective against the differential form's (the book's); a lower
-    objective is another local optimum reached, not a property of the form."""
+    objective is another local optimum reached, not a property of the form. The time ratio is
+    given only when both runs converged."""
     out = []
     for prob, g in pd.DataFrame(res["rows"]).groupby("problem", sort=False):
         r = g.set_index("form")
@@ -843,7 +844,10 @@ def defect_form_findings(res: dict) -> list[str]:
                    f"{d['solve_s']:.1f} s ({d['ms_per_iteration']:.0f} ms each), objective {d['objective']:.4f}; "
                    f"integral {i['status']}, {int(i['iterations'])} iterations, {i['solve_s']:.1f} s "
                    f"({i['ms_per_iteration']:.0f} ms each), objective {i['objective']:.4f} — "
-                   f"{i['solve_s'] / d['solve_s']:.2f}× the time.")
+                   + (f"{i['solve_s'] / d['solve_s']:.2f}× the time." if d["status"] == i["status"] == CONVERGED else
+                      "no time ratio: the " + " and the ".join(f for f, x in (("differential", d), ("integral", i))
+                                                              if x["status"] != CONVERGED)
+                      + " form did not converge."))
     return out
 
 
