@@ -341,7 +341,7 @@ class GaitSpec:
     defects : ``None`` (the differential form, X Aᵀ − h F Bᵀ, as GPOPS-II by default) or
         ``"integral"``: the same defects multiplied by the inverse of their end columns
         (:func:`gaitlib.collocation.integral_form`) — the same problem, other row scaling,
-        another path for IPOPT (``benchmarks/bench_fatrop.py``, ``bench_ipopt_options.py``).
+        another path for IPOPT (measured: ``benchmarks/bench_defect_form.py``).
     """
 
     model: str = "SK"

@@ -782,7 +782,7 @@ def mumps_orderings_findings(res: dict) -> list[str]:
     return out
 
 
-FATROP_COLUMNS = ["model", "mesh", "solver", "status", "iterations", "solve_s", "ms_per_iteration", "objective",
+FATROP_COLUMNS = ["model", "mesh", "solver", "status", "iterations", "build_s", "solve_s", "ms_per_iteration", "objective",
                   "max_violation", "n_variables", "n_constraints"]
 
 
@@ -795,8 +795,8 @@ def fatrop_table(res: dict) -> pd.DataFrame:
 
 def fatrop_findings(res: dict) -> list[str]:
     """``bench_fatrop.py`` in sentences, per model: FATROP's time per iteration against
-    IPOPT's on the same problem, what that means at IPOPT's iteration count (a floor: FATROP
-    would need at least as many iterations to be as fast), and the IPOPT runs on the
+    IPOPT's on the same problem, the time FATROP would take at IPOPT's iteration count (to
+    match IPOPT it would have to converge in 1/ratio of IPOPT's iterations), and the IPOPT runs on the
     integral form and on the stage-wise rewrite beside the book's differential form."""
     out = []
     for (model, mesh), g in pd.DataFrame(res["rows"]).groupby(["model", "mesh"], sort=False):
