@@ -53,6 +53,7 @@ def test_plate_injections_are_undone_by_their_effects(tmp_path, frame, base_gait
     g = _read(tmp_path, V.inject(frame, "plate_gain", s), "gain")
     back = effects_mod.adjust_data(g, {"grf_scale": {"s": s}})
     assert np.allclose(back.mean.to_numpy(float), base_gait.mean.to_numpy(float), atol=1e-9)
+    assert np.allclose(back.sd.to_numpy(float), base_gait.sd.to_numpy(float), atol=1e-9)  # a gain scales the SD
     b_bw = 0.015
     g = _read(tmp_path, V.inject(frame, "plate_ap_bias", b_bw), "bias")
     b_n = b_bw * base_gait.body_mass * cv.G * cv.DATA_SIGN.get("grf_x", 1.0)
@@ -66,8 +67,9 @@ def test_load_scale_scales_every_load_and_nothing_else(tmp_path, frame, base_gai
     m = 0.1
     g = _read(tmp_path, V.inject(frame, "load_scale", m), "load")
     for c in g.mean.columns:
-        ratio_ok = np.allclose(g.mean[c], (1 + m) * base_gait.mean[c], atol=1e-9)
-        same = np.allclose(g.mean[c], base_gait.mean[c], atol=1e-12)
+        ratio_ok = np.allclose(g.mean[c], (1 + m) * base_gait.mean[c], atol=1e-9) \
+            and np.allclose(g.sd[c], (1 + m) * base_gait.sd[c], atol=1e-9)
+        same = np.allclose(g.mean[c], base_gait.mean[c], atol=1e-12) and np.allclose(g.sd[c], base_gait.sd[c], atol=1e-12)
         if c.startswith(("tau_", "pow_", "grf_")):
             assert ratio_ok, c
         else:

@@ -53,7 +53,7 @@ from .contact import param_index
 from . import data as data_mod
 from .ocp import Parameter
 
-__all__ = ["EffectParam", "Effect", "EFFECTS", "TWIN_EFFECTS", "LAB_EFFECTS", "MODEL_EFFECTS", "PLATE_THRESHOLD_N", "Context", "Bound", "bind", "validate",
+__all__ = ["EffectParam", "Effect", "EFFECTS", "TWIN_EFFECTS", "LAB_EFFECTS", "MODEL_EFFECTS", "PLATE_THRESHOLD_N", "Context", "Bound", "bind", "validate", "formulation_versions",
            "data_columns", "adjust_data", "theta_of", "ARM"]
 
 
@@ -101,6 +101,9 @@ class Effect:
         ``"profile"`` — the cost function cannot see the effect's signature (EMG), so the
         magnitude is fitted by minimising the located gap over a grid of fixed values.
     twin_magnitudes : magnitudes used by the twin validation (small, middle, large).
+    version : the effect's formulation version (``""``: its first). Cache keys of solves with
+        the effect switched on name it when set (:func:`formulation_versions`), so a change
+        of what the effect solves re-keys only those solves.
     """
 
     name: str
@@ -119,6 +122,7 @@ class Effect:
     columns: Callable | None = None      # (ref, tau_grid) -> dict name -> array
     path: Callable | None = None         # (node_out: dict, th, ctx) -> expr, constrained ≥ 0
     data_adjust: Callable | None = None  # (gait, th) -> gait
+    version: str = ""
 
     @property
     def n_params(self) -> int:
@@ -693,10 +697,11 @@ ACTIVATION_TIMING = Effect(
 PLATE_THRESHOLD_N = 10.0
 
 
-def _replace_gait(gait, mean, note):
+def _replace_gait(gait, mean, note, sd=None):
     import dataclasses
 
-    return dataclasses.replace(gait, mean=mean, notes=tuple(gait.notes) + (note,))
+    extra = {} if sd is None else {"sd": sd}
+    return dataclasses.replace(gait, mean=mean, notes=tuple(gait.notes) + (note,), **extra)
 
 
 def _offset_reference(joint):
@@ -755,17 +760,21 @@ _GRF_REFS = tuple(f"grf_{a}_{s}" for s in cv.SIDES for a in ("x", "y"))
 
 
 def _grf_scale_reference(d, th, ctx, t):
-    return {f"ref_{g}": d[f"ref_{g}"] / (1 + th["s"]) for g in _GRF_REFS}
+    out = {f"ref_{g}": d[f"ref_{g}"] / (1 + th["s"]) for g in _GRF_REFS}
+    # the SD-standardised fit (gaitlib.gap.solve): the SD is the gain's too
+    out.update({f"sd_{g}": d[f"sd_{g}"] / (1 + th["s"]) for g in _GRF_REFS if f"sd_{g}" in d})
+    return out
 
 
 def _grf_scale_adjust(gait, th):
     s = float(th["s"])
     if s == 0.0:
         return gait
-    mean = gait.mean.copy()
+    mean, sd = gait.mean.copy(), gait.sd.copy()
     for g in _GRF_REFS:
         mean[g] = mean[g] / (1 + s)
-    return _replace_gait(gait, mean, f"force-plate gain {1 + s:.4f} removed")
+        sd[g] = sd[g] / (1 + s)
+    return _replace_gait(gait, mean, f"force-plate gain {1 + s:.4f} removed (mean and SD)", sd=sd)
 
 
 GRF_SCALE = Effect(
@@ -777,6 +786,15 @@ GRF_SCALE = Effect(
     corrected. The data's joint moments are left as published: a laboratory's inverse
     dynamics would carry part of the gain into them, which this effect does not model.
 
+    The gain scales every child's force, so the data's SD too: the corrected data are
+    mean/(1 + s) ± SD/(1 + s), and the standardised residual of a GRF channel is
+    ((1 + s)·sim − mean)/SD — the same data on the same scale as the baseline's residual
+    (sim − mean)/SD. (Version 2; version 1 divided the mean only, so a gain s > 0 shrank
+    every GRF residual by 1/(1 + s) whatever the cause of the misfit — a gain that
+    "closed" part of any gap in which the model's forces fall short of the data's.) Under the spec's own cost function
+    (``objective="cost"``) the GRF tracking term's normalising range is the spec's and is
+    not rescaled.
+
     A data-model effect; its null value s = 0 is the baseline.
 
     Parameters
@@ -787,6 +805,7 @@ GRF_SCALE = Effect(
     twin_magnitudes=(0.03, 0.06, 0.1),
     reference=_grf_scale_reference,
     data_adjust=_grf_scale_adjust,
+    version="2",
 )
 
 
@@ -1030,3 +1049,10 @@ def numeric_body_contact(spec, ctx: Context, parameters: dict, pb, pc):
         if e.contact is not None:
             pc = e.contact(pc, th[n], ctx)
     return np.array([float(v) for v in pb]), np.array([float(v) for v in pc])
+
+
+def formulation_versions(effects) -> tuple[str, ...]:
+    """The formulation versions a solve with ``effects`` ((name, magnitude), …) adds to its
+    cache key: ``"effect:<name>-<version>"`` for each effect with a :attr:`Effect.version`
+    (none for an effect in its first formulation, so those keys stay)."""
+    return tuple(f"effect:{n}-{EFFECTS[n].version}" for n in sorted({n for n, _ in effects}) if EFFECTS[n].version)

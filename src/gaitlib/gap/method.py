@@ -37,6 +37,10 @@ class Method:
         diagnosis is "unexplained" and names the contenders. When the data hold a gap no
         library effect represents, several effects each absorb a part of it and none stands
         out; when one effect is the cause, it does.
+    revision : bumped when the diagnosis decides differently for a reason outside these
+        fields, so that the validation is redrawn. 1: the first frozen method; 2: the
+        force-plate gain effect scales the data's SD with its mean (``grf_scale`` version 2,
+        :mod:`gaitlib.effects`) and the validation's gain manipulations do too.
     """
 
     bic_threshold: float = -10.0
@@ -44,6 +48,7 @@ class Method:
     profile_grid: tuple = (("co_contraction", (0.1, 0.2, 0.35, 0.5)), ("joint_stiffness", (-0.5, 1.0, 2.0, 3.0)))
     base: tuple = (("model", "SK"), ("cost", "DT"), ("n_intervals", 10), ("degree", 3))
     runner_up_margin: float = 10.0
+    revision: int = 2
 
     def to_dict(self) -> dict:
         return json.loads(json.dumps(asdict(self)))

@@ -61,7 +61,8 @@ def null_guess(base) -> ocp.Guess:
 def _where(spec, gait, base, root, objective) -> Path:
     desc = {"kind": "gap-null-start", "spec": spec.to_dict(), "data": signature(gait),
             "guess": gait_ocp.guess_signature(base), "objective": objective, "ipopt": dict(NULL_START_IPOPT)}
-    return cache.lookup("gap", desc, root, formulation=(gait_ocp.FORMULATION, FIT_FORMULATION, FORMULATION),
+    return cache.lookup("gap", desc, root, formulation=(gait_ocp.FORMULATION, FIT_FORMULATION, FORMULATION)
+                        + spec.effect_versions(),
                         identified=spec.identified_sets())
 
 

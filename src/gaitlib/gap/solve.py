@@ -20,7 +20,8 @@ cannot be computed for every synthetic GRF).
 
 Solutions are cached under ``<root>/gap/<key>``, the key hashing the spec, the data set's
 numbers (:func:`gaitlib.gap.io.signature`), the warm start, and the formulation versions
-(:data:`gaitlib.problems.gait.FORMULATION` and this module's :data:`FORMULATION`).
+(:data:`gaitlib.problems.gait.FORMULATION`, this module's :data:`FORMULATION` and those of
+the spec's effects, :func:`gaitlib.effects.formulation_versions`).
 Failed solves are cached and returned as failed (their IPOPT status is the result).
 """
 
@@ -61,7 +62,7 @@ FORMULATION = "gap-fit-1"
 def _where(spec: gait_ocp.GaitSpec, gait, guess, root, objective="fit") -> Path:
     desc = {"kind": "gap-solve", "spec": spec.to_dict(), "data": signature(gait), "guess": gait_ocp.guess_signature(guess),
             "objective": objective}
-    return cache.lookup("gap", desc, root, formulation=(gait_ocp.FORMULATION, FORMULATION),
+    return cache.lookup("gap", desc, root, formulation=(gait_ocp.FORMULATION, FORMULATION) + spec.effect_versions(),
                         identified=spec.identified_sets())
 
 
@@ -105,7 +106,7 @@ def fit_problem(gp) -> ocp.Problem:
         tot = 0
         for name, src, i in chans:
             sim = x[i] if src == "x" else n[src][i]
-            tot = tot + ((sim - dd[f"ref_{name}"]) / d[f"sd_{name}"]) ** 2
+            tot = tot + ((sim - dd[f"ref_{name}"]) / dd[f"sd_{name}"]) ** 2  # an effect may rescale both
         return tot / len(chans)
 
     goals = [dataclasses.replace(g, weight=g.weight * REG_FACTOR) for g in ph.goals if g.name in _KEEP]

@@ -24,7 +24,8 @@ Two sets, each manipulation with its right answer stated here, in advance:
                     represents the variant, stated here.
 
 Every manipulation acts on the tidy CSV in its own units (degrees, N·m/kg, W/kg, body
-weights) and on the ipsilateral rows; the real data already carry a gap of their own (the
+weights) and on the ipsilateral rows; a gain (``load_scale``, ``plate_gain``) scales the SD
+with the mean, as it scales every child's curve; the real data already carry a gap of their own (the
 unedited data's diagnosis is run beside), so an injection is found on top of it, as in a
 laboratory.
 
@@ -70,10 +71,12 @@ def _rows(df, quantities):
 
 
 def _scale(quantities):
+    """× (1 + m) on the mean *and* the SD: a gain (a plate's calibration, the mass that
+    normalises the loads) acts on every child's curve, so on their spread as well."""
     def f(df, m):
         df = df.copy()
         r = _rows(df, quantities)
-        df.loc[r, "mean"] = df.loc[r, "mean"] * (1.0 + m)
+        df.loc[r, ["mean", "sd"]] = df.loc[r, ["mean", "sd"]] * (1.0 + m)
         return df
 
     return f

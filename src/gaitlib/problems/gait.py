@@ -452,10 +452,16 @@ class GaitSpec:
             sets.append(ACTIVATION_SET)
         return tuple(sets)
 
+    def effect_versions(self) -> tuple[str, ...]:
+        """The formulation versions of the spec's effects that cache keys add
+        (:func:`gaitlib.effects.formulation_versions`; empty for most specs)."""
+        return effects_mod.formulation_versions(self.effects)
+
     def key(self) -> str:
-        """Cache key: hash of the full spec, :data:`FORMULATION` and the data
-        (:func:`gaitlib.cache.key`)."""
-        return cache.key({"kind": "gait", **self.to_dict()}, FORMULATION, identified=self.identified_sets())
+        """Cache key: hash of the full spec, :data:`FORMULATION` (and its effects'
+        versions) and the data (:func:`gaitlib.cache.key`)."""
+        return cache.key({"kind": "gait", **self.to_dict()}, (FORMULATION,) + self.effect_versions(),
+                         identified=self.identified_sets())
 
     def to_dict(self) -> dict:
         """The spec as plain JSON values; options added after the store was written are
@@ -1755,7 +1761,8 @@ def cache_dir(spec: GaitSpec, *, guess=None, root=None) -> Path:
     desc = {"kind": "gait", **spec.to_dict()}
     if guess is not None:
         desc["warm_start"] = guess_signature(guess)
-    return cache.lookup("gait", desc, root, formulation=FORMULATION, identified=spec.identified_sets())
+    return cache.lookup("gait", desc, root, formulation=(FORMULATION,) + spec.effect_versions(),
+                        identified=spec.identified_sets())
 
 
 def load_cached(where) -> GaitSolution | None:
