@@ -292,3 +292,36 @@ def test_muscle_twin_lines_from_the_rows():
                             "identified 0.2, 0.2. Effect-free twins read \"unexplained\": 1 of 2.")
     assert second == ("Misnamed: none#1 (no effect) → joint_stiffness (partial; ΔBIC -277.7); co@0#1 → "
                       "activation_timing (partial; ΔBIC named -52.2, injected -15.2).")
+
+
+def test_revision_lines_count_an_effect_in_both_revisions(tmp_path, monkeypatch):
+    """The before/after of a method change counts, per revision, the cases that named the
+    effect, named it rightly (also within a "|" family), ranked it first and expected it —
+    by hand on two made-up validations; a superseded result loads without the hash check."""
+    import pandas as pd
+    from gaitlib.studies import gap as G
+    from gaitlib.studies import performance as perf
+
+    def rows(named, rank1, expected):
+        return pd.DataFrame({"set": "independent", "band": "middle", "named": named, "rank1": rank1, "expected": expected,
+                             "correct": [n in e.split("|") for n, e in zip(named, expected)]})
+
+    old = V.Validation(rows(["grf_scale", "grf_scale", "unexplained"], ["grf_scale", "grf_scale", "grf_scale"],
+                            ["body_mass", "grf_scale|body_mass", "grf_scale"]),
+                       {"named": "unexplained", "rank1": "grf_scale"}, {"method_hash": "a" * 16, "method": {}})
+    new = V.Validation(rows(["body_mass", "unexplained", "grf_scale"], ["body_mass", "left_shift", "grf_scale"],
+                            ["body_mass", "grf_scale|body_mass", "grf_scale"]),
+                       {"named": "unexplained", "rank1": "left_shift"},
+                       {"method_hash": "b" * 16, "method": {"revision": 2}})
+    assert G.effect_naming(old, "grf_scale") == {"cases": 3, "named": 2, "named_right": 1, "ranked_first": 3,
+                                                 "expected": 2, "unedited_named": "unexplained",
+                                                 "unedited_rank1": "grf_scale"}
+    assert G.effect_naming(new, "grf_scale")["named"] == 1 and G.effect_naming(new, "grf_scale")["named_right"] == 1
+    before, after = G.revision_lines(old, new)
+    assert "revision 1" in before and "named in 2 of 3 cases (1 of them right" in before
+    assert "revision 2" in after and "ranked first in 1;" in after and "ranked first left_shift" in after
+    old.save(tmp_path / "gap_validation" / "real_rev1")
+    monkeypatch.setattr(perf, "results_dir", lambda: tmp_path)
+    assert G.superseded_validation("real_rev1").settings["method_hash"] == "a" * 16
+    with pytest.raises(ValueError, match="unknown superseded"):
+        G.superseded_validation("real")

@@ -55,7 +55,8 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "book_gaps", "twin_validation_full_mesh", "twin_full_mesh_lines", "twin_full_mesh_verdict",
            "left_leg_flips", "co_contraction_text", "findings",
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
-           "VALIDATION_RUNS", "stored_validation"]
+           "VALIDATION_RUNS", "stored_validation", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
+           "revision_lines"]
 
 #: Baseline of the twin study: SK, data tracking (Eq 4.11), 10 × 3 LGR — the coarse mesh (the full 20 × 5 mesh costs ≈ 10× per solve and the twin study
 #: needs ≈ 170 solves per seed).
@@ -376,6 +377,48 @@ def stored_validation(name: str = "real") -> gval.Validation:
         raise RuntimeError(f"{folder}: a validation of method {v.settings.get('method_hash')}, the method is now "
                            f"{now}: rerun `{VALIDATION_RUNS[name]}`")
     return v
+
+
+#: A validation made by an earlier method, kept as the "before" of a method change:
+#: folder under ``gap_validation`` → the method revision that made it.
+SUPERSEDED_VALIDATIONS = {"real_rev1": 1}
+
+
+def superseded_validation(name: str = "real_rev1") -> gval.Validation:
+    """A stored validation of an earlier method (:data:`SUPERSEDED_VALIDATIONS`), loaded
+    without the hash check — for the side-by-side of a method change only, never as a result
+    of the current method."""
+    if name not in SUPERSEDED_VALIDATIONS:
+        raise ValueError(f"unknown superseded validation {name!r}; known: {', '.join(SUPERSEDED_VALIDATIONS)}")
+    return gval.Validation.load(perf.results_dir() / "gap_validation" / name)
+
+
+def effect_naming(v: gval.Validation, effect: str) -> dict:
+    """How often ``effect`` was named and ranked first in ``v`` (every case), and in how many
+    cases it was the expected answer: ``{"cases", "named", "named_right", "ranked_first",
+    "expected", "unedited_named", "unedited_rank1"}``."""
+    r = v.rows
+    exp = r["expected"].astype(str).str.split("|").apply(lambda x: effect in x)
+    return {"cases": len(r), "named": int((r["named"] == effect).sum()),
+            "named_right": int(((r["named"] == effect) & exp).sum()), "ranked_first": int((r["rank1"] == effect).sum()),
+            "expected": int(exp.sum()), "unedited_named": v.unedited.get("named"),
+            "unedited_rank1": v.unedited.get("rank1")}
+
+
+def revision_lines(old: gval.Validation, new: gval.Validation, effect: str = "grf_scale") -> list[str]:
+    """The validation before and after a method change, for the effect the change concerns:
+    each revision's counts (:func:`effect_naming`) and unedited verdict, every number from
+    the two results. The two draw different magnitudes (the draws follow the method's
+    hash), so the comparison is of rates, not of paired cases."""
+    out = []
+    for label, v in (("before", old), ("after", new)):
+        c = effect_naming(v, effect)
+        out.append(f"{label} (method {v.settings.get('method_hash')}, revision "
+                   f"{v.settings.get('method', {}).get('revision', 1)}): `{effect}` named in {c['named']} of "
+                   f"{c['cases']} cases ({c['named_right']} of them right; it was the expected answer in "
+                   f"{c['expected']}), ranked first in {c['ranked_first']}; the unedited data: {c['unedited_named']}, "
+                   f"ranked first {c['unedited_rank1']}.")
+    return out
 
 
 def validation_cases(v: gval.Validation) -> pd.DataFrame:
