@@ -109,6 +109,8 @@ def test_each_ch5_ablation_change_is_one_change_on_the_book_reading_spec():
         differs = {k for k, v in spec.to_dict().items() if base.to_dict().get(k) != v}
         assert differs <= set(change) and differs, name
     assert {"coordinate weight ×4", "torque weight ×4", "GRF weight ×4"} <= set(fidelity.ch5_changes("MSK"))
+    for model in ("MSK", "NMSK"):  # the same NLP, its defects in integral form: the one field
+        assert fidelity.ch5_changes(model)[fidelity.INTEGRAL_DEFECTS] == {"defects": "integral"}
 
 
 def test_nmsk_ch5_ablation_starts_each_change_from_the_msk_run_of_that_change(monkeypatch):

@@ -232,7 +232,11 @@ marks.mark_rows(gait.rmse_beside_thesis(msk_sol), marks.failure_label(msk_sol))
 # metatarsal untracked *and* the coordinate weight raised, the two changes the geometric
 # floor below and the single-change runs point at — the weight in steps (×4, ×16, ×32,
 # ×64), which shows what each degree of angle accuracy costs in the torque and GRF
-# terms. Every run is solved from the data like the book's, and only runs that
+# terms. The last row changes no problem: the same NLP with its collocation defects written
+# in integral form (`GaitSpec(defects="integral")`: an invertible linear map of the defect
+# rows, so the same feasible set and the same optima), which IPOPT walks along another path
+# — how much of the misfit is the local optimum IPOPT stops in rather than the problem.
+# Every run is solved from the data like the book's, and only runs that
 # converge and pass the validity gates count. Beside the angles, the geometric floor of Ch 2:
 # the poses closest to the data whose feet agree with its phases (standing foot 0.5–5 mm in
 # the ground, metatarsal on the thesis's planned trajectory or free), with no dynamics at
@@ -375,7 +379,8 @@ t511.rename(columns={"ours": marks.run_label("ours (NMSK)", marks.failure_label(
 # start, the NMSK ×16 run (`fidelity.SECOND_STARTS`). The coordinate weight alone trades the
 # angles for the GRFs; four more rows raise the GRF weight with it (×2 and ×1.5 at ×32, ×2
 # and ×4 at ×64), each started from an NMSK run: the second start, then its GRF ×2 run
-# (`fidelity.TRADE_OFF`). Only runs that converge and pass the validity gates count.
+# (`fidelity.TRADE_OFF`). The same NLP with its defects in integral form is the last row, as
+# for MSK (from the MSK run of it). Only runs that converge and pass the validity gates count.
 
 # %%
 try:

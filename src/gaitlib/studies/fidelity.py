@@ -279,6 +279,8 @@ TARGET_FACTOR = 1.5
 
 #: The Ch 5 ablation's change that stops tracking the planned metatarsal angles.
 METATARSAL_FREE = "metatarsal untracked"
+#: The Ch 5 ablation's row of the same problem with its defects in integral form.
+INTEGRAL_DEFECTS = "defects in integral form (the same NLP)"
 
 
 def ch5_changes(model: str = "MSK") -> dict[str, dict]:
@@ -291,7 +293,11 @@ def ch5_changes(model: str = "MSK") -> dict[str, dict]:
     that with the coordinate weight raised (the single change that lowers the angles most) to
     each of :data:`Q_SCAN`: how much angle accuracy the torque and GRF terms cost. NMSK adds
     one row: the scan's run at :data:`MTB_FREE_Q` without the Mtb term (Eq 5.55), which with
-    the activation dynamics is what the NMSK problem adds to the MSK one."""
+    the activation dynamics is what the NMSK problem adds to the MSK one. The last row,
+    :data:`INTEGRAL_DEFECTS`, changes no problem: the same NLP with its collocation defects in
+    integral form (:attr:`GaitSpec.defects`, an invertible linear map of the rows, so the same
+    feasible set and optima), which IPOPT walks along another path — how much of the misfit
+    is the local optimum IPOPT stops in rather than the problem."""
     w = dict(gait_ocp.COST_FUNCTIONS[model][msk.ch5_spec(model).cost])
     q = f"coordinate weight ×{1 / w['Q']:g}"
     return {
@@ -306,6 +312,7 @@ def ch5_changes(model: str = "MSK") -> dict[str, dict]:
            for f in Q_SCAN},
         **({_no_mtb(f"{METATARSAL_FREE} + coordinate weight ×{MTB_FREE_Q / w['Q']:g}"):
             {"track_mtp": False, "weights": (("Q", MTB_FREE_Q), ("Mtb", 0.0))}} if "Mtb" in w else {}),
+        INTEGRAL_DEFECTS: {"defects": "integral"},
     }
 
 
