@@ -325,3 +325,38 @@ def test_revision_lines_count_an_effect_in_both_revisions(tmp_path, monkeypatch)
     assert G.superseded_validation("real_rev1").settings["method_hash"] == "a" * 16
     with pytest.raises(ValueError, match="unknown superseded"):
         G.superseded_validation("real")
+
+
+def test_experiment_lines_are_computed_from_their_results(tmp_path, monkeypatch):
+    """The normative-start and pair-test sentences count what their results hold (made-up
+    results, counted by hand); a result of another method is refused."""
+    import json
+    from gaitlib.studies import gap as G
+    from gaitlib.studies import performance as perf
+
+    def r(named, start, obj, rss):
+        return {"named": named, "start": start, "objective": obj, "rss_baseline": rss}
+
+    norm = {"method_hash": M.METHOD.hash(), "cases": [
+        {"injection": "load_scale", "band": "middle", "expected": "body_mass",
+         "without": r("unexplained", "grf", 0.8, 713.0), "with": r("body_mass", "warm", 0.7, 692.0)},
+        {"injection": "hip_offset", "band": "large", "expected": "hip_offset",
+         "without": r("hip_offset", "grf", 0.8, 650.0), "with": r("hip_offset", "grf", 0.8, 650.0)}]}
+    (line,) = G.normative_start_lines(norm)
+    assert "named right in 2 (without it: 1)" in line and "in 1 (load_scale middle: RSS 713 → 692)" in line
+    assert "changed in 1 (load_scale middle: unexplained → body_mass)" in line
+    pair = {"method_hash": M.METHOD.hash(), "threshold": -10.0, "margin": 10.0, "cases": [
+        {"case": "a", "top": "x", "second": "y", "expected": "x", "cond_top": -12.0, "cond_second": -11.0,
+         "rule_names": "x", "rule_right": True, "method_right": False},
+        {"case": "b", "top": "y", "second": "z", "expected": "unexplained", "cond_top": -3.0, "cond_second": -1.0,
+         "rule_names": "unexplained", "rule_right": True, "method_right": True},
+        {"case": "c", "top": "y", "second": "z", "expected": "z", "skipped": "no converged pair fit"}]}
+    first, second = G.pair_test_lines(pair)
+    assert "In 3 cases" in first and "converged in 2" in first and "passed the threshold in 1 of them (both" \
+        " effects given the other in 1" in first
+    assert "right in 2 of these 2 cases, the method in 1" in second
+    (tmp_path / "x.json").write_text(json.dumps(dict(pair, method_hash="0" * 16)))
+    monkeypatch.setattr(perf, "results_dir", lambda: tmp_path)
+    assert G.stored_experiment("absent.json", "s.py") is None
+    with pytest.raises(RuntimeError, match="rerun benchmarks/s.py"):
+        G.stored_experiment("x.json", "s.py")

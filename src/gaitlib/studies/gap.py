@@ -56,7 +56,7 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "left_leg_flips", "co_contraction_text", "findings",
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
            "VALIDATION_RUNS", "stored_validation", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
-           "revision_lines"]
+           "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines"]
 
 #: Baseline of the twin study: SK, data tracking (Eq 4.11), 10 × 3 LGR — the coarse mesh (the full 20 × 5 mesh costs ≈ 10× per solve and the twin study
 #: needs ≈ 170 solves per seed).
@@ -564,17 +564,61 @@ def null_lines(null: gval.Validation, real: gval.Validation, top: int = 4) -> li
 NULL_REFIT_FILE = "null_refit.json"
 
 
-def stored_null_refit() -> dict | None:
-    """``benchmarks/gap_null_refit.py``'s result, or None if absent; refused if made with
-    another method than the current one."""
-    f = perf.results_dir() / "gap_validation" / NULL_REFIT_FILE
+def stored_experiment(relpath: str, script: str) -> dict | None:
+    """A gap experiment's JSON result under the benchmark results folder (``relpath``,
+    written by ``benchmarks/<script>``), or None if absent; refused if made with another
+    method than the current one."""
+    f = perf.results_dir() / relpath
     if not f.is_file():
         return None
     r = json.loads(f.read_text())
     if r.get("method_hash") != gap_method.METHOD.hash():
         raise RuntimeError(f"{f}: made with method {r.get('method_hash')}, the method is now "
-                           f"{gap_method.METHOD.hash()}: rerun benchmarks/gap_null_refit.py")
+                           f"{gap_method.METHOD.hash()}: rerun benchmarks/{script}")
     return r
+
+
+def stored_null_refit() -> dict | None:
+    """``benchmarks/gap_null_refit.py``'s result (:func:`stored_experiment`)."""
+    return stored_experiment(f"gap_validation/{NULL_REFIT_FILE}", "gap_null_refit.py")
+
+
+def normative_start_lines(res: dict) -> list[str]:
+    """``benchmarks/gap_normative_start.py``'s result in a sentence computed from it."""
+    c = res["cases"]
+    right = {k: sum(x[k]["named"] == x["expected"] for x in c) for k in ("without", "with")}
+    better = [x for x in c if x["with"]["start"] == "warm" and x["with"]["objective"] < x["without"]["objective"]]
+    changed = [x for x in c if x["with"]["named"] != x["without"]["named"]]
+    return [f"**The baseline from the unedited data's fit.** Given the fit of the unedited data as one more start "
+            f"(the most favourable start a baseline could get: the data differ by the injection only), the "
+            f"{len(c)} independent injections at middle and large magnitudes are named right in {right['with']} "
+            f"(without it: {right['without']}); the kept baseline came from that start, with a lower objective, in "
+            f"{len(better)}" + (" (" + "; ".join(f"{x['injection']} {x['band']}: RSS {x['without']['rss_baseline']:.0f} "
+                                                 f"→ {x['with']['rss_baseline']:.0f}" for x in better) + ")" if better else "")
+            + f"; the named effect changed in {len(changed)}" + (" (" + "; ".join(
+                f"{x['injection']} {x['band']}: {x['without']['named']} → {x['with']['named']}" for x in changed) + ")"
+                if changed else "") + " (`benchmarks/gap_normative_start.py`)."]
+
+
+def pair_test_lines(res: dict) -> list[str]:
+    """``benchmarks/gap_pair_test.py``'s result in sentences computed from it."""
+    c = res["cases"]
+    done = [x for x in c if "rule_names" in x]
+    passed = [x for x in done if x["cond_top"] <= res["threshold"]]
+    both = [x for x in passed if x["cond_second"] <= res["threshold"]]
+    out = [f"**The top effect given the runner-up.** In {len(c)} cases (the unedited data and the manipulations) the "
+           f"top effect passed the threshold ({res['threshold']:g}) but not the runner-up margin ({res['margin']:g}); "
+           f"the pair of effects fitted together converged in {len(done)}. The top effect's ΔBIC given the runner-up "
+           f"still passed the threshold in {len(passed)} of them (both effects given the other in {len(both)}: two "
+           f"causes rather than one gap absorbed twice)."]
+    if done:
+        out.append(f"A rule naming the top effect whenever its ΔBIC given the runner-up passes would be right in "
+                   f"{sum(x['rule_right'] for x in done)} of these {len(done)} cases, the method in "
+                   f"{sum(x['method_right'] for x in done)}: " + "; ".join(
+                       f"{x['case']} ({x['top']} | {x['second']} {x['cond_top']:.1f}; would name {x['rule_names']}, "
+                       f"expected {x['expected']})" for x in done) + " (`benchmarks/gap_pair_test.py`; not part of "
+                   f"the method).")
+    return out
 
 
 def null_refit_lines(refit: dict, top: int = 4) -> list[str]:
