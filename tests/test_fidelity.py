@@ -286,3 +286,19 @@ def test_q_scan_findings_read_the_worst_channel_of_each_kind_and_every_target_at
     # objectives within 1 %: no claim that the start matters
     text = " ".join(fidelity.q_scan_findings(nm3, "NMSK", objectives={two: 0.1100, f"{m} + coordinate weight ×32": 0.1101}))
     assert f"From a second start: {two} (objective" in text and "The start matters" not in text
+
+
+def test_path_findings_compare_the_integral_row_with_the_book_run():
+    cols = ["status", "iterations", "objective", "worst angle RMSE (deg)", "worst torque RMSE (N·m)",
+            "worst GRF RMSE (N)", "gates"]
+    t = pd.DataFrame([["Solve_Succeeded", 435, 0.0446, 5.8, 2.93, 25.6, "valid"],
+                      ["Solve_Succeeded", 574, 0.0391, 5.08, 3.24, 26.2, "valid"]], columns=cols,
+                     index=[fidelity.CH5_BASE_ROW, fidelity.INTEGRAL_DEFECTS])
+    (line,) = fidelity.path_findings(t)
+    # 0.0391 / 0.0446 - 1 = -12.33 %
+    assert "objective 0.0391 in 574 iterations vs the book's 0.0446 in 435 (-12.3 %)" in line
+    assert "worst angle RMSE 5.08° vs 5.80°" in line and "worst GRF RMSE 26.20 N vs 25.60 N" in line
+    t.loc[fidelity.INTEGRAL_DEFECTS, "status"] = "Maximum_Iterations_Exceeded"
+    (line,) = fidelity.path_findings(t)
+    assert line.startswith("- The same NLP with its defects in integral form: not compared") and "(-" not in line
+    assert fidelity.path_findings(t.drop(index=fidelity.INTEGRAL_DEFECTS)) == []

@@ -253,7 +253,8 @@ abl_channels
 _floor = fidelity.kinematic_floor_table((fidelity.TOUCH,))
 display(Markdown("\n".join(fidelity.ch5_ablation_findings(abl_table, abl_channels, _floor)
                            + fidelity.metatarsal_findings(abl_channels, _floor)
-                           + fidelity.q_scan_findings(abl_channels, "MSK"))))
+                           + fidelity.q_scan_findings(abl_channels, "MSK")
+                           + fidelity.path_findings(abl_table))))
 
 # %% [markdown]
 # ### Figs 5.4–5.6: angles, torques and GRFs (MSK)
@@ -397,7 +398,8 @@ if nabl_table is not None:
     display(Markdown("\n".join(fidelity.ch5_ablation_findings(nabl_table, nabl_channels, _floor)
                                + fidelity.metatarsal_findings(nabl_channels, _floor)
                                + fidelity.q_scan_findings(nabl_channels, "NMSK", abl_channels,
-                                                          nabl_table["objective"].to_dict()))))
+                                                          nabl_table["objective"].to_dict())
+                               + fidelity.path_findings(nabl_table))))
 
 # %% [markdown]
 # ### Figs 5.8–5.10: angles, torques and GRFs (NMSK)

@@ -418,6 +418,28 @@ def ch5_ablation_findings(table: pd.DataFrame, per_channel: pd.DataFrame, floor:
     return out
 
 
+def path_findings(table: pd.DataFrame) -> list[str]:
+    """The :data:`INTEGRAL_DEFECTS` row of a Ch 5 ablation table (:func:`ch5_ablation`)
+    beside the book's own run (:data:`CH5_BASE_ROW`): the objective each reached and the
+    worst RMSE per kind — the same NLP along another path. Empty when either row is missing;
+    a row that did not converge or fails a gate is said so and nothing is concluded from it."""
+    if INTEGRAL_DEFECTS not in table.index or CH5_BASE_ROW not in table.index:
+        return []
+    a, b = table.loc[CH5_BASE_ROW], table.loc[INTEGRAL_DEFECTS]
+    bad = [f"{k} ({r['status']}, {r['gates']})" for k, r in ((CH5_BASE_ROW, a), (INTEGRAL_DEFECTS, b))
+           if r["status"] not in validity.CONVERGED_STATUSES or r["gates"] != "valid"]
+    if bad:
+        return [f"- The same NLP with its defects in integral form: not compared — {'; '.join(bad)}."]
+    kinds = (("angle", "deg", "°"), ("torque", "N·m", " N·m"), ("GRF", "N", " N"))
+    worst = "; ".join(f"worst {k} RMSE {b[f'worst {k} RMSE ({u})']:.2f}{s} vs {a[f'worst {k} RMSE ({u})']:.2f}{s}"
+                      for k, u, s in kinds)
+    rel = 100.0 * (float(b["objective"]) / float(a["objective"]) - 1.0)
+    return [f"- The same NLP with its defects in integral form (IPOPT's path, not the problem): objective "
+            f"{b['objective']:.4g} in {int(b['iterations'])} iterations vs the book's {a['objective']:.4g} in "
+            f"{int(a['iterations'])} ({rel:+.1f} %); {worst}. A lower objective is another local optimum of the same "
+            f"problem; the RMSEs say how much of the misfit moves with it."]
+
+
 def metatarsal_findings(per_channel: pd.DataFrame, floor: pd.DataFrame, clearance_mm: float = 1e3 * TOUCH) -> list[str]:
     """The metatarsal experiment of the Ch 5 ablation (:data:`METATARSAL_FREE`, alone and with
     the coordinate weight raised), read from ``per_channel`` (:func:`channel_table` of the
