@@ -27,6 +27,7 @@ import numpy as np
 import pytest
 
 from gaitlib import cache
+from gaitlib import effects as effects_mod
 from gaitlib.problems import gait as gait_ocp
 from gaitlib.gap import solve as gsolve
 from gaitlib.studies import contact_id as ci
@@ -96,10 +97,10 @@ def _gait(spec):
     return lambda: gait_ocp.solve(spec)
 
 
-def _gap():
+def _gap(effects=()):
     from gaitlib import data
 
-    spec = gait_ocp.GaitSpec(model="SK", cost="DT", n_intervals=3, degree=2)
+    spec = gait_ocp.GaitSpec(model="SK", cost="DT", n_intervals=3, degree=2, effects=tuple(effects))
     return lambda: gsolve.Runner(spec).solve(data.load_gait_data("Free"))
 
 
@@ -124,6 +125,10 @@ PROBES = [
     # the probe of the printed problem: the book's reading only sets GaitSpec fields
     (gait_ocp.FORMULATION, "contact (b)", _gait(ci.spec_b(3, 2, reading="thesis"))),
     (gsolve.FORMULATION, "SK fit", _gap()),
+    # an effect with its own version (gaitlib.effects.formulation_versions): the Fit with it free. The probe
+    # reads the NLP at its guess, s = 0, where versions 1 and 2 agree; the SD scaling itself is checked by
+    # hand in tests/test_lab_effects.py
+    (effects_mod.formulation_versions((("grf_scale", None),))[0], "SK fit + grf_scale", _gap((("grf_scale", None),))),
     (jump.FORMULATION, "toeless", _jump("toeless")),
     (jump.FORMULATION, "ellipsoid", _jump("ellipsoid")),
     (ci.TRAJOPT_FORMULATION, "trajopt", _trajopt()),
