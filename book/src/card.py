@@ -53,8 +53,10 @@ print("Ch 3 jumps (the thesis's bounds, kept on purpose): " + "; ".join(
 # The Ch 3 rows replicate the thesis's jump formulation as printed (Table 3.5 bounds: joint
 # torques up to 4000 N·m, no strength or power limit), which does not confine the optimum
 # to a human jump: their *cause* column compares the COM rise with the range of human
-# standing jumps, and the *valid* column names the gate they fail. A jump under
-# physiological limits is future work.
+# standing jumps, and the *valid* column names the gate they fail. The rows marked
+# "torques within the body's strength (ours)" are the physiological version of the same
+# three jumps (Ch 3, the joint torques limited by the Ch 5 MTGs' strength envelopes), with
+# their own validity gates.
 #
 # ## The card, chapter by chapter
 
