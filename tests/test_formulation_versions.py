@@ -26,7 +26,7 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from gaitlib import cache
+from gaitlib import cache, ocp
 from gaitlib import effects as effects_mod
 from gaitlib.problems import gait as gait_ocp
 from gaitlib.gap import solve as gsolve
@@ -68,6 +68,7 @@ def _probe(run, monkeypatch) -> dict:
         return _FakeSolver(rec)
 
     monkeypatch.setattr(ca, "nlpsol", fake)
+    monkeypatch.setenv(ocp.BUILD_REUSE_ENV, "0")  # a solver built earlier in the session would skip nlpsol
     with pytest.raises(_Intercepted):
         run()
     nlp, args = rec["nlp"], rec["args"]

@@ -29,6 +29,7 @@ def _intercept(run, monkeypatch) -> dict:
         return _FakeSolver(rec)
 
     monkeypatch.setattr(ca, "nlpsol", fake)
+    monkeypatch.setenv(ocp.BUILD_REUSE_ENV, "0")  # a solver built earlier in the session would skip nlpsol
     with pytest.raises(_Intercepted):
         run()
     return rec

@@ -41,12 +41,14 @@ given as dynamics is called with the leading ``n_in`` of ``(x, u, p, t)`` as pla
 
 from __future__ import annotations
 
+import hashlib
 import inspect
 import json
 import math
 import os
 import time
 import warnings
+from collections import OrderedDict
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -509,6 +511,73 @@ class SolverOptions:
 
 
 # ======================================================================================
+# Reusing built solvers (whole-graph derivatives)
+# ======================================================================================
+#: ``GAITLIB_BUILD_REUSE_MB``: how much memory (MB, estimated) a process may keep in built
+#: whole-graph solvers for reuse (:func:`_graph_solver`); ``0`` turns reuse off.
+BUILD_REUSE_ENV = "GAITLIB_BUILD_REUSE_MB"
+#: Its default: about two MSK solvers at 20 × 5 (≈ 1.5 GB each).
+BUILD_REUSE_MB = 3000
+#: Estimated memory of a built SX solver per instruction of its functions (bytes), measured
+#: as the growth of the process's resident memory over the build of SK 10 × 3, SK 20 × 5 and
+#: MSK 20 × 5 solvers (59–84 B; the larger value).
+_BYTES_PER_INSTRUCTION = 85
+_SOLVERS: "OrderedDict[str, tuple[ca.Function, float]]" = OrderedDict()
+_DERIVATIVE_FUNCTIONS = ("nlp_f", "nlp_g", "nlp_grad_f", "nlp_jac_g", "nlp_hess_l", "nlp_grad")
+
+
+def _reuse_budget_mb() -> float:
+    raw = os.environ.get(BUILD_REUSE_ENV, "")
+    try:
+        return float(raw) if raw.strip() else float(BUILD_REUSE_MB)
+    except ValueError:
+        raise ValueError(f"${BUILD_REUSE_ENV}={raw!r}: expected a number of MB (0 turns reuse off)") from None
+
+
+def _structure_key(name: str, nlp: Mapping[str, Any], opts: Mapping[str, Any]) -> str:
+    """SHA-256 of the NLP's objective and constraints as one function of (x, p) — its
+    serialised SX graph, which fixes every derivative CasADi builds from it — with the
+    solver's name, options and CasADi's version. Bounds, guesses, data and weights are
+    arguments of each solve, not part of the solver, so they are no part of the key."""
+    h = hashlib.sha256()
+    fg = ca.Function("fg", [nlp["x"], nlp["p"]], [nlp["f"], nlp["g"]])
+    for part in (name, json.dumps(opts, sort_keys=True, default=str), ca.__version__, fg.serialize()):
+        h.update(part.encode())
+        h.update(b"\0")
+    return h.hexdigest()
+
+
+def _graph_solver(name: str, nlp: Mapping[str, Any], opts: Mapping[str, Any]) -> tuple[ca.Function, bool]:
+    """IPOPT's solver for an SX NLP with whole-graph derivatives: the one this process built
+    for the same NLP before (the same graph, options and name: identical functions, so the
+    same iterates to the last bit), or a new one. Building differentiates the whole graph
+    (seconds for SK, ≈ 30 s for MSK at 20 × 5), so a process that solves one structure with
+    other data, weights, bounds or guesses (twins, speeds, restarts) builds it once. Kept
+    least-recently-used within :data:`BUILD_REUSE_MB` (``$GAITLIB_BUILD_REUSE_MB``) of
+    estimated memory. Returns (solver, reused)."""
+    budget = _reuse_budget_mb()
+    if budget <= 0:
+        return ca.nlpsol(name, "ipopt", nlp, dict(opts)), False
+    key = _structure_key(name, nlp, opts)
+    hit = _SOLVERS.get(key)
+    if hit is not None:
+        _SOLVERS.move_to_end(key)
+        return hit[0], True
+    solver = ca.nlpsol(name, "ipopt", nlp, dict(opts))
+    mb = sum(solver.get_function(f).n_instructions() for f in _DERIVATIVE_FUNCTIONS) * _BYTES_PER_INSTRUCTION / 1e6
+    if mb <= budget:
+        _SOLVERS[key] = (solver, mb)
+        while sum(v[1] for v in _SOLVERS.values()) > budget:
+            _SOLVERS.popitem(last=False)
+    return solver, False
+
+
+def clear_built_solvers() -> None:
+    """Forget every solver kept for reuse (frees their memory once no Transcription holds them)."""
+    _SOLVERS.clear()
+
+
+# ======================================================================================
 # Initial guess
 # ======================================================================================
 @dataclass(frozen=True, eq=False)
@@ -924,6 +993,10 @@ class Transcription:
         Seconds to build the symbolic NLP and the IPOPT solver (with derivatives).
     symbolic_time : float
         Of which: seconds to build the symbolic NLP graph only.
+    reused : bool
+        The solver is one this process had built for an identical NLP (whole-graph
+        derivatives; :func:`_graph_solver`): ``build_time`` is then the symbolic graph and
+        the key's hash only.
     """
 
     def __init__(self, problem: Problem, mesh: Mesh | Mapping[str, Mesh], options: SolverOptions):
@@ -940,9 +1013,11 @@ class Transcription:
         self._build()
         functions = self._node_derivatives() if self._by_nodes else {}
         self.symbolic_time = time.perf_counter() - t_start
-        self.solver = ca.nlpsol(
-            f"{problem.name}_nlp", "ipopt", self.nlp, {**options.nlpsol_options(), **functions}
-        )
+        name, opts = f"{problem.name}_nlp", {**options.nlpsol_options(), **functions}
+        if self._by_nodes:  # its derivatives take seconds to build: nothing to reuse
+            self.solver, self.reused = ca.nlpsol(name, "ipopt", self.nlp, opts), False
+        else:
+            self.solver, self.reused = _graph_solver(name, self.nlp, opts)
         self.build_time = time.perf_counter() - t_start
 
     # -- construction ------------------------------------------------------------------
@@ -1571,6 +1646,7 @@ class Transcription:
             "derivatives": "nodes" if self._by_nodes else "graph",
             "compiled": bool(self._by_nodes and self.options.compiled),
             "symbolic_time": self.symbolic_time,
+            "solver_reused": bool(self.reused),
             "ipopt_t_wall": {k: float(v) for k, v in stats.items()
                              if k.startswith("t_wall_") and isinstance(v, (int, float))},
             "n_call_nlp_hess_l": int(stats.get("n_call_nlp_hess_l", 0)),

@@ -1608,6 +1608,7 @@ def postprocess(gp: GaitProblem, sol: ocp.Solution) -> GaitSolution:
     stats = {
         "status": sol.status, "success": sol.success, "iterations": sol.iterations,
         "solve_time_s": sol.solve_time, "build_time_s": sol.build_time,
+        "solver_reused": bool(sol.info.get("solver_reused", False)),
         "time_per_iteration_s": sol.time_per_iteration, "objective": sol.objective,
         "max_violation": sol.max_violation, "n_variables": sol.info.get("n_variables"),
         "n_constraints": sol.info.get("n_constraints"), "spec_key": spec.key(),
