@@ -100,3 +100,12 @@ def test_least_recently_used_is_dropped_first(monkeypatch):
     transcribe(_swing_up(damping=0.3), MESH, SolverOptions())      # evicts damping 0.2
     assert transcribe(_swing_up(), MESH, SolverOptions()).solver is t1.solver
     assert not transcribe(_swing_up(damping=0.2), MESH, SolverOptions()).reused
+
+
+def test_default_budget_is_a_quarter_of_the_machine_at_most_the_cap(monkeypatch):
+    monkeypatch.setattr(ocp, "_machine_mb", lambda: 8000.0)
+    assert ocp._reuse_budget_mb() == 2000.0
+    monkeypatch.setattr(ocp, "_machine_mb", lambda: 64000.0)
+    assert ocp._reuse_budget_mb() == ocp.BUILD_REUSE_MB
+    monkeypatch.setenv(ocp.BUILD_REUSE_ENV, "123")
+    assert ocp._reuse_budget_mb() == 123.0

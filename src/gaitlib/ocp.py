@@ -516,20 +516,29 @@ class SolverOptions:
 #: ``GAITLIB_BUILD_REUSE_MB``: how much memory (MB, estimated) a process may keep in built
 #: whole-graph solvers for reuse (:func:`_graph_solver`); ``0`` turns reuse off.
 BUILD_REUSE_ENV = "GAITLIB_BUILD_REUSE_MB"
-#: Its default: about two MSK solvers at 20 × 5 (≈ 1.5 GB each).
-BUILD_REUSE_MB = 3000
-#: Estimated memory of a built SX solver per instruction of its functions (bytes), measured
-#: as the growth of the process's resident memory over the build of SK 10 × 3, SK 20 × 5 and
-#: MSK 20 × 5 solvers (59–84 B; the larger value).
+#: Its default: a quarter of the machine's memory, at most this (MB). Solvers at 20 × 5 hold
+#: ≈ 0.6 GB (SK), 1.5 GB (MSK; contact identification (b)) and 2.4 GB (contact
+#: identification (c), free body) of resident memory.
+BUILD_REUSE_MB = 6000
+#: Estimated memory of a built SX solver per instruction of its functions (bytes): the
+#: growth of the process's resident memory over the build of SK 10 × 3, SK 20 × 5, MSK 20 × 5
+#: and contact-identification solvers was 59–84 B per instruction; the larger value.
 _BYTES_PER_INSTRUCTION = 85
 _SOLVERS: "OrderedDict[str, tuple[ca.Function, float]]" = OrderedDict()
 _DERIVATIVE_FUNCTIONS = ("nlp_f", "nlp_g", "nlp_grad_f", "nlp_jac_g", "nlp_hess_l", "nlp_grad")
 
 
+def _machine_mb() -> float:
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 1e6
+    except (ValueError, OSError, AttributeError):
+        return 4.0 * BUILD_REUSE_MB
+
+
 def _reuse_budget_mb() -> float:
     raw = os.environ.get(BUILD_REUSE_ENV, "")
     try:
-        return float(raw) if raw.strip() else float(BUILD_REUSE_MB)
+        return float(raw) if raw.strip() else min(float(BUILD_REUSE_MB), 0.25 * _machine_mb())
     except ValueError:
         raise ValueError(f"${BUILD_REUSE_ENV}={raw!r}: expected a number of MB (0 turns reuse off)") from None
 
@@ -553,8 +562,8 @@ def _graph_solver(name: str, nlp: Mapping[str, Any], opts: Mapping[str, Any]) ->
     same iterates to the last bit), or a new one. Building differentiates the whole graph
     (seconds for SK, ≈ 30 s for MSK at 20 × 5), so a process that solves one structure with
     other data, weights, bounds or guesses (twins, speeds, restarts) builds it once. Kept
-    least-recently-used within :data:`BUILD_REUSE_MB` (``$GAITLIB_BUILD_REUSE_MB``) of
-    estimated memory. Returns (solver, reused)."""
+    least-recently-used within ``$GAITLIB_BUILD_REUSE_MB`` of estimated memory (default a
+    quarter of the machine's, at most :data:`BUILD_REUSE_MB`). Returns (solver, reused)."""
     budget = _reuse_budget_mb()
     if budget <= 0:
         return ca.nlpsol(name, "ipopt", nlp, dict(opts)), False
