@@ -81,11 +81,13 @@ def main(argv=None) -> int:
     n, d = (6, 3) if args.quick else (20, 5)
     starts = ("thesis (c)",) if args.quick else ci_starts()
     stem = args.stem or ("build_reuse_quick" if args.quick else "build_reuse")
+    load = list(os.getloadavg())
     runs = [run(n, d, reuse, starts) for reuse in (False, True)]
     off, on = runs
     same = [a["key"] == b["key"] and a["iterations"] == b["iterations"] and a["objective"] == b["objective"]
             for a, b in zip(sorted(off["rows"], key=lambda r: r["key"]), sorted(on["rows"], key=lambda r: r["key"]))]
-    doc = {"when": datetime.now(timezone.utc).isoformat(timespec="seconds"), "machine": machine_info(),
+    doc = {"measured": datetime.now(timezone.utc).isoformat(timespec="seconds"), "machine": machine_info(),
+           "load_average_start": load,
            "mesh": [n, d], "starts": list(starts), "runs": runs, "identical_solves": f"{sum(same)} of {len(same)}",
            "command": "python benchmarks/bench_build_reuse.py" + (" --quick" if args.quick else "")}
     cols = ["reuse", "solves", "builds", "e2e_s", "build_s", "solve_s", "iterations"]
@@ -93,7 +95,7 @@ def main(argv=None) -> int:
               "builds": sum(not row["reused"] for row in r["rows"]),
               "e2e_s": r["e2e_s"], "build_s": r["build_s"], "solve_s": r["solve_s"], "iterations": r["iterations"]}
              for r in runs]
-    md = [f"# Reusing built solvers: Ch 4 (b) from an empty cache, {n} × {d}, starts {', '.join(starts)} ({doc['when']}, "
+    md = [f"# Reusing built solvers: Ch 4 (b) from an empty cache, {n} × {d}, starts {', '.join(starts)} ({doc['measured']}, "
           f"{doc['machine'].get('cpu', '')}, {doc['machine'].get('cores', '')} cores)", "",
           f"`{doc['command']}`; each run a fresh process, one BLAS thread. Solves identical (key, iterations, "
           f"objective to the last bit): {doc['identical_solves']}.", "",

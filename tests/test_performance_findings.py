@@ -256,3 +256,19 @@ def test_ipopt_options_findings_separate_same_and_other_solutions():
     assert "A 200 it, objective 0.15 (+50 %), 6.0° from the default's" in f[1]
     assert "B 300 it, objective 0.099 (-1.0 %)" in f[2] and "B, takes 25 % fewer iterations" in f[2]
     assert "would allow 200 iterations, against its 300" in f[2] and "between 0.5 and 2.0" in f[2]
+
+
+def test_build_reuse_findings_count_builds_and_report_identity():
+    def row(reused, build, solve):
+        return {"key": "k", "reused": reused, "build_s": build, "solve_s": solve, "iterations": 10, "objective": "0.5"}
+
+    off = {"reuse": False, "e2e_s": 100.0, "build_s": 60.0, "solve_s": 35.0,
+           "rows": [row(False, 20.0, 10.0), row(False, 20.0, 12.0), row(False, 20.0, 13.0)]}
+    on = {"reuse": True, "e2e_s": 62.0, "build_s": 20.5, "solve_s": 36.0,
+          "rows": [row(False, 20.0, 10.0), row(True, 0.25, 13.0), row(True, 0.25, 13.0)]}
+    (line,) = perf.build_reuse_findings({"mesh": [20, 5], "starts": ["neutral"], "identical_solves": "3 of 3",
+                                         "runs": [off, on]})
+    assert "(b), 20 × 5, starts neutral: 3 solves" in line
+    assert "in 3 of 3. Built anew every time: 3 builds, 60.0 s; reused: 1 build, 20.5 s." in line
+    assert "Solving took 35 s and 36 s, the whole process 100 s and 62 s." in line
+    assert perf.build_reuse_findings({"mesh": [6, 3], "identical_solves": "0 of 0", "runs": [on]}) == []

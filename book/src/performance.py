@@ -105,6 +105,23 @@ if build is not None:
     print("\n".join(perf.build_findings(build)))
 
 # %% [markdown]
+# On the whole-graph path a process also keeps the solvers it built: a later problem with
+# the same NLP graph and solver options (other data, weights, bounds or starting point — a
+# continuation over bounds, a multistart, a twin) reuses the solver instead of
+# differentiating the graph again. The same functions, so the same iterates to the last
+# bit (`tests/test_build_reuse.py`); the key is the SHA-256 of the NLP's serialised graph,
+# and what a process keeps is bounded by `GAITLIB_BUILD_REUSE_MB` (default a quarter of
+# the machine's memory, at most 6 GB). `bench_build_reuse.py`, the contact identification
+# (b) of Chapter 4 in two fresh processes, without and with reuse:
+
+# %%
+for stem in ("build_reuse", "build_reuse_6x3"):
+    reuse = perf.load_optional(stem)
+    if reuse is not None:
+        print(perf.measured_on(reuse))
+        print("\n".join(perf.build_reuse_findings(reuse)))
+
+# %% [markdown]
 # ## Where the MSK solve's time goes
 #
 # The target for the MSK data-tracking solve at the full mesh is ≤ 20 s. `bench_msk_profile.py`

@@ -829,6 +829,25 @@ def fatrop_findings(res: dict) -> list[str]:
     return out
 
 
+def build_reuse_findings(res: dict) -> list[str]:
+    """``bench_build_reuse.py`` in sentences: the same solves with a process's whole-graph
+    solvers built anew for every solve and reused where the NLP is identical — how many
+    builds, their time, the solves' time and the process's wall time, and whether every solve
+    took the same path (iterations and objective to the last bit)."""
+    runs = {("on" if r["reuse"] else "off"): r for r in res["runs"]}
+    if set(runs) != {"on", "off"}:
+        return []
+    off, on = runs["off"], runs["on"]
+    n, d = res["mesh"]
+    builds = sum(not row.get("reused", False) for row in on["rows"])
+    return [f"• Contact identification (b), {n} × {d}, starts {', '.join(res.get('starts', ['all']))}: "
+            f"{len(off['rows'])} solves; identical with and without reuse (iterations and objective to the "
+            f"last bit) in {res['identical_solves']}. Built anew every time: {len(off['rows'])} builds, "
+            f"{off['build_s']:.1f} s; reused: {builds} build{'' if builds == 1 else 's'}, {on['build_s']:.1f} s. Solving took "
+            f"{off['solve_s']:.0f} s and {on['solve_s']:.0f} s, the whole process {off['e2e_s']:.0f} s and "
+            f"{on['e2e_s']:.0f} s."]
+
+
 def defect_form_findings(res: dict) -> list[str]:
     """``bench_defect_form.py`` in sentences: per problem, the integral form's iterations,
     solve time and objective against the differential form's (the book's); a lower
