@@ -245,3 +245,20 @@ def test_torque_gain_lines_by_hand(monkeypatch):
     ours = SimpleNamespace(solutions={"NMSK Slow": sol(0.08), "NMSK Fast": sol(0.08)})
     (line,) = pr_mod.torque_gain_lines(book, ours)
     assert "Slow -20 % → +20 % (thesis S: +12 %)" in line and "Fast" not in line
+
+
+def test_guess_lines_count_converged_and_invalid_runs_per_start():
+    from types import SimpleNamespace
+
+    def study(rows):
+        df = pd.DataFrame(rows, columns=["run", "mark", "status", "converged", "iterations"]).set_index("run")
+        return SimpleNamespace(stats=lambda: df)
+
+    a = study([("MSK DT", "", "Solve_Succeeded", True, 500), ("MSK SP3", "NOT CONVERGED", "Maximum_Iterations_Exceeded",
+                                                              False, 1000),
+               ("MSK FP", "INVALID: double support", "Solve_Succeeded", True, 900), ("NMSK DT", "", "x", False, 3)])
+    b = study([("MSK DT", "", "Solve_Succeeded", True, 450), ("MSK SP3", "", "Solve_Succeeded", True, 201)])
+    la, lb = pr.guess_lines({"partial": a, "whole": b}, "MSK")
+    assert la == ("- partial: 2 of 3 MSK runs converged within 1000 iterations (500–900 iterations); not converged: "
+                  "MSK SP3 (Maximum_Iterations_Exceeded); converged but invalid: MSK FP (INVALID: double support).")
+    assert lb == "- whole: 2 of 2 MSK runs converged within 1000 iterations (201–450 iterations)."

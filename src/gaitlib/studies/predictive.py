@@ -32,6 +32,7 @@ in-process) and the solution cache, so a rerun only reloads.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -51,7 +52,7 @@ __all__ = ["CH6_COSTS", "CH7_CLASSES", "THESIS_CLASS", "THESIS_HOURS_TABLE_6_3",
            "THESIS_COT_FIG_7_5", "THESIS_FP_GAIN_PCT", "THESIS_FP_EXCITATION_GAIN_PCT",
            "THESIS_TORQUE_GAIN_PCT_CH7", "BASELINE_COST", "GUESS_POLICY", "baseline", "default_params", "thesis_guess", "run_guess", "ch6_specs", "ch7_specs",
            "score", "excitation_score", "StudyResult", "cost_function_study", "speed_study", "cot_table", "u_breaks",
-           "times_table", "SDT3_ENOUGH_FACTOR", "COT_CURVE_MIN_POINTS", "kind_nrmse", "mean_nrmse", "ch6_findings",
+           "times_table", "guess_lines", "SDT3_ENOUGH_FACTOR", "COT_CURVE_MIN_POINTS", "kind_nrmse", "mean_nrmse", "ch6_findings",
            "ch7_findings", "cot_figure"]
 
 CH6_COSTS = ("DT", "SDT1", "SDT2", "SDT3", "SP1", "SP2", "SP3", "FP")
@@ -734,6 +735,30 @@ def _converged_line(stats: pd.DataFrame, extra: str = "") -> str:
     ok = stats["converged"]
     return (f"- {int(ok.sum())} of {len(ok)} runs converged{extra}"
             + ("" if ok.all() else "; not converged: " + ", ".join(f"{k} ({v})" for k, v in stats.loc[~ok, 'status'].items())))
+
+
+def guess_lines(by_guess: Mapping[str, StudyResult], model: str, limit: int = 1000) -> list[str]:
+    """One sentence per start (``by_guess``: label → a study of the same runs from that
+    start): how many of ``model``'s runs converged within ``limit`` iterations, their
+    iterations, which did not (with IPOPT's status) and which converged but fail a validity
+    gate (their mark)."""
+    out = []
+    for label, res in by_guess.items():
+        st = res.stats()
+        st = st[st.index.str.startswith(f"{model} ")]
+        if st.empty:
+            continue
+        ok = st["converged"].astype(bool)
+        line = (f"- {label}: {int(ok.sum())} of {len(st)} {model} runs converged within {limit} iterations"
+                + (f" ({int(st.loc[ok, 'iterations'].min())}–{int(st.loc[ok, 'iterations'].max())} iterations)"
+                   if ok.any() else ""))
+        if not ok.all():
+            line += "; not converged: " + ", ".join(f"{k} ({v})" for k, v in st.loc[~ok, "status"].items())
+        bad = st[ok & st["mark"].astype(bool)]
+        if len(bad):
+            line += "; converged but invalid: " + ", ".join(f"{k} ({v})" for k, v in bad["mark"].items())
+        out.append(line + ".")
+    return out
 
 
 def ch6_findings(res: StudyResult, thesis_guess_stats: pd.DataFrame, reruns: dict,
