@@ -259,6 +259,6 @@ def test_guess_lines_count_converged_and_invalid_runs_per_start():
                ("MSK FP", "INVALID: double support", "Solve_Succeeded", True, 900), ("NMSK DT", "", "x", False, 3)])
     b = study([("MSK DT", "", "Solve_Succeeded", True, 450), ("MSK SP3", "", "Solve_Succeeded", True, 201)])
     la, lb = pr.guess_lines({"partial": a, "whole": b}, "MSK")
-    assert la == ("- partial: 2 of 3 MSK runs converged within 1000 iterations (500–900 iterations); not converged: "
+    assert la == ("- partial: MSK 2 of 3 runs converged within 1000 iterations (500–900 iterations); not converged: "
                   "MSK SP3 (Maximum_Iterations_Exceeded); converged but invalid: MSK FP (INVALID: double support).")
-    assert lb == "- whole: 2 of 2 MSK runs converged within 1000 iterations (201–450 iterations)."
+    assert lb == "- whole: MSK 2 of 2 runs converged within 1000 iterations (201–450 iterations)."

@@ -561,7 +561,8 @@ def _graph_solver(name: str, nlp: Mapping[str, Any], opts: Mapping[str, Any]) ->
     for the same NLP before (the same graph, options and name: identical functions, so the
     same iterates to the last bit), or a new one. Building differentiates the whole graph
     (seconds for SK, ≈ 30 s for MSK at 20 × 5), so a process that solves one structure with
-    other data, weights, bounds or guesses (twins, speeds, restarts) builds it once. Kept
+    other data, weights, bounds or guesses (continuation stages over bounds, multistarts,
+    restarts) builds it once; speed classes and cost functions are other graphs. Kept
     least-recently-used within ``$GAITLIB_BUILD_REUSE_MB`` of estimated memory (default a
     quarter of the machine's, at most :data:`BUILD_REUSE_MB`). Returns (solver, reused)."""
     budget = _reuse_budget_mb()

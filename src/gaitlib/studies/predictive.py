@@ -749,11 +749,9 @@ def guess_lines(by_guess: Mapping[str, StudyResult], model: str, limit: int = 10
         if st.empty:
             continue
         ok = st["converged"].astype(bool)
-        line = (f"- {label}: {int(ok.sum())} of {len(st)} {model} runs converged within {limit} iterations"
-                + (f" ({int(st.loc[ok, 'iterations'].min())}–{int(st.loc[ok, 'iterations'].max())} iterations)"
-                   if ok.any() else ""))
-        if not ok.all():
-            line += "; not converged: " + ", ".join(f"{k} ({v})" for k, v in st.loc[~ok, "status"].items())
+        span = (f" ({int(st.loc[ok, 'iterations'].min())}–{int(st.loc[ok, 'iterations'].max())} iterations)"
+                if ok.any() else "")
+        line = f"- {label}: {model} " + _converged_line(st, f" within {limit} iterations{span}")[2:]
         bad = st[ok & st["mark"].astype(bool)]
         if len(bad):
             line += "; converged but invalid: " + ", ".join(f"{k} ({v})" for k, v in bad["mark"].items())
