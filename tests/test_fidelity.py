@@ -302,3 +302,24 @@ def test_path_findings_compare_the_integral_row_with_the_book_run():
     (line,) = fidelity.path_findings(t)
     assert line.startswith("- The same NLP with its defects in integral form: not compared") and "(-" not in line
     assert fidelity.path_findings(t.drop(index=fidelity.INTEGRAL_DEFECTS)) == []
+
+
+def test_single_change_findings_by_hand():
+    cols = ["status", "iterations", "objective", "worst angle RMSE (deg)", "worst torque RMSE (N·m)",
+            "worst GRF RMSE (N)", "gates"]
+    t = pd.DataFrame([["Solve_Succeeded", 1063, 0.0326, 4.5, 3.3, 23.9, "valid"],
+                      ["Solve_Succeeded", 306, 0.0331, 3.6, 3.4, 24.1, "valid"]], columns=cols,
+                     index=[fidelity.CH5_BASE_ROW, fidelity.SD_NORM])
+    idx = pd.MultiIndex.from_tuples([("angle", "knee", "r", "deg"), ("angle", "ankle", "l", "deg"),
+                                     ("grf", "y", "r", "N")], names=["kind", "channel", "side", "unit"])
+    ch = pd.DataFrame({fidelity.CH5_BASE_ROW: [4.5, 1.7, 23.9], fidelity.SD_NORM: [3.6, 3.4, 24.1],
+                       "target": [1.8, 1.8, 36.3]}, index=idx)
+    (line,) = fidelity.single_change_findings(t, ch, rows=(fidelity.SD_NORM,), n_moves=2)
+    # moves / target: knee 0.9/1.8 = 0.5, ankle 1.7/1.8 = 0.94, GRF 0.2/36.3: ankle first, then knee
+    assert "the largest moves relative to their targets: angle ankle L 1.70 → 3.40°, angle knee R 4.50 → 3.60°;" in line
+    assert "worst RMSE angle 4.50 → 3.60°; torque 3.30 → 3.40 N·m; GRF 23.90 → 24.10 N" in line
+    # within target: the book's ankle (1.7 ≤ 1.8) and GRF; the change's GRF only
+    assert "channels within target: 1 of 3 (the book's run: 2)" in line
+    t.loc[fidelity.SD_NORM, "gates"] = "invalid: swing load"
+    (line,) = fidelity.single_change_findings(t, ch, rows=(fidelity.SD_NORM,))
+    assert line.startswith(f"- {fidelity.SD_NORM}: not compared") and "→" not in line

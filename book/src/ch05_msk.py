@@ -232,7 +232,14 @@ marks.mark_rows(gait.rmse_beside_thesis(msk_sol), marks.failure_label(msk_sol))
 # metatarsal untracked *and* the coordinate weight raised, the two changes the geometric
 # floor below and the single-change runs point at — the weight in steps (×4, ×16, ×32,
 # ×64), which shows what each degree of angle accuracy costs in the torque and GRF
-# terms. The last row changes no problem: the same NLP with its collocation defects written
+# terms. Two more single changes ask whether the misfit is how the data are tracked rather
+# than the model: each measured channel normalised by the data's between-subject SD instead
+# of its range (Eqs 4.9–4.11 divide by max − min; `GaitSpec(track_norm="sd")`, each term's
+# total weight kept, so only the split between the channels of a term moves: the knees,
+# whose range is the largest, gain weight, the ankles lose it), and the left leg tracked as
+# the right leg's samples shifted instead of the thesis's five-harmonic series (Eqs 4.1–4.3;
+# the row the Ch 4 (c) ablation also has — that run's RMSEs are against the left leg it
+# tracks). The last row changes no problem: the same NLP with its collocation defects written
 # in integral form (`GaitSpec(defects="integral")`: an invertible linear map of the defect
 # rows, so the same feasible set and the same optima), which IPOPT walks along another path
 # — how much of the misfit is the local optimum IPOPT stops in rather than the problem.
@@ -254,6 +261,7 @@ _floor = fidelity.kinematic_floor_table((fidelity.TOUCH,))
 display(Markdown("\n".join(fidelity.ch5_ablation_findings(abl_table, abl_channels, _floor)
                            + fidelity.metatarsal_findings(abl_channels, _floor)
                            + fidelity.q_scan_findings(abl_channels, "MSK")
+                           + fidelity.single_change_findings(abl_table, abl_channels)
                            + fidelity.path_findings(abl_table))))
 
 # %% [markdown]
@@ -373,7 +381,8 @@ t511.rename(columns={"ours": marks.run_label("ours (NMSK)", marks.failure_label(
 # The NMSK problem above, again, with the same single changes as the MSK ablation
 # (`fidelity.ch5_ablation("NMSK")`): each data-tracking weight of Table 5.9 from ¼ to 1, the
 # mesh doubled (40 × 5), the thesis's parameter sets instead of ours, the metatarsal angles
-# untracked, and that with the coordinate weight raised in the same steps; one more row
+# untracked, and that with the coordinate weight raised in the same steps, the tracking
+# normalised by the data's SD and the left leg as the right leg's samples shifted; one more row
 # drops the Mtb term (Eq 5.55) from the ×32 run. As the book's NMSK solve starts from the
 # book's MSK solution, each run starts from the MSK ablation's run of the same change (the
 # no-Mtb row from the MSK ×32 run); one more row solves the ×32 problem again from a second
@@ -399,6 +408,7 @@ if nabl_table is not None:
                                + fidelity.metatarsal_findings(nabl_channels, _floor)
                                + fidelity.q_scan_findings(nabl_channels, "NMSK", abl_channels,
                                                           nabl_table["objective"].to_dict())
+                               + fidelity.single_change_findings(nabl_table, nabl_channels)
                                + fidelity.path_findings(nabl_table))))
 
 # %% [markdown]

@@ -229,7 +229,7 @@ for _name, _w in _T62_NMSK.items():
 #: Spec options that are left out of :meth:`GaitSpec.to_dict` (hence of every cache key)
 #: while unset: added after the store was written, they must not change existing keys.
 KEY_STABLE_OPTIONS = ("swing_load_max", "derivatives", "jerk_ranges", "track_mtp", "activation_params",
-                      "fourier_order", "defects")
+                      "fourier_order", "defects", "track_norm")
 #: The Fourier order of the left leg generated from the right (thesis Eqs 4.1–4.3: 5).
 FOURIER_ORDER = 5
 #: The highest order a cycle of the data's 51 samples (50 distinct) carries: the left leg is
@@ -239,6 +239,12 @@ EXACT_FOURIER_ORDER = 25
 #: How the Jrk term (Eq 4.11) normalises the jerk of each coordinate (:class:`GaitSpec`
 #: ``jerk_ranges``; :func:`reference`).
 JERK_RANGES = ("reference", "data")
+#: How the data-tracking terms normalise each measured channel (:class:`GaitSpec`
+#: ``track_norm``; :func:`reference`): the data's range (Eqs 4.9–4.11) or its SD.
+TRACK_NORMS = ("range", "sd")
+#: The measured channels :func:`sd_ranges` re-normalises, one group per tracking term (the
+#: leg angles of Ang and Q, the net torques of Trq, the foot forces of GRF).
+SD_GROUPS = (LEG_JOINTS, tuple(f"tau_{j}" for j in LEG_JOINTS), GRF_CHANNELS)
 
 
 @dataclass(frozen=True)
@@ -331,6 +337,14 @@ class GaitSpec:
         two metatarsal angles. Their reference is not measured: it is the thesis's planned
         trajectory (Table 4.6), so ``False`` leaves the metatarsal joints to the dynamics — an
         ablation of the Fidelity II study (:func:`gaitlib.studies.fidelity.ch5_changes`).
+    track_norm : ``None`` / ``"range"`` (the thesis, Eqs 4.9–4.11: each tracked channel's
+        error divided by the data's range, max − min) or ``"sd"``: the measured channels
+        divided by the data's between-subject SD instead, scaled per term so that a uniform
+        error costs the term what it costs under ``"range"`` (:func:`sd_ranges`) — the term
+        weights unchanged, only the split between the channels of a term moves. The HAT
+        and metatarsal references (estimated or planned, no SD) keep their ranges; Imp,
+        which borrows the torque ranges, follows them. An ablation of the Fidelity II study
+        (:func:`gaitlib.studies.fidelity.ch5_changes`).
     fourier_order : ``None`` (the thesis's Eqs 4.1–4.3: :data:`FOURIER_ORDER`, 5) or the order
         of the least-squares Fourier series that generates the left leg's data from the right
         leg's (:func:`gaitlib.data.fourier_shift`); :data:`EXACT_FOURIER_ORDER` reproduces the
@@ -378,6 +392,7 @@ class GaitSpec:
     activation_params: str | None = None
     fourier_order: int | None = None
     defects: str | None = None
+    track_norm: str | None = None
 
     def __post_init__(self):
         if self.fourier_order is not None:
@@ -388,6 +403,8 @@ class GaitSpec:
                 raise ValueError("fourier_order cannot be combined with effects (they assume the thesis's order 5)")
         if self.jerk_ranges not in (None,) + JERK_RANGES:
             raise ValueError(f"jerk_ranges must be None or one of {JERK_RANGES}, got {self.jerk_ranges!r}")
+        if self.track_norm not in (None,) + TRACK_NORMS:
+            raise ValueError(f"track_norm must be None or one of {TRACK_NORMS}, got {self.track_norm!r}")
         if self.derivatives not in (None, "graph", "nodes"):
             raise ValueError(f"derivatives must be None, 'graph' or 'nodes', got {self.derivatives!r}")
         if self.model not in MODELS:
@@ -522,12 +539,13 @@ class Reference:
 
 
 def reference(gait: data_mod.GaitData, model: ChildModel, p_contact=None, order: int = 12,
-              jerk_ranges: str = "reference") -> Reference:
+              jerk_ranges: str = "reference", track_norm: str = "range") -> Reference:
     """Model-channel references from data: joint angles (data), metatarsal (planned), HAT
     (pelvis_tx = speed·t, pelvis_ty from the lowest ellipsoid at 2 mm penetration,
     pelvis_tilt = 0); torques; GRFs; Fourier-fit derivatives for the guess and jerk ranges.
     ``jerk_ranges``: :data:`JERK_RANGES` (:class:`GaitSpec`); ``"data"`` replaces the jerk
-    ranges of pelvis_tx and pelvis_tilt by :func:`data_jerk_ranges`."""
+    ranges of pelvis_tx and pelvis_tilt by :func:`data_jerk_ranges`. ``track_norm``:
+    :data:`TRACK_NORMS`; ``"sd"`` replaces the measured channels' ranges by :func:`sd_ranges`."""
     T = gait.cycle_time
     t = gait.time
     # thigh="lab": hip reference = data hip + data pelvic tilt, so that with an upright HAT
@@ -568,6 +586,10 @@ def reference(gait: data_mod.GaitData, model: ChildModel, p_contact=None, order:
         ranges.update(data_jerk_ranges(gait, order))
     elif jerk_ranges != "reference":
         raise ValueError(f"jerk_ranges must be one of {JERK_RANGES}, got {jerk_ranges!r}")
+    if track_norm == "sd":
+        ranges.update(sd_ranges(gait, ranges))
+    elif track_norm != "range":
+        raise ValueError(f"track_norm must be one of {TRACK_NORMS}, got {track_norm!r}")
     return Reference(gait=gait, q=qref, deriv=deriv, tau=tau, grf=grf, ranges=ranges)
 
 
@@ -576,6 +598,27 @@ def joint_angle_bounds(gait: data_mod.GaitData) -> dict[str, tuple[float, float]
     by 15° (thesis: "based on the standard deviation")."""
     return {c: (float((gait.mean[c] - 3 * gait.sd[c]).min()) - 15 * cv.DEG,
                 float((gait.mean[c] + 3 * gait.sd[c]).max()) + 15 * cv.DEG) for c in cv.COORDS[3:]}
+
+
+def sd_ranges(gait: data_mod.GaitData, ranges: dict) -> dict[str, float]:
+    """The denominators of the measured channels under ``track_norm="sd"``: per group of
+    :data:`SD_GROUPS` (one tracking term's channels, one unit), k·σ_c with σ_c the RMS over
+    the cycle of channel c's between-subject SD and k such that Σ_c 1/(k σ_c)² =
+    Σ_c 1/range_c² — a uniform error e costs the term e² Σ 1/range² either way; only the
+    weight of each channel relative to the others of its term becomes 1/σ_c² instead of
+    1/range_c². Units those of the channel (rad, N·m, N)."""
+    out = {}
+    for group in SD_GROUPS:
+        sd = {}
+        for c in group:
+            v = np.sqrt(np.mean(np.square(gait.sd[c].to_numpy(float)))) if c in gait.sd else np.nan
+            if not np.isfinite(v) or v <= 0:
+                raise ValueError(f"track_norm='sd': the data's SD of channel {c!r} is {v!r}; expected a positive "
+                                 "between-subject SD (a source without SDs can only be normalised by range)")
+            sd[c] = float(v)
+        k = np.sqrt(sum(1 / s**2 for s in sd.values()) / sum(1 / ranges[c]**2 for c in group))
+        out.update({c: float(k * s) for c, s in sd.items()})
+    return out
 
 
 def data_jerk_ranges(gait: data_mod.GaitData, order: int = 12, n: int = 401) -> dict[str, float]:
@@ -913,7 +956,8 @@ def build(spec: GaitSpec) -> GaitProblem:
             if spec.track_class else gait_class)
     p_body = params_mod.body_params(spec.body_params, model)
     p_contact = params_mod.contact_params(spec.contact_params)
-    ref = reference(gait, model, p_contact, jerk_ranges=spec.jerk_ranges or "reference")
+    ref = reference(gait, model, p_contact, jerk_ranges=spec.jerk_ranges or "reference",
+                    track_norm=spec.track_norm or "range")
     if spec.hat_reference:
         ref = _with_hat_reference(ref, spec.hat_reference)
     T = gait.cycle_time

@@ -31,6 +31,7 @@ from .. import kinematics
 from .. import validity
 from ..model import ChildModel
 from ..problems import gait as gait_ocp
+from . import contact_id as ci_study
 from . import gait as gait_study
 from . import msk
 from . import predictive as pr
@@ -279,6 +280,8 @@ TARGET_FACTOR = 1.5
 
 #: The Ch 5 ablation's change that stops tracking the planned metatarsal angles.
 METATARSAL_FREE = "metatarsal untracked"
+#: The Ch 5 ablation's row that normalises the tracked channels by the data's SD, not range.
+SD_NORM = "tracking normalised by the data's SD"
 #: The Ch 5 ablation's row of the same problem with its defects in integral form.
 INTEGRAL_DEFECTS = "defects in integral form (the same NLP)"
 
@@ -293,7 +296,12 @@ def ch5_changes(model: str = "MSK") -> dict[str, dict]:
     that with the coordinate weight raised (the single change that lowers the angles most) to
     each of :data:`Q_SCAN`: how much angle accuracy the torque and GRF terms cost. NMSK adds
     one row: the scan's run at :data:`MTB_FREE_Q` without the Mtb term (Eq 5.55), which with
-    the activation dynamics is what the NMSK problem adds to the MSK one. The last row,
+    the activation dynamics is what the NMSK problem adds to the MSK one. Two more single
+    changes: :data:`SD_NORM`, each measured channel of the tracking terms normalised by the
+    data's between-subject SD instead of its range (Eqs 4.9–4.11; :attr:`GaitSpec.track_norm`,
+    each term's total weight kept), and the left leg tracked as the right leg's samples
+    shifted instead of Eqs 4.1–4.3's five-harmonic series (:attr:`GaitSpec.fourier_order`;
+    the row the Ch 4 (c) ablation also has). The last row,
     :data:`INTEGRAL_DEFECTS`, changes no problem: the same NLP with its collocation defects in
     integral form (:attr:`GaitSpec.defects`, an invertible linear map of the rows, so the same
     feasible set and optima), which IPOPT walks along another path — how much of the misfit
@@ -312,6 +320,8 @@ def ch5_changes(model: str = "MSK") -> dict[str, dict]:
            for f in Q_SCAN},
         **({_no_mtb(f"{METATARSAL_FREE} + coordinate weight ×{MTB_FREE_Q / w['Q']:g}"):
             {"track_mtp": False, "weights": (("Q", MTB_FREE_Q), ("Mtb", 0.0))}} if "Mtb" in w else {}),
+        SD_NORM: {"track_norm": "sd"},
+        ci_study.LEFT_SHIFTED_ROW: {"fourier_order": gait_ocp.EXACT_FOURIER_ORDER},
         INTEGRAL_DEFECTS: {"defects": "integral"},
     }
 
@@ -415,6 +425,41 @@ def ch5_ablation_findings(table: pd.DataFrame, per_channel: pd.DataFrame, floor:
               if fcol in at.columns else "")
         out.append(f"- {ch} {side.upper()}: {r[cols[0]]:.1f}° in the book's Ch 5; lowest {r[r['best change']]:.1f}° "
                    f"({r['best change']}); target {r['target']:.1f}° met by: {r['met by']}{fl}.")
+    return out
+
+
+def single_change_findings(table: pd.DataFrame, per_channel: pd.DataFrame,
+                           rows: tuple = (SD_NORM, ci_study.LEFT_SHIFTED_ROW), n_moves: int = 4) -> list[str]:
+    """One sentence per ``rows`` entry of a Ch 5 ablation (:func:`ch5_ablation`; ``per_channel``:
+    its :func:`channel_table` over the usable runs) beside the book's run (:data:`CH5_BASE_ROW`):
+    the worst RMSE per kind, the ``n_moves`` channels whose RMSE moved most relative to their
+    target (:data:`TARGET_FACTOR` × the thesis's worst row), and how many channels meet their
+    target in each run. Each run's RMSEs are against the data it tracks. A row that did not
+    converge or fails a gate is said so and nothing is concluded from it."""
+    if CH5_BASE_ROW not in table.index or CH5_BASE_ROW not in per_channel.columns:
+        return []
+    a = table.loc[CH5_BASE_ROW]
+    kinds = (("angle", "deg", "°"), ("torque", "N·m", " N·m"), ("GRF", "N", " N"))
+    units = {"deg": "°", "N*m": " N·m", "N·m": " N·m", "N": " N"}
+    n_base = int((per_channel[CH5_BASE_ROW] <= per_channel["target"]).sum())
+    out = []
+    for row in rows:
+        if row not in table.index:
+            continue
+        b = table.loc[row]
+        if b["status"] not in validity.CONVERGED_STATUSES or b["gates"] != "valid" or row not in per_channel.columns:
+            out.append(f"- {row}: not compared — {b['status']}, {b['gates']}.")
+            continue
+        worst = "; ".join(f"{k} {a[f'worst {k} RMSE ({u})']:.2f} → {b[f'worst {k} RMSE ({u})']:.2f}{s}"
+                          for k, u, s in kinds)
+        moved = ((per_channel[row] - per_channel[CH5_BASE_ROW]).abs() / per_channel["target"]).sort_values(ascending=False)
+        moves = ", ".join(f"{kind} {ch} {side.upper()} {per_channel.loc[(kind, ch, side, unit), CH5_BASE_ROW]:.2f} → "
+                          f"{per_channel.loc[(kind, ch, side, unit), row]:.2f}{units.get(unit, ' ' + unit)}"
+                          for kind, ch, side, unit in moved.index[:n_moves])
+        n_row = int((per_channel[row] <= per_channel["target"]).sum())
+        out.append(f"- **{row}** (one change; {int(b['iterations'])} iterations, objective {b['objective']:.4g} vs the "
+                   f"book's {a['objective']:.4g}): worst RMSE {worst}; the largest moves relative to their targets: "
+                   f"{moves}; channels within target: {n_row} of {len(per_channel)} (the book's run: {n_base}).")
     return out
 
 
