@@ -58,6 +58,21 @@ print("Ch 3 jumps (the thesis's bounds, kept on purpose): " + "; ".join(
 # three jumps (Ch 3, the joint torques limited by the Ch 5 MTGs' strength envelopes), with
 # their own validity gates.
 #
+# ### Do the feet stand still? Foot slip (measured, not yet a gate)
+#
+# The validity gates above do not look at how fast a loaded foot slides. The contact law's
+# friction acts on the tangential velocity of each ellipsoid's body point at its penetration
+# centroid, and models sticking below its transition velocity v_tr = 0.1 m/s; a standing
+# foot does not slide. For every stored gait solution a row below names, the force-weighted
+# mean slip speed of the loaded feet (`card.slip_table`, `fidelity.foot_slip`); Ch 7
+# measures what happens when the feet cannot skate.
+
+# %%
+slips = card.slip_table(c)
+display(Markdown(" ".join(card.slip_lines(slips))))
+slips.drop(columns=["rows counted as reproduced"])
+
+# %% [markdown]
 # ## The card, chapter by chapter
 
 # %%

@@ -239,7 +239,11 @@ marks.mark_rows(gait.rmse_beside_thesis(msk_sol), marks.failure_label(msk_sol))
 # whose range is the largest, gain weight, the ankles lose it), and the left leg tracked as
 # the right leg's samples shifted instead of the thesis's five-harmonic series (Eqs 4.1–4.3;
 # the row the Ch 4 (c) ablation also has — that run's RMSEs are against the left leg it
-# tracks). The last row changes no problem: the same NLP with its collocation defects written
+# tracks). One more asks whether the fit leans on feet that slide: every ellipsoid's friction
+# coefficients at least 0.2819 (`fidelity.FRICTION_FLOOR`; the ball ellipsoid, which carries
+# most of the load, has μ ≈ 0.01 in Table 4.18 and in our Ch 4 identification — the
+# *foot slip* column gives each run's force-weighted slip speed of the loaded feet, which the
+# friction law treats as sticking below 0.1 m/s). The last row changes no problem: the same NLP with its collocation defects written
 # in integral form (`GaitSpec(defects="integral")`: an invertible linear map of the defect
 # rows, so the same feasible set and the same optima), which IPOPT walks along another path
 # — how much of the misfit is the local optimum IPOPT stops in rather than the problem.
@@ -382,7 +386,8 @@ t511.rename(columns={"ours": marks.run_label("ours (NMSK)", marks.failure_label(
 # (`fidelity.ch5_ablation("NMSK")`): each data-tracking weight of Table 5.9 from ¼ to 1, the
 # mesh doubled (40 × 5), the thesis's parameter sets instead of ours, the metatarsal angles
 # untracked, and that with the coordinate weight raised in the same steps, the tracking
-# normalised by the data's SD and the left leg as the right leg's samples shifted; one more row
+# normalised by the data's SD, the left leg as the right leg's samples shifted and the friction
+# floor; one more row
 # drops the Mtb term (Eq 5.55) from the ×32 run. As the book's NMSK solve starts from the
 # book's MSK solution, each run starts from the MSK ablation's run of the same change (the
 # no-Mtb row from the MSK ×32 run); one more row solves the ×32 problem again from a second

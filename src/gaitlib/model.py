@@ -827,6 +827,12 @@ class ChildModel:
                                ["kinetic", "potential_gravity", "potential_spring"])
         if name == "points":
             return self._build_points()
+        if name == "slip":
+            st = tree.kinematics(qs, qds)
+            frames = self._ellipsoid_frames(st, ca.vertsplit(pc))
+            res = [ellipsoid_contact(fr, self._smoothing) for fr in frames]
+            return ca.Function(name, [q, qd, pc], [ca.vertcat(*[r[k] for r in res]) for k in ("v_slip", "fn")],
+                               ["q", "qd", "p_contact"], ["v_slip", "fn"])
         if name == "ellipsoid_poses":
             st = tree.kinematics(qs)
             frames = self._ellipsoid_frames(st, ca.vertsplit(pc))
@@ -879,6 +885,10 @@ class ChildModel:
         * ``energies``: (q, qd, p_body) -> kinetic, potential_gravity, potential_spring
         * ``points``: (q, p_body) -> named points (2,) and ``angles`` (9,)
         * ``ellipsoid_poses``: (q, p_contact) -> centres (6, 3), R_<label> (3, 3)
+        * ``slip``: (q, qd, p_contact) -> v_slip (6,), m/s: the ground-tangential (x)
+          velocity of each ellipsoid's body material point at its penetration centroid, the
+          velocity the friction law reads (:func:`gaitlib.contact.friction_coefficient`);
+          fn (6,), N: its normal force
         """
         cache = self.__dict__.setdefault("_functions", {})
         if name not in cache:
@@ -937,6 +947,11 @@ class ChildModel:
         the order :data:`ELLIPSOID_LABELS`; per-foot arrays (2,) are (right, left); ``Q``
         (11,) is the contact generalised force."""
         return _call(self.function("contact"), [q, qd, self._pc(p_contact)])
+
+    def slip(self, q, qd, p_contact=None) -> dict:
+        """Each ellipsoid's slip velocity ``v_slip`` (6,), m/s (+x forward), and normal force
+        ``fn`` (6,), N, in the order :data:`ELLIPSOID_LABELS` (see :meth:`function`, 'slip')."""
+        return _call(self.function("slip"), [q, qd, self._pc(p_contact)])
 
     def com(self, q, qd=None, p_body=None):
         """Whole-body COM position (2,) and velocity (2,), m and m/s."""

@@ -229,7 +229,7 @@ for _name, _w in _T62_NMSK.items():
 #: Spec options that are left out of :meth:`GaitSpec.to_dict` (hence of every cache key)
 #: while unset: added after the store was written, they must not change existing keys.
 KEY_STABLE_OPTIONS = ("swing_load_max", "derivatives", "jerk_ranges", "track_mtp", "activation_params",
-                      "fourier_order", "defects", "track_norm")
+                      "fourier_order", "defects", "track_norm", "friction_floor")
 #: The Fourier order of the left leg generated from the right (thesis Eqs 4.1–4.3: 5).
 FOURIER_ORDER = 5
 #: The highest order a cycle of the data's 51 samples (50 distinct) carries: the left leg is
@@ -345,6 +345,12 @@ class GaitSpec:
         and metatarsal references (estimated or planned, no SD) keep their ranges; Imp,
         which borrows the torque ranges, follows them. An ablation of the Fidelity II study
         (:func:`gaitlib.studies.fidelity.ch5_changes`).
+    friction_floor : ``None`` (the identified friction coefficients) or a lower bound on every
+        ellipsoid's μ_s and μ_d (:func:`contact_params_of`). Both the thesis's Table 4.18 and
+        our Ch 4 identification put the ball ellipsoid — the one that carries most of the
+        load — at μ ≈ 0.01, so a loaded foot can slide almost for free; an ablation of the
+        Fidelity II study measures what a floor on the friction changes. Not with
+        ``free_contact``.
     fourier_order : ``None`` (the thesis's Eqs 4.1–4.3: :data:`FOURIER_ORDER`, 5) or the order
         of the least-squares Fourier series that generates the left leg's data from the right
         leg's (:func:`gaitlib.data.fourier_shift`); :data:`EXACT_FOURIER_ORDER` reproduces the
@@ -393,6 +399,7 @@ class GaitSpec:
     fourier_order: int | None = None
     defects: str | None = None
     track_norm: str | None = None
+    friction_floor: float | None = None
 
     def __post_init__(self):
         if self.fourier_order is not None:
@@ -403,6 +410,12 @@ class GaitSpec:
                 raise ValueError("fourier_order cannot be combined with effects (they assume the thesis's order 5)")
         if self.jerk_ranges not in (None,) + JERK_RANGES:
             raise ValueError(f"jerk_ranges must be None or one of {JERK_RANGES}, got {self.jerk_ranges!r}")
+        if self.friction_floor is not None:
+            if not (isinstance(self.friction_floor, (int, float)) and 0.0 < float(self.friction_floor) <= 2.0):
+                raise ValueError(f"friction_floor must be None or a friction coefficient in (0, 2], "
+                                 f"got {self.friction_floor!r}")
+            if self.free_contact:
+                raise ValueError("friction_floor fixes the friction coefficients; free_contact identifies them: choose one")
         if self.track_norm not in (None,) + TRACK_NORMS:
             raise ValueError(f"track_norm must be None or one of {TRACK_NORMS}, got {self.track_norm!r}")
         if self.derivatives not in (None, "graph", "nodes"):
@@ -598,6 +611,27 @@ def joint_angle_bounds(gait: data_mod.GaitData) -> dict[str, tuple[float, float]
     by 15° (thesis: "based on the standard deviation")."""
     return {c: (float((gait.mean[c] - 3 * gait.sd[c]).min()) - 15 * cv.DEG,
                 float((gait.mean[c] + 3 * gait.sd[c]).max()) + 15 * cv.DEG) for c in cv.COORDS[3:]}
+
+
+def contact_params_of(spec: GaitSpec) -> np.ndarray:
+    """The 39 contact parameters a spec solves with (SI, left foot order): the set
+    ``spec.contact_params`` names (:func:`gaitlib.params.contact_params`), with every
+    ellipsoid's μ_s and μ_d raised to at least ``spec.friction_floor`` when it is set."""
+    p = np.array(params_mod.contact_params(spec.contact_params), dtype=float)
+    if spec.friction_floor is not None:
+        for e in cv.ELLIPSOIDS:
+            for k in ("mu_s", "mu_d"):
+                i = contact_mod.param_index(e, k)
+                p[i] = max(p[i], float(spec.friction_floor))
+    return p
+
+
+def slip_velocities(model: ChildModel, q: np.ndarray, qd: np.ndarray, p_contact) -> np.ndarray:
+    """Each ellipsoid's slip velocity (m/s, +x forward; :meth:`gaitlib.model.ChildModel.slip`)
+    at every row of ``q``, ``qd`` (n, 11; SI) → (6, n), order :data:`gaitlib.model.ELLIPSOID_LABELS`."""
+    n = q.shape[0]
+    return np.asarray(model.function("slip").map(n)(np.asarray(q, float).T, np.asarray(qd, float).T,
+                                                    ca.repmat(ca.DM(p_contact), 1, n))[0])
 
 
 def sd_ranges(gait: data_mod.GaitData, ranges: dict) -> dict[str, float]:
@@ -955,7 +989,7 @@ def build(spec: GaitSpec) -> GaitProblem:
     gait = (data_mod.time_scaled(data_mod.load_gait_data(spec.track_class, spec.source, **order), gait_class)
             if spec.track_class else gait_class)
     p_body = params_mod.body_params(spec.body_params, model)
-    p_contact = params_mod.contact_params(spec.contact_params)
+    p_contact = contact_params_of(spec)
     ref = reference(gait, model, p_contact, jerk_ranges=spec.jerk_ranges or "reference",
                     track_norm=spec.track_norm or "range")
     if spec.hat_reference:
@@ -1371,7 +1405,7 @@ class GaitSolution:
     Frames are indexed by time (s) at the collocation nodes: ``q`` (11 coordinates, SI),
     ``torques`` (8 net joint torques, N·m: actuators + joint spring–dampers, comparable
     with the data), ``torques_active`` (the actuators' share: SK controls, MSK MTGs), ``residuals`` (3), ``grf`` (per foot
-    grf_x_r, grf_y_r, grf_x_l, grf_y_l, N), ``ellipsoids`` (fn/fx per ellipsoid, N),
+    grf_x_r, grf_y_r, grf_x_l, grf_y_l, N), ``ellipsoids`` (fn/fx per ellipsoid, N; vs: its slip velocity, m/s),
     ``activations`` (MSK: the controls; NMSK: the 12 generator activations of Eq 5.54, same
     column names). ``rmse`` is a table per channel against the data mean (on normalised time
     when the final time is free).
@@ -1619,10 +1653,13 @@ def postprocess(gp: GaitProblem, sol: ocp.Solution) -> GaitSolution:
     ct = {k: np.asarray(v) for k, v in zip(model.function("contact").name_out(), ct)}
     grf = pd.DataFrame({"grf_x_r": ct["grf_x"][0], "grf_y_r": ct["grf_y"][0],
                         "grf_x_l": ct["grf_x"][1], "grf_y_l": ct["grf_y"][1]}, index=q.index)
+    vs = slip_velocities(model, q.to_numpy(), qd.to_numpy(), pc)
     ell = {}
     for i, lab in enumerate(model.ellipsoid_labels):
         ell[f"fn_{lab}"] = ct["fn"][i]
         ell[f"fx_{lab}"] = ct["fx"][i]
+    for i, lab in enumerate(model.ellipsoid_labels):
+        ell[f"vs_{lab}"] = vs[i]  # slip velocity of the body point the friction law reads, m/s
     ellipsoids = pd.DataFrame(ell, index=q.index)
     nmsk_frames: dict = {}
     nmsk_stats: dict = {}

@@ -54,7 +54,8 @@ from .. import ocp
 from ..problems import gait as gait_ocp
 from .. import validity
 from . import jump
-from ..model import ChildModel
+from .. import contact
+from ..model import ELLIPSOID_LABELS, ChildModel
 from . import contact_id as ci
 from .. import mtg
 from . import gait as sg
@@ -200,6 +201,22 @@ class StoredGait:
             f = self.path / f"{name}.csv"
             setattr(self, name, pd.read_csv(f, index_col=0) if f.is_file() else None)
         self.rmse = pd.read_csv(self.path / "rmse.csv")
+        self._add_slip()
+
+    def _add_slip(self) -> None:
+        """Entries stored before the foot-slip gate have no ``vs_`` (slip velocity) columns:
+        computed from the stored q and q̇ with the spec's contact parameters (the identified
+        ones when the contact was free). Left out for specs with effects (they may change
+        the contact parameters)."""
+        e, q, qd = self.ellipsoids, self.q, self.qd
+        if e is None or q is None or qd is None or any(c.startswith("vs_") for c in e.columns) or self.spec.effects:
+            return
+        if self.spec.free_contact:
+            pc = np.array([self.solution.parameters[f"c.{n}"] for n in contact.param_names()])
+        else:
+            pc = gait_ocp.contact_params_of(self.spec)
+        vs = gait_ocp.slip_velocities(ChildModel(), q[list(cv.COORDS)].to_numpy(), qd[list(cv.COORDS)].to_numpy(), pc)
+        self.ellipsoids = e.assign(**{f"vs_{lab}": vs[i] for i, lab in enumerate(ELLIPSOID_LABELS)})
 
     @property
     def success(self) -> bool:
@@ -1278,6 +1295,47 @@ def _ch7_consistent() -> list[Row]:
 # ======================================================================================
 # The card
 # ======================================================================================
+#: The verdicts that count a row as (at least qualitatively) reproduced.
+_AGREE = ("reproduced", "within data SD", "qualitatively reproduced")
+
+
+def slip_table(card: pd.DataFrame) -> pd.DataFrame:
+    """Foot slip (:func:`gaitlib.studies.fidelity.foot_slip`, a measurement, not a validity
+    gate) of every stored gait solution a card row names (``gait/<key>`` in its ``solution``
+    column): chapter, the solution, its rows, the force-weighted slip speed of the loaded
+    feet (m/s), the share of the load carried while sliding faster than the friction law's
+    v_tr (%), the walking speed (m/s) and the row verdicts it carries."""
+    out = []
+    ids = card["solution"].str.extract(r"^(gait/[0-9a-f]{16})", expand=False)
+    for sid, part in card.groupby(ids, sort=False):
+        sol = stored_gait(cache.default_dir() / sid)
+        if sol is None:
+            continue
+        f = fidelity.foot_slip(sol)
+        out.append({"chapter": int(part["chapter"].iloc[0]), "solution": part["solution"].iloc[0], "rows": len(part),
+                    "slip (m/s)": f["slip"], f"load sliding > {fidelity.SLIP_V:g} m/s (%)": 100 * f["sliding"],
+                    "walking speed (m/s)": f["speed"],
+                    "verdicts": ", ".join(f"{k} {v}" for k, v in part["verdict"].value_counts().items()),
+                    "rows counted as reproduced": int(part["verdict"].isin(_AGREE).sum())})
+    return pd.DataFrame(out)
+
+
+def slip_lines(table: pd.DataFrame) -> list[str]:
+    """Sentences on :func:`slip_table`: how many of the card's gait solutions (and rows) slide
+    faster than v_tr on average, the range, and how many rows would change verdict if foot
+    slip were a gate (the rows not already invalid or not comparable)."""
+    if table.empty:
+        return []
+    v = fidelity.SLIP_V
+    over = table[table["slip (m/s)"] > v]
+    carried = int(over["rows counted as reproduced"].sum())
+    return [f"Of the {len(table)} stored gait solutions behind the card's rows, {len(over)} carry their load on feet "
+            f"that slide faster than the friction law's sticking limit v_tr = {v:g} m/s on average (force-weighted "
+            f"slip {table['slip (m/s)'].min():.2f}–{table['slip (m/s)'].max():.2f} m/s; a standing foot does not "
+            f"slide). They back {int(over['rows'].sum())} rows, {carried} of them now reproduced, within data SD or "
+            "qualitatively reproduced. Foot slip is measured here, not yet a validity gate."]
+
+
 def build(chapters=(3, 4, 5, 6, 7)) -> pd.DataFrame:
     """The report card (module docstring) from the stored solutions; never solves
     (:func:`gaitlib.cache.only`: a missing solution is a "not comparable" row)."""

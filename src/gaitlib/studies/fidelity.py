@@ -25,6 +25,7 @@ import casadi as ca
 import numpy as np
 import pandas as pd
 
+from .. import contact as contact_mod
 from .. import conventions as cv
 from .. import data as data_mod
 from .. import kinematics
@@ -123,6 +124,7 @@ def ablation_row(label: str, sol: gait_ocp.GaitSolution) -> dict:
             "objective": sol.stats["objective"],
             "swing load (N)": float(tab.loc["swing_load", "value"]),
             "double support (%)": float(tab.loc["double_support", "value"]),
+            "foot slip (m/s)": foot_slip(sol)["slip"],
             "worst angle RMSE (deg)": float(worst.get("angle", np.nan)),
             "worst torque RMSE (N·m)": float(worst.get("torque", np.nan)),
             "worst GRF RMSE (N)": float(worst.get("grf", np.nan)),
@@ -282,6 +284,8 @@ TARGET_FACTOR = 1.5
 METATARSAL_FREE = "metatarsal untracked"
 #: The Ch 5 ablation's row that normalises the tracked channels by the data's SD, not range.
 SD_NORM = "tracking normalised by the data's SD"
+#: The Ch 5 ablation's row with every ellipsoid's friction at least :data:`FRICTION_FLOOR`.
+FRICTION_ROW = "friction at least Table 4.18's toe μ_d (no skating ball)"
 #: The Ch 5 ablation's row of the same problem with its defects in integral form.
 INTEGRAL_DEFECTS = "defects in integral form (the same NLP)"
 
@@ -301,7 +305,9 @@ def ch5_changes(model: str = "MSK") -> dict[str, dict]:
     data's between-subject SD instead of its range (Eqs 4.9–4.11; :attr:`GaitSpec.track_norm`,
     each term's total weight kept), and the left leg tracked as the right leg's samples
     shifted instead of Eqs 4.1–4.3's five-harmonic series (:attr:`GaitSpec.fourier_order`;
-    the row the Ch 4 (c) ablation also has). The last row,
+    the row the Ch 4 (c) ablation also has); and :data:`FRICTION_ROW`, every ellipsoid's
+    friction coefficients at least :data:`FRICTION_FLOOR` (the ball's identified μ ≈ 0.01 lets
+    a loaded foot slide, :func:`foot_slip`). The last row,
     :data:`INTEGRAL_DEFECTS`, changes no problem: the same NLP with its collocation defects in
     integral form (:attr:`GaitSpec.defects`, an invertible linear map of the rows, so the same
     feasible set and optima), which IPOPT walks along another path — how much of the misfit
@@ -321,6 +327,7 @@ def ch5_changes(model: str = "MSK") -> dict[str, dict]:
         **({_no_mtb(f"{METATARSAL_FREE} + coordinate weight ×{MTB_FREE_Q / w['Q']:g}"):
             {"track_mtp": False, "weights": (("Q", MTB_FREE_Q), ("Mtb", 0.0))}} if "Mtb" in w else {}),
         SD_NORM: {"track_norm": "sd"},
+        FRICTION_ROW: {"friction_floor": FRICTION_FLOOR},
         ci_study.LEFT_SHIFTED_ROW: {"fourier_order": gait_ocp.EXACT_FOURIER_ORDER},
         INTEGRAL_DEFECTS: {"defects": "integral"},
     }
@@ -429,7 +436,8 @@ def ch5_ablation_findings(table: pd.DataFrame, per_channel: pd.DataFrame, floor:
 
 
 def single_change_findings(table: pd.DataFrame, per_channel: pd.DataFrame,
-                           rows: tuple = (SD_NORM, ci_study.LEFT_SHIFTED_ROW), n_moves: int = 4) -> list[str]:
+                           rows: tuple = (SD_NORM, ci_study.LEFT_SHIFTED_ROW, FRICTION_ROW),
+                           n_moves: int = 4) -> list[str]:
     """One sentence per ``rows`` entry of a Ch 5 ablation (:func:`ch5_ablation`; ``per_channel``:
     its :func:`channel_table` over the usable runs) beside the book's run (:data:`CH5_BASE_ROW`):
     the worst RMSE per kind, the ``n_moves`` channels whose RMSE moved most relative to their
@@ -728,12 +736,66 @@ def cot_findings(readings: pd.DataFrame, readings_unloaded: pd.DataFrame, sol, s
 # Ch 7: the COT–speed curve of one consistent problem on valid gaits
 # ======================================================================================
 
-def consistent_speed_study(**kw):
+#: The slip speed above which the friction law models sliding, m/s: its transition velocity
+#: v_tr (:class:`gaitlib.contact.Smoothing`; Brown & McPhee's 0.1 m/s, thesis Sec 3.4.3).
+SLIP_V = contact_mod.Smoothing.v_transition
+
+
+def foot_slip(sol, v: float = SLIP_V) -> dict:
+    """How fast a gait solution's loaded feet slide (a measurement, not a validity gate).
+
+    From ``sol.ellipsoids`` (``fn_<label>``, N; ``vs_<label>``: the tangential velocity of
+    the body point the friction law reads, m/s — :meth:`gaitlib.model.ChildModel.slip`),
+    each node weighted by the share of the cycle it stands for: ``slip`` — the mean of |vs|
+    weighted by the normal force (m/s); ``sliding`` — the share of the load (force × time)
+    carried while sliding faster than ``v`` (0…1); ``speed`` — the walking speed the spec's
+    data give (m/s), for scale; ``worst`` — the ellipsoid carrying the most slip × load. A
+    stance foot stands still: in the friction law anything slower than v_tr is sticking."""
+    e = sol.ellipsoids
+    cols = [c for c in e.columns if c.startswith("vs_")]
+    if not cols:
+        raise ValueError(f"{getattr(sol, 'name', 'solution')}: no slip velocities (vs_ columns) in its ellipsoids frame")
+    fn = np.clip(e[["fn_" + c[3:] for c in cols]].to_numpy(float), 0.0, None)
+    vs = np.abs(e[cols].to_numpy(float))
+    t = e.index.to_numpy(float)
+    tf = float(sol.stats.get("tf_s", t[-1]))
+    w = (np.diff(np.append(t, tf)) / (tf - t[0]))[:, None]
+    load = float((w * fn).sum())
+    gd = data_mod.load_gait_data(sol.spec.speed_class, sol.spec.source)
+    return {"slip": float((w * fn * vs).sum() / load), "sliding": float((w * fn * (vs > v)).sum() / load),
+            "speed": float(gd.speed), "worst": cols[int(np.argmax((w * fn * vs).sum(axis=0)))][3:]}
+
+
+def slip_table(solutions: dict, v: float = SLIP_V) -> pd.DataFrame:
+    """:func:`foot_slip` of each solution (run label → solution) as a table: force-weighted
+    slip speed (m/s), share of the load carried sliding faster than ``v`` (%), the walking
+    speed (m/s) and the ellipsoid that slides most under load."""
+    rows = {}
+    for k, s in solutions.items():
+        if s is None:
+            continue
+        f = foot_slip(s, v)
+        rows[k] = {"walking speed (m/s)": f["speed"], "slip, force-weighted (m/s)": f["slip"],
+                   f"load carried sliding > {v:g} m/s (%)": 100 * f["sliding"], "slides most": f["worst"]}
+    return pd.DataFrame.from_dict(rows, orient="index")
+
+
+#: The friction floor of the sliding ablation (:attr:`GaitSpec.friction_floor`): the largest
+#: dynamic friction coefficient the thesis's final identification gives any ellipsoid
+#: (Table 4.18, toe μ_d 0.2819); its ball ellipsoid, which carries most of the load, has 0.0100.
+FRICTION_FLOOR = 0.2819
+
+
+def consistent_speed_study(friction_floor: float | None = None, **kw):
     """Thesis Ch 7's NMSK DT problem at **every** speed class, *Free* included (same cost,
     activation parameters and parameter sets at each speed; Free data scaled in time), with
     the swing foot unloaded (:func:`swing_bound`), warm-started from the swing-unloaded
-    Ch 5 NMSK solution (:func:`gaitlib.studies.predictive.speed_study`)."""
+    Ch 5 NMSK solution (:func:`gaitlib.studies.predictive.speed_study`). ``friction_floor``:
+    every ellipsoid's friction coefficients at least this (:attr:`GaitSpec.friction_floor`,
+    e.g. :data:`FRICTION_FLOOR`), the Ch 5 start solved with the same floor."""
     params = {**pr.default_params(), "swing_load_max": swing_bound()}
+    if friction_floor is not None:
+        params["friction_floor"] = float(friction_floor)
     return pr.speed_study(models=("NMSK",), classes=cv.SPEED_CLASSES, params=params, **kw)
 
 
@@ -748,6 +810,40 @@ def cot_terms(cot: pd.DataFrame, solutions: dict) -> pd.DataFrame:
         br = msk.cot_breakdown(solutions[r["source"]]).iloc[:, 0]
         rows[cls] = {"speed (m/s)": r["speed (m/s)"], **br.to_dict()}
     return pd.DataFrame(rows).T
+
+
+def skating_findings(cot: pd.DataFrame, slip: pd.DataFrame, cot_f: pd.DataFrame, slip_f: pd.DataFrame,
+                     terms_f: pd.DataFrame, floor: float = FRICTION_FLOOR) -> list[str]:
+    """The consistent curve's runs (``cot``, ``slip``: :func:`gaitlib.studies.predictive.cot_table`
+    and :func:`slip_table`, rows by class) beside the same problem with every ellipsoid's
+    friction at least ``floor`` (``cot_f``, ``slip_f``, ``terms_f``: :func:`cot_terms`): how
+    fast the loaded feet slide at each speed, and where the curve's minimum is once they
+    cannot skate. Runs marked (not converged or failing a gate) are named and left out."""
+    col = "slip, force-weighted (m/s)"
+    share = [c for c in slip.columns if c.startswith("load carried")][0]
+    ok = [c for c in cot.index if not cot.loc[c, "mark"] and c in slip.index]
+    out = []
+    if ok:
+        sp = ", ".join(f"{c} {slip.loc[c, col]:.2f} m/s ({slip.loc[c, share]:.0f} % of the load)" for c in ok)
+        out.append(f"**The loaded feet slide.** Force-weighted slip speed of the consistent runs: {sp} — the "
+                   f"friction law models sticking below {SLIP_V:g} m/s, and a standing foot does not slide. The ball "
+                   "ellipsoid, which carries most of the load, has μ_s ≈ μ_d ≈ 0.01 (Table 4.18 and our Ch 4 "
+                   "identification alike), so sliding on it costs almost no friction.")
+    okf = [c for c in cot_f.index if not cot_f.loc[c, "mark"] and c in slip_f.index]
+    bad = [f"{c} ({cot_f.loc[c, 'mark']})" for c in cot_f.index if cot_f.loc[c, "mark"]]
+    if okf:
+        sp = ", ".join(f"{c} {slip_f.loc[c, col]:.2f} m/s" for c in okf)
+        pts = ", ".join(f"{c} {cot_f.loc[c, 'COT (J/kg/m)']:.2f}" for c in okf)
+        at = cot_f.loc[okf, "COT (J/kg/m)"].astype(float).idxmin()
+        out.append(f"**With every ellipsoid's friction at least {floor:g}** (Table 4.18's largest, the toe's μ_d; "
+                   f"`GaitSpec(friction_floor=…)`, the start solved with the same floor), {len(okf)} of {len(cot_f)} "
+                   f"runs converge to valid gaits; their slip: {sp}; COT (J kg⁻¹ m⁻¹): {pts} — minimum at **{at}**"
+                   + (", the natural speed." if at == "Free" else ", not at the natural speed.")
+                   + (f" Left out (marked): {'; '.join(bad)}." if bad else ""))
+    elif bad:
+        out.append(f"**With every ellipsoid's friction at least {floor:g}** no run converges to a valid gait "
+                   f"({'; '.join(bad)}): no conclusion is drawn.")
+    return out
 
 
 def cot_curve_findings(cot: pd.DataFrame, terms: pd.DataFrame, min_points: int = 3,

@@ -1,0 +1,92 @@
+"""Foot slip (gaitlib.studies.fidelity.foot_slip, a measurement) and the friction floor
+(GaitSpec.friction_floor): the model's slip velocity on a translating pose by hand, the
+same velocity the friction law reads, the force-weighted mean slip by hand, and the
+floor's effect on the contact parameters and keys."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from gaitlib import contact, kinematics
+from gaitlib import conventions as cv
+from gaitlib import data as data_mod
+from gaitlib.model import ChildModel
+from gaitlib.problems import gait as gait_ocp
+from gaitlib.studies import fidelity
+
+
+def _standing(model, sink=0.004):
+    q = np.zeros(len(cv.COORDS))
+    q[1] = kinematics.settle_height(model, q) - sink  # feet a few mm in the ground
+    return q
+
+
+def test_a_translating_pose_slips_at_its_speed_and_the_friction_law_reads_that_slip():
+    model = ChildModel()
+    q = _standing(model)
+    v = 0.37
+    qd = np.zeros(len(cv.COORDS))
+    qd[0] = v  # the whole body moves forward, nothing rotates
+    r = model.slip(q, qd)
+    fn = np.ravel(r["fn"])
+    assert (fn > 1.0).sum() >= 2  # some ellipsoids carry load
+    np.testing.assert_allclose(np.ravel(r["v_slip"]), v, atol=1e-12)
+    # the contact function's friction force is −μ(v_slip) fn with the same v_slip
+    ct = model.contact(q, qd)
+    p = contact.default_params()
+    for i, e in enumerate(cv.ELLIPSOIDS * 2):
+        mu = contact.friction_coefficient(v, p[contact.param_index(e, "mu_s")], p[contact.param_index(e, "mu_d")])
+        assert float(np.ravel(ct["fx"])[i]) == pytest.approx(-mu * fn[i], rel=1e-9, abs=1e-12)
+    # standing still: no slip
+    np.testing.assert_allclose(np.ravel(model.slip(q, np.zeros(len(cv.COORDS)))["v_slip"]), 0.0, atol=1e-12)
+
+
+def _solution(vs, fn, t, tf=1.0):
+    """A stand-in solution: two ellipsoids' normal forces and slip velocities, Free data."""
+    labs = [f"{e}_{s}" for s in cv.SIDES for e in cv.ELLIPSOIDS][:2]
+    ell = pd.DataFrame({**{f"fn_{lab}": fn[:, j] for j, lab in enumerate(labs)},
+                        **{f"vs_{lab}": vs[:, j] for j, lab in enumerate(labs)}}, index=pd.Index(t, name="time"))
+    return SimpleNamespace(ellipsoids=ell, stats={"tf_s": tf}, spec=gait_ocp.GaitSpec(model="SK"))
+
+
+def test_foot_slip_is_the_force_weighted_mean_slip_by_hand():
+    t = np.array([0.0, 0.25, 0.5, 0.75])  # four equal quarters of a 1-s cycle
+    fn = np.array([[100.0, 0.0], [300.0, 100.0], [0.0, 200.0], [100.0, 100.0]])
+    vs = np.array([[0.0, 5.0], [0.2, -0.1], [9.0, 0.05], [0.0, 0.0]])
+    # Σ fn|vs| = 300·0.2 + 100·0.1 + 200·0.05 = 80; Σ fn = 900 → 0.0889 m/s (equal time weights)
+    f = fidelity.foot_slip(_solution(vs, fn, t))
+    assert f["slip"] == pytest.approx(80.0 / 900.0)
+    assert f["sliding"] == pytest.approx(300.0 / 900.0)  # the load carried faster than 0.1 m/s
+    assert f["worst"] == "toe_r" and fidelity.SLIP_V == 0.1
+    assert f["speed"] == pytest.approx(data_mod.load_gait_data("Free").speed)
+    # unequal time weights: the last node stands for half the cycle
+    f2 = fidelity.foot_slip(_solution(vs, fn, t, tf=1.25))
+    w = np.array([0.2, 0.2, 0.2, 0.4])
+    num = (w[:, None] * fn * np.abs(vs)).sum()
+    assert f2["slip"] == pytest.approx(num / (w[:, None] * fn).sum())
+    with pytest.raises(ValueError, match="no slip velocities"):
+        fidelity.foot_slip(SimpleNamespace(ellipsoids=_solution(vs, fn, t).ellipsoids.filter(like="fn_"),
+                                           stats={}, spec=gait_ocp.GaitSpec(model="SK")))
+
+
+def test_friction_floor_raises_only_the_coefficients_below_it_and_keeps_keys():
+    spec = gait_ocp.GaitSpec(model="MSK", cost="Eq5.33", n_intervals=2, degree=2)
+    assert "friction_floor" not in spec.to_dict()
+    fl = replace(spec, friction_floor=0.2819)
+    assert fl.key() != spec.key() and replace(spec, friction_floor=None).key() == spec.key()
+    assert gait_ocp.GaitSpec.from_dict(fl.to_dict()) == fl
+    base, raised = gait_ocp.contact_params_of(spec), gait_ocp.contact_params_of(fl)
+    changed = {i for i in range(base.size) if base[i] != raised[i]}
+    # Table 4.18: ball μ_s 0.0101, μ_d 0.0100 and heel μ_s 0.1703, μ_d 0.1686 are below it; toe (0.3404, 0.2819) is not
+    expect = {contact.param_index(e, k) for e in ("ball", "heel") for k in ("mu_s", "mu_d")}
+    assert changed == expect and all(raised[i] == 0.2819 for i in expect)
+    for bad in (0.0, -1.0, 3.0, "0.3"):
+        with pytest.raises(ValueError, match="friction_floor"):
+            replace(spec, friction_floor=bad)
+    with pytest.raises(ValueError, match="free_contact"):
+        replace(spec, friction_floor=0.3, free_contact=True)
