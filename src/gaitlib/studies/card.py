@@ -1288,8 +1288,37 @@ def _ch7_consistent() -> list[Row]:
     ours = ", ".join(f"{c} {v:.2f}" for c, v in terms["total"].items()) + f" (minimum at {at})"
     cause = fidelity.cot_curve_findings(cot, terms)[-1] if at != "Free" else ""
     where = _anchor("ch07_speed", "One consistent problem on valid gaits")
-    return [Row(7, item, "U, minimum at natural speed", ours, "", f"{cause} [{where}]" if cause else "unknown",
+    cause = f"{cause} [{where}]" if cause else ""
+    skate = _skating_cause(cot, res)
+    cause = "; ".join(x for x in (cause, skate) if x) or "unknown"
+    return [Row(7, item, "U, minimum at natural speed", ours, "", cause,
                 "Ch 7 NMSK DT, swing unloaded", _joint(valid), holds=at == "Free")]
+
+
+def _skating_cause(cot: pd.DataFrame, res) -> str:
+    """The consistent runs' foot slip and the same problem with the friction floor (Ch 7,
+    "The feet skate"): where its curve has its minimum, from the converged, valid runs."""
+    slip = fidelity.slip_table({s.spec.speed_class: s for s in res.solutions.values()})
+    col = "slip, force-weighted (m/s)"
+    text = (f"the loaded feet slide at {slip[col].min():.2f}–{slip[col].max():.2f} m/s (force-weighted; the friction "
+            f"law sticks below {fidelity.SLIP_V:g} m/s)")
+    try:
+        res_f0 = fidelity.consistent_speed_study(friction_floor=fidelity.FRICTION_FLOOR, progress=False)
+        res_f = res_f0.with_reruns(res_f0.rerun_failed(max_iter=3000))
+    except cache.NotCached:
+        return text + " — the same problem with friction not stored"
+    cot_f = pr.cot_table(res_f)
+    ok = [c for c in cot_f.index if not cot_f.loc[c, "mark"]]
+    where = _anchor("ch07_speed", "The feet skate: the same problem with friction")
+    if not ok:
+        return text + f"; with every ellipsoid's friction ≥ {fidelity.FRICTION_FLOOR:g} no run is a converged, valid gait [{where}]"
+    slip_f = fidelity.slip_table({s.spec.speed_class: s for s in res_f.solutions.values()})
+    at = cot_f.loc[ok, "COT (J/kg/m)"].astype(float).idxmin()
+    used = f"; {', '.join(res_f.rerun_used)} through {'its' if len(res_f.rerun_used) == 1 else 'their'} 3000-iteration rerun" \
+        if res_f.rerun_used else ""
+    return (text + f"; with every ellipsoid's friction ≥ {fidelity.FRICTION_FLOOR:g} ({len(ok)} of {len(cot_f)} runs "
+            f"converged and valid{used}, slip {slip_f.loc[ok, col].min():.2f}–{slip_f.loc[ok, col].max():.2f} m/s): "
+            + ", ".join(f"{c} {cot_f.loc[c, 'COT (J/kg/m)']:.2f}" for c in ok) + f", minimum at {at} [{where}]")
 
 
 # ======================================================================================
