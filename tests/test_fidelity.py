@@ -323,3 +323,20 @@ def test_single_change_findings_by_hand():
     t.loc[fidelity.SD_NORM, "gates"] = "invalid: swing load"
     (line,) = fidelity.single_change_findings(t, ch, rows=(fidelity.SD_NORM,))
     assert line.startswith(f"- {fidelity.SD_NORM}: not compared") and "→" not in line
+
+
+def test_skating_findings_by_hand():
+    cls = ["Slow", "Free", "Fast"]
+    cot = pd.DataFrame({"mark": ["", "", ""], "COT (J/kg/m)": [4.0, 5.0, 3.0]}, index=cls)
+    slip = pd.DataFrame({"slip, force-weighted (m/s)": [0.5, 0.8, 1.2],
+                         "load carried sliding > 0.1 m/s (%)": [70.0, 90.0, 95.0]}, index=cls)
+    cot_f = pd.DataFrame({"mark": ["", "", "NOT CONVERGED: Maximum_Iterations_Exceeded"],
+                          "COT (J/kg/m)": [6.0, 5.5, 5.0]}, index=cls)
+    slip_f = pd.DataFrame({"slip, force-weighted (m/s)": [0.02, 0.15, 0.3],
+                           "load carried sliding > 0.1 m/s (%)": [1.0, 20.0, 30.0]}, index=cls)
+    a, b = fidelity.skating_findings(cot, slip, cot_f, slip_f, pd.DataFrame(), floor=0.3, reruns=("Slow",))
+    assert "Slow 0.50 m/s (70 % of the load), Free 0.80 m/s (90 % of the load), Fast 1.20 m/s" in a
+    assert "2 of 3 runs converge to valid gaits (Slow through its 3000-iteration rerun)" in b
+    # the marked Fast run is left out of the minimum: Free 5.5 < Slow 6.0
+    assert "minimum at **Free**, the natural speed." in b and "Left out (marked): Fast (NOT CONVERGED" in b
+    assert "Still sliding faster than 0.1 m/s: Free — the minimum's own run" in b

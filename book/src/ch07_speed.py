@@ -242,7 +242,8 @@ if res_f is not None:
     fig = pr.cot_figure(cot_f, label=f"ours: one problem, friction ≥ {fidelity.FRICTION_FLOOR:g} (converged, valid)")
     display(pd.concat({"as identified": slip_u, f"friction ≥ {fidelity.FRICTION_FLOOR:g}": slip_f}, axis=1),
             cot_f, terms_f)
-    display(Markdown("\n\n".join(fidelity.skating_findings(cot_u, slip_u, cot_f, slip_f, terms_f)
+    display(Markdown("\n\n".join(fidelity.skating_findings(cot_u, slip_u, cot_f, slip_f, terms_f,
+                                                            reruns=tuple(k.split()[-1] for k in res_f.rerun_used))
                                   + fidelity.cot_curve_findings(cot_f, terms_f, name="The curve with the friction floor"))))
 else:
     display(slip_u)

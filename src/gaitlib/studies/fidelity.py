@@ -813,12 +813,13 @@ def cot_terms(cot: pd.DataFrame, solutions: dict) -> pd.DataFrame:
 
 
 def skating_findings(cot: pd.DataFrame, slip: pd.DataFrame, cot_f: pd.DataFrame, slip_f: pd.DataFrame,
-                     terms_f: pd.DataFrame, floor: float = FRICTION_FLOOR) -> list[str]:
+                     terms_f: pd.DataFrame, floor: float = FRICTION_FLOOR, reruns: tuple = ()) -> list[str]:
     """The consistent curve's runs (``cot``, ``slip``: :func:`gaitlib.studies.predictive.cot_table`
     and :func:`slip_table`, rows by class) beside the same problem with every ellipsoid's
     friction at least ``floor`` (``cot_f``, ``slip_f``, ``terms_f``: :func:`cot_terms`): how
     fast the loaded feet slide at each speed, and where the curve's minimum is once they
-    cannot skate. Runs marked (not converged or failing a gate) are named and left out."""
+    cannot skate. Runs marked (not converged or failing a gate) are named and left out;
+    ``reruns``: the classes whose 3000-iteration rerun stands in (named)."""
     col = "slip, force-weighted (m/s)"
     share = [c for c in slip.columns if c.startswith("load carried")][0]
     ok = [c for c in cot.index if not cot.loc[c, "mark"] and c in slip.index]
@@ -835,10 +836,17 @@ def skating_findings(cot: pd.DataFrame, slip: pd.DataFrame, cot_f: pd.DataFrame,
         sp = ", ".join(f"{c} {slip_f.loc[c, col]:.2f} m/s" for c in okf)
         pts = ", ".join(f"{c} {cot_f.loc[c, 'COT (J/kg/m)']:.2f}" for c in okf)
         at = cot_f.loc[okf, "COT (J/kg/m)"].astype(float).idxmin()
+        still = [c for c in okf if slip_f.loc[c, col] > SLIP_V]
+        still_txt = (f" Still sliding faster than {SLIP_V:g} m/s: {', '.join(still)}"
+                     + (" — the minimum's own run: the floor stops the ball's skating, not every slide."
+                        if at in still else ".") if still else
+                     f" Every one of them keeps its feet below {SLIP_V:g} m/s.")
         out.append(f"**With every ellipsoid's friction at least {floor:g}** (Table 4.18's largest, the toe's μ_d; "
                    f"`GaitSpec(friction_floor=…)`, the start solved with the same floor), {len(okf)} of {len(cot_f)} "
-                   f"runs converge to valid gaits; their slip: {sp}; COT (J kg⁻¹ m⁻¹): {pts} — minimum at **{at}**"
-                   + (", the natural speed." if at == "Free" else ", not at the natural speed.")
+                   f"runs converge to valid gaits"
+                   + (f" ({', '.join(reruns)} through {'its 3000-iteration rerun' if len(reruns) == 1 else 'their 3000-iteration reruns'})"
+                      if reruns else "") + f"; their slip: {sp}; COT (J kg⁻¹ m⁻¹): {pts} — minimum at **{at}**"
+                   + (", the natural speed." if at == "Free" else ", not at the natural speed.") + still_txt
                    + (f" Left out (marked): {'; '.join(bad)}." if bad else ""))
     elif bad:
         out.append(f"**With every ellipsoid's friction at least {floor:g}** no run converges to a valid gait "
