@@ -85,7 +85,7 @@ def test_friction_floor_raises_only_the_coefficients_below_it_and_keeps_keys():
     # Table 4.18: ball μ_s 0.0101, μ_d 0.0100 and heel μ_s 0.1703, μ_d 0.1686 are below it; toe (0.3404, 0.2819) is not
     expect = {contact.param_index(e, k) for e in ("ball", "heel") for k in ("mu_s", "mu_d")}
     assert changed == expect and all(raised[i] == 0.2819 for i in expect)
-    for bad in (0.0, -1.0, 3.0, "0.3"):
+    for bad in (0.0, -1.0, 3.0, "0.3", True):
         with pytest.raises(ValueError, match="friction_floor"):
             replace(spec, friction_floor=bad)
     with pytest.raises(ValueError, match="free_contact"):

@@ -411,7 +411,8 @@ class GaitSpec:
         if self.jerk_ranges not in (None,) + JERK_RANGES:
             raise ValueError(f"jerk_ranges must be None or one of {JERK_RANGES}, got {self.jerk_ranges!r}")
         if self.friction_floor is not None:
-            if not (isinstance(self.friction_floor, (int, float)) and 0.0 < float(self.friction_floor) <= 2.0):
+            if (isinstance(self.friction_floor, bool) or not isinstance(self.friction_floor, (int, float))
+                    or not 0.0 < float(self.friction_floor) <= 2.0):
                 raise ValueError(f"friction_floor must be None or a friction coefficient in (0, 2], "
                                  f"got {self.friction_floor!r}")
             if self.free_contact:

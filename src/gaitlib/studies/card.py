@@ -1314,8 +1314,9 @@ def _skating_cause(cot: pd.DataFrame, res) -> str:
         return text + f"; with every ellipsoid's friction ≥ {fidelity.FRICTION_FLOOR:g} no run is a converged, valid gait [{where}]"
     slip_f = fidelity.slip_table({s.spec.speed_class: s for s in res_f.solutions.values()})
     at = cot_f.loc[ok, "COT (J/kg/m)"].astype(float).idxmin()
-    used = f"; {', '.join(res_f.rerun_used)} through {'its' if len(res_f.rerun_used) == 1 else 'their'} 3000-iteration rerun" \
-        if res_f.rerun_used else ""
+    used = (f"; {', '.join(res_f.rerun_used)} through "
+            f"{'its 3000-iteration rerun' if len(res_f.rerun_used) == 1 else 'their 3000-iteration reruns'}"
+            if res_f.rerun_used else "")
     return (text + f"; with every ellipsoid's friction ≥ {fidelity.FRICTION_FLOOR:g} ({len(ok)} of {len(cot_f)} runs "
             f"converged and valid{used}, slip {slip_f.loc[ok, col].min():.2f}–{slip_f.loc[ok, col].max():.2f} m/s): "
             + ", ".join(f"{c} {cot_f.loc[c, 'COT (J/kg/m)']:.2f}" for c in ok) + f", minimum at {at} [{where}]")
