@@ -63,6 +63,7 @@ def test_foot_slip_is_the_force_weighted_mean_slip_by_hand():
     assert f["slip"] == pytest.approx(80.0 / 900.0)
     assert f["sliding"] == pytest.approx(300.0 / 900.0)  # the load carried faster than 0.1 m/s
     assert f["worst"] == "toe_r" and fidelity.SLIP_V == 0.1
+    assert f["ball"] == pytest.approx(400.0 / 900.0)  # ball_r (second column) carries 0 + 100 + 200 + 100 of 900
     assert f["speed"] == pytest.approx(data_mod.load_gait_data("Free").speed)
     # unequal time weights: the last node stands for half the cycle
     f2 = fidelity.foot_slip(_solution(vs, fn, t, tf=1.25))
@@ -90,3 +91,9 @@ def test_friction_floor_raises_only_the_coefficients_below_it_and_keeps_keys():
             replace(spec, friction_floor=bad)
     with pytest.raises(ValueError, match="free_contact"):
         replace(spec, friction_floor=0.3, free_contact=True)
+
+
+def test_friction_floor_and_ball_friction_read_the_parameter_sets():
+    # Table 4.18 (the thesis's set): ball μ_s 0.0101, μ_d 0.0100; the largest μ_d is the toe's 0.2819
+    assert fidelity.ball_friction("default") == (0.0101, 0.0100)
+    assert fidelity.FRICTION_FLOOR == 0.2819

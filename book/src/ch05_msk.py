@@ -240,8 +240,8 @@ marks.mark_rows(gait.rmse_beside_thesis(msk_sol), marks.failure_label(msk_sol))
 # the right leg's samples shifted instead of the thesis's five-harmonic series (Eqs 4.1–4.3;
 # the row the Ch 4 (c) ablation also has — that run's RMSEs are against the left leg it
 # tracks). One more asks whether the fit leans on feet that slide: every ellipsoid's friction
-# coefficients at least 0.2819 (`fidelity.FRICTION_FLOOR`; the ball ellipsoid, which carries
-# most of the load, has μ ≈ 0.01 in Table 4.18 and in our Ch 4 identification — the
+# coefficients at least 0.2819 (`fidelity.FRICTION_FLOOR`, Table 4.18's toe μ_d; the thesis's
+# ball ellipsoid has μ 0.01, Table 4.7's lower bound, and Ch 7 gives ours — the
 # *foot slip* column gives each run's force-weighted slip speed of the loaded feet, which the
 # friction law treats as sticking below 0.1 m/s). The last row changes no problem: the same NLP with its collocation defects written
 # in integral form (`GaitSpec(defects="integral")`: an invertible linear map of the defect

@@ -210,11 +210,12 @@ display(Markdown("\n\n".join(fidelity.cot_curve_findings(cot_u, terms_u))))
 # tangential velocity of each ellipsoid's body point at its penetration centroid
 # (`ChildModel.slip`); below the transition velocity v_tr = 0.1 m/s it models sticking.
 # `fidelity.foot_slip` averages that speed over the cycle and the six ellipsoids, weighted
-# by the normal force. The ball ellipsoid carries most of the load and has μ_s ≈ μ_d ≈ 0.01
-# in the thesis's Table 4.18 and in our Ch 4 identification alike, so a loaded foot can
-# slide almost for free. The same consistent problem is solved again with one change:
-# every ellipsoid's friction coefficients at least 0.2819 (`fidelity.FRICTION_FLOOR`, the
-# largest coefficient Table 4.18 gives any ellipsoid: the toe's μ_d; `GaitSpec(friction_floor=…)`,
+# by the normal force. The thesis's Table 4.18 gives the ball ellipsoid μ_s 0.0101 and
+# μ_d 0.0100 — Table 4.7's lower bound — so sliding on it costs almost no friction (the
+# sentences below give our Ch 4 set's values and the ball's share of the load). The same
+# consistent problem is solved again with one change: every ellipsoid's friction
+# coefficients at least `fidelity.FRICTION_FLOOR` (the largest coefficient Table 4.18 gives
+# any ellipsoid: the toe's μ_d, 0.2819; `GaitSpec(friction_floor=…)`,
 # the Ch 5 start solved with the same floor) — **our change**, labelled, everything else as
 # above. A run that stops at the 1000-iteration limit counts through its converged, valid
 # 3000-iteration rerun from the same start (the chapter's rule), named below.

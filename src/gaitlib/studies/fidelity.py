@@ -29,6 +29,7 @@ from .. import contact as contact_mod
 from .. import conventions as cv
 from .. import data as data_mod
 from .. import kinematics
+from .. import params as params_mod
 from .. import validity
 from ..model import ChildModel
 from ..problems import gait as gait_ocp
@@ -749,7 +750,8 @@ def foot_slip(sol, v: float = SLIP_V) -> dict:
     each node weighted by the share of the cycle it stands for: ``slip`` — the mean of |vs|
     weighted by the normal force (m/s); ``sliding`` — the share of the load (force × time)
     carried while sliding faster than ``v`` (0…1); ``speed`` — the walking speed the spec's
-    data give (m/s), for scale; ``worst`` — the ellipsoid carrying the most slip × load. A
+    data give (m/s), for scale; ``worst`` — the ellipsoid carrying the most slip × load;
+    ``ball`` — the share of the load (force × time) on the two ball ellipsoids (0…1). A
     stance foot stands still: in the friction law anything slower than v_tr is sticking."""
     e = sol.ellipsoids
     cols = [c for c in e.columns if c.startswith("vs_")]
@@ -763,7 +765,8 @@ def foot_slip(sol, v: float = SLIP_V) -> dict:
     load = float((w * fn).sum())
     gd = data_mod.load_gait_data(sol.spec.speed_class, sol.spec.source)
     return {"slip": float((w * fn * vs).sum() / load), "sliding": float((w * fn * (vs > v)).sum() / load),
-            "speed": float(gd.speed), "worst": cols[int(np.argmax((w * fn * vs).sum(axis=0)))][3:]}
+            "speed": float(gd.speed), "worst": cols[int(np.argmax((w * fn * vs).sum(axis=0)))][3:],
+            "ball": float(sum((w * fn[:, [j]]).sum() for j, c in enumerate(cols) if c.startswith("vs_ball")) / load)}
 
 
 def slip_table(solutions: dict, v: float = SLIP_V) -> pd.DataFrame:
@@ -776,14 +779,22 @@ def slip_table(solutions: dict, v: float = SLIP_V) -> pd.DataFrame:
             continue
         f = foot_slip(s, v)
         rows[k] = {"walking speed (m/s)": f["speed"], "slip, force-weighted (m/s)": f["slip"],
-                   f"load carried sliding > {v:g} m/s (%)": 100 * f["sliding"], "slides most": f["worst"]}
+                   f"load carried sliding > {v:g} m/s (%)": 100 * f["sliding"], "slides most": f["worst"],
+                   "load on the ball ellipsoids (%)": 100 * f["ball"]}
     return pd.DataFrame.from_dict(rows, orient="index")
+
+
+def ball_friction(which: str = "default") -> tuple[float, float]:
+    """The ball ellipsoid's (μ_s, μ_d) in a contact parameter set (:func:`gaitlib.params.contact_params`:
+    ``"default"`` the thesis's Table 4.18, ``"ch4"`` ours)."""
+    p = params_mod.contact_params(which)
+    return tuple(float(p[contact_mod.param_index("ball", k)]) for k in ("mu_s", "mu_d"))
 
 
 #: The friction floor of the sliding ablation (:attr:`GaitSpec.friction_floor`): the largest
 #: dynamic friction coefficient the thesis's final identification gives any ellipsoid
-#: (Table 4.18, toe μ_d 0.2819); its ball ellipsoid, which carries most of the load, has 0.0100.
-FRICTION_FLOOR = 0.2819
+#: (Table 4.18: the toe's μ_d), read from the thesis's contact set.
+FRICTION_FLOOR = max(float(contact_mod.default_params()[contact_mod.param_index(e, "mu_d")]) for e in cv.ELLIPSOIDS)
 
 
 def consistent_speed_study(friction_floor: float | None = None, **kw):
@@ -826,10 +837,14 @@ def skating_findings(cot: pd.DataFrame, slip: pd.DataFrame, cot_f: pd.DataFrame,
     out = []
     if ok:
         sp = ", ".join(f"{c} {slip.loc[c, col]:.2f} m/s ({slip.loc[c, share]:.0f} % of the load)" for c in ok)
+        ball = [c for c in slip.columns if c.startswith("load on the ball")]
+        share_txt = (f", which carry {slip.loc[ok, ball[0]].min():.0f}–{slip.loc[ok, ball[0]].max():.0f} % of these "
+                     "runs' load," if ball else "")
+        (ts, td), (os_, od) = ball_friction("default"), ball_friction("ch4")
         out.append(f"**The loaded feet slide.** Force-weighted slip speed of the consistent runs: {sp} — the "
                    f"friction law models sticking below {SLIP_V:g} m/s, and a standing foot does not slide. The ball "
-                   "ellipsoid, which carries most of the load, has μ_s ≈ μ_d ≈ 0.01 (Table 4.18 and our Ch 4 "
-                   "identification alike), so sliding on it costs almost no friction.")
+                   f"ellipsoids{share_txt} have μ_s {ts:.4f}, μ_d {td:.4f} in the thesis's Table 4.18 and μ_s {os_:.4f}, "
+                   f"μ_d {od:.4f} in our Ch 4 identification (Table 4.7's lower bound: 0.01).")
     okf = [c for c in cot_f.index if not cot_f.loc[c, "mark"] and c in slip_f.index]
     bad = [f"{c} ({cot_f.loc[c, 'mark']})" for c in cot_f.index if cot_f.loc[c, "mark"]]
     if okf:
