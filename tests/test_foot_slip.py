@@ -17,7 +17,9 @@ from gaitlib import conventions as cv
 from gaitlib import data as data_mod
 from gaitlib.model import ChildModel
 from gaitlib.problems import gait as gait_ocp
+from gaitlib.studies import contact_id as ci_study
 from gaitlib.studies import fidelity
+from gaitlib.studies import gait as gait_study
 
 
 def _standing(model, sink=0.004):
@@ -89,11 +91,49 @@ def test_friction_floor_raises_only_the_coefficients_below_it_and_keeps_keys():
     for bad in (0.0, -1.0, 3.0, "0.3", True):
         with pytest.raises(ValueError, match="friction_floor"):
             replace(spec, friction_floor=bad)
-    with pytest.raises(ValueError, match="free_contact"):
-        replace(spec, friction_floor=0.3, free_contact=True)
+
+
+def test_friction_floor_with_free_contact_raises_the_identification_lower_bounds():
+    # Ch 4 (b)/(c): Table 4.7's friction lower bound is 0.01 for every ellipsoid (contact.bounds);
+    # with the floor every μ_s and μ_d parameter's lower bound is the floor, nothing else moves
+    sb = ci_study.spec_b(n_intervals=2, degree=2)
+    lo, hi = contact.bounds()
+    fr = [contact.param_index(e, k) for e in cv.ELLIPSOIDS for k in ("mu_s", "mu_d")]
+    assert all(lo[i] == 0.01 for i in fr)
+    base = {p.name: p for p in gait_ocp.build(sb).problem.parameters}
+    floored = {p.name: p for p in gait_ocp.build(replace(sb, friction_floor=0.2819)).problem.parameters}
+    names = contact.param_names()
+    moved = {n for n in base if (base[n].lower, base[n].upper) != (floored[n].lower, floored[n].upper)}
+    assert moved == {f"c.{names[i]}" for i in fr}
+    for i in fr:
+        f = floored[f"c.{names[i]}"]
+        assert f.lower == 0.2819 and f.upper == max(hi[i], 0.2819)
 
 
 def test_friction_floor_and_ball_friction_read_the_parameter_sets():
     # Table 4.18 (the thesis's set): ball μ_s 0.0101, μ_d 0.0100; the largest μ_d is the toe's 0.2819
     assert fidelity.ball_friction("default") == (0.0101, 0.0100)
     assert fidelity.FRICTION_FLOOR == 0.2819
+
+
+def _friction_row(status, gates, grf, angle, torque, obj, slip, sliding, mu_d, start="neutral"):
+    v = gait_study.SLIP_V
+    return {"status": status, "gates": gates, "iterations": 1, "objective": obj, "start kept": start,
+            "mean GRF RMSE (N)": grf, "worst angle RMSE (deg)": angle, "worst torque RMSE (N·m)": torque,
+            "foot slip (m/s)": slip, f"load sliding > {v:g} m/s (%)": sliding, "ball mu_s": mu_d, "ball mu_d": mu_d}
+
+
+def test_friction_findings_compare_the_bounded_identification_by_hand():
+    f = 0.2819
+    t = pd.DataFrame.from_dict({
+        ci_study.APPROACHES["b"]: _friction_row("Solve_Succeeded", "valid", 12.5, 2.0, 1.0, 0.013, 0.115, 35.0, 0.0261),
+        ci_study.friction_label("b", f): _friction_row("Solve_Succeeded", "valid", 15.0, 3.0, 1.5, 0.026, 0.013, 1.0, 0.2819),
+        ci_study.APPROACHES["c"]: _friction_row("Solve_Succeeded", "valid", 10.0, 2.0, 1.0, 0.014, 0.114, 30.0, 0.01),
+        ci_study.friction_label("c", f): _friction_row("Maximum_Iterations_Exceeded", "not converged", 99.0, 9.0, 9.0,
+                                                       1.0, 0.0, 0.0, 0.2819, "warm: (b)")}, orient="index")
+    out = ci_study.friction_findings(t, f)
+    assert len(out) == 2
+    # (b): 12.5 → 15.0 N is +20 %; slip 0.115 → 0.013 m/s; load sliding 35 → 1 %
+    assert "12.5 → 15.0 N (+20 %)" in out[0] and "0.115 → 0.013 m/s" in out[0] and "35 → 1 %" in out[0]
+    assert "start kept: neutral" in out[0] and "0.0261 → 0.2819" in out[0]
+    assert out[1].startswith(ci_study.friction_label("c", f) + ": not compared") and "99.0" not in out[1]

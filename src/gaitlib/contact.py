@@ -64,6 +64,7 @@ __all__ = [
     "TABLE_4_17_OUTSIDE_TABLE_4_7",
     "param_names",
     "param_index",
+    "with_friction_floor",
     "ellipsoid_slice",
     "default_params",
     "bounds",
@@ -127,6 +128,17 @@ def param_names() -> list[str]:
 def param_index(ellipsoid: str, name: str) -> int:
     """Index of parameter ``name`` of ``ellipsoid`` in the 39-vector."""
     return ELLIPSOIDS.index(ellipsoid) * N_PER_ELLIPSOID + PARAM_NAMES.index(name)
+
+
+def with_friction_floor(p, floor: float) -> np.ndarray:
+    """A copy of the 39-vector ``p`` (parameters or their bounds) with every ellipsoid's μ_s
+    and μ_d raised to at least ``floor`` (dimensionless); the other entries unchanged."""
+    out = np.array(p, dtype=float)
+    for e in ELLIPSOIDS:
+        for k in ("mu_s", "mu_d"):
+            i = param_index(e, k)
+            out[i] = max(out[i], float(floor))
+    return out
 
 
 def ellipsoid_slice(ellipsoid: str) -> slice:

@@ -267,7 +267,8 @@ class GaitSpec:
         ``"ch4"`` (ours, Ch 4 approach (c), ``data/identified/ch4_child.json``,
         :func:`gaitlib.params.load_identified`). The fixed values, or the guess when free.
     contact_params : ``"default"`` (the thesis's Tables 4.17–4.18) or ``"ch4"`` (ours, as
-        ``body_params``). The fixed values, or the guess when free; also the geometry of the
+        ``body_params``; ``"ch4_friction"`` for both: ours identified with every friction
+        coefficient ≥ the friction floor, :data:`gaitlib.params.IDENTIFIED_CH4`). The fixed values, or the guess when free; also the geometry of the
         HAT-height reference.
     mtg_params : MSK/NMSK MTG fitting parameters (Eq 5.9) of the 12 generators (left leg =
         right leg): ``"default"`` — Eq 5.22, the adult Gymnast curves scaled to the child
@@ -349,8 +350,10 @@ class GaitSpec:
         ellipsoid's μ_s and μ_d (:func:`contact_params_of`). Both the thesis's Table 4.18 and
         our Ch 4 identification put the ball ellipsoid — the one that carries most of the
         load — at μ ≈ 0.01, so a loaded foot can slide almost for free; an ablation of the
-        Fidelity II study measures what a floor on the friction changes. Not with
-        ``free_contact``.
+        Fidelity II study measures what a floor on the friction changes. With
+        ``free_contact`` (Ch 4 (b)/(c)): the lower bound of every μ_s and μ_d raised from
+        Table 4.7's 0.01 to the floor (the identification ablation of
+        :func:`gaitlib.studies.contact_id.c_changes`).
     fourier_order : ``None`` (the thesis's Eqs 4.1–4.3: :data:`FOURIER_ORDER`, 5) or the order
         of the least-squares Fourier series that generates the left leg's data from the right
         leg's (:func:`gaitlib.data.fourier_shift`); :data:`EXACT_FOURIER_ORDER` reproduces the
@@ -415,8 +418,6 @@ class GaitSpec:
                     or not 0.0 < float(self.friction_floor) <= 2.0):
                 raise ValueError(f"friction_floor must be None or a friction coefficient in (0, 2], "
                                  f"got {self.friction_floor!r}")
-            if self.free_contact:
-                raise ValueError("friction_floor fixes the friction coefficients; free_contact identifies them: choose one")
         if self.track_norm not in (None,) + TRACK_NORMS:
             raise ValueError(f"track_norm must be None or one of {TRACK_NORMS}, got {self.track_norm!r}")
         if self.derivatives not in (None, "graph", "nodes"):
@@ -434,12 +435,14 @@ class GaitSpec:
             raise ValueError(f"activation_params must be None or 'ch5', got {self.activation_params!r}")
         if self.activation_params is not None and self.free_activation:
             raise ValueError("activation_params fixes γ; free_activation identifies it: choose one")
-        if self.body_params not in ("default", "thesis", "ch4"):
-            raise ValueError(f"body_params must be 'default', 'thesis' or 'ch4', got {self.body_params!r}")
+        if self.body_params not in ("default", "thesis", *params_mod.IDENTIFIED_CH4):
+            raise ValueError(f"body_params must be 'default', 'thesis' or one of {tuple(params_mod.IDENTIFIED_CH4)}, "
+                             f"got {self.body_params!r}")
         if self.mtg_params not in MTG_PARAM_SETS:
             raise ValueError(f"mtg_params must be one of {MTG_PARAM_SETS}, got {self.mtg_params!r}")
-        if self.contact_params not in ("default", "ch4"):
-            raise ValueError(f"contact_params must be 'default' or 'ch4', got {self.contact_params!r}")
+        if self.contact_params not in ("default", *params_mod.IDENTIFIED_CH4):
+            raise ValueError(f"contact_params must be 'default' or one of {tuple(params_mod.IDENTIFIED_CH4)}, "
+                             f"got {self.contact_params!r}")
         if self.contact_bounds not in ("widened", "table4.7"):
             raise ValueError(f"contact_bounds must be 'widened' or 'table4.7', got {self.contact_bounds!r}")
         if self.excitation_guess not in ("mtg", "emg"):
@@ -472,11 +475,13 @@ class GaitSpec:
 
     def identified_sets(self) -> tuple[str, ...]:
         """Names of the identified parameter sets (``data/identified/<name>.json``) this spec
-        reads: ``"ch4_child"`` for ``contact_params``/``body_params`` ``"ch4"``, ``"ch5_mtg"``
+        reads: ``"ch4_child"`` for ``contact_params``/``body_params`` ``"ch4"`` (``"ch4_friction"``
+        for ``"ch4_friction"``, :data:`gaitlib.params.IDENTIFIED_CH4`), ``"ch5_mtg"``
         for ``mtg_params="ch5"``. Cache keys hash exactly these (:func:`gaitlib.cache.fingerprint`)."""
         sets = []
-        if "ch4" in (self.contact_params, self.body_params):
-            sets.append("ch4_child")
+        for name, stem in params_mod.IDENTIFIED_CH4.items():
+            if name in (self.contact_params, self.body_params):
+                sets.append(stem)
         if self.mtg_params == "ch5":
             sets.append("ch5_mtg")
         if self.activation_params == "ch5":
@@ -619,12 +624,7 @@ def contact_params_of(spec: GaitSpec) -> np.ndarray:
     ``spec.contact_params`` names (:func:`gaitlib.params.contact_params`), with every
     ellipsoid's μ_s and μ_d raised to at least ``spec.friction_floor`` when it is set."""
     p = np.array(params_mod.contact_params(spec.contact_params), dtype=float)
-    if spec.friction_floor is not None:
-        for e in cv.ELLIPSOIDS:
-            for k in ("mu_s", "mu_d"):
-                i = contact_mod.param_index(e, k)
-                p[i] = max(p[i], float(spec.friction_floor))
-    return p
+    return p if spec.friction_floor is None else contact_mod.with_friction_floor(p, spec.friction_floor)
 
 
 def slip_velocities(model: ChildModel, q: np.ndarray, qd: np.ndarray, p_contact) -> np.ndarray:
@@ -1013,6 +1013,9 @@ def build(spec: GaitSpec) -> GaitProblem:
         lo, hi = contact_mod.bounds()  # Table 4.7
         if spec.contact_bounds == "widened":  # … widened to contain the guess
             lo, hi = np.minimum(lo, p_contact), np.maximum(hi, p_contact)
+        if spec.friction_floor is not None:  # the friction coefficients' lower bound raised
+            lo = contact_mod.with_friction_floor(lo, spec.friction_floor)
+            hi = np.maximum(hi, lo)
         for n_, l_, h_, g_ in zip(contact_mod.param_names(), lo, hi, p_contact):
             params.append(Parameter(f"c.{n_}", float(l_), float(h_), float(g_)))
     if spec.free_body:

@@ -372,6 +372,7 @@ def _ch4() -> list[Row]:
     jerk = _jerk_causes("SK")
     a_cause = _ch4_a_cause(table) if "a" in res else ""
     cabl = _ch4c_ablation_causes(res.get("b"))
+    fric = _ch4_friction_causes() if {"b", "c"} <= set(res) else {}
     rows = []
     for k, th in ci.THESIS_RMSE.items():
         if k == "c_wide":
@@ -395,6 +396,8 @@ def _ch4() -> list[Row]:
                 cause = jerk[jk]
             if cause == "unknown" and k == "a" and a_cause:
                 cause = a_cause
+            if k in fric and qty.startswith("grf"):
+                cause = fric[k] if cause == "unknown" else f"{cause}; {fric[k]}"
             item = f"({k}) RMSE {qty}{' ' + side.upper() if side else ''} ({ci.THESIS_RMSE_SOURCE[k]})"
             rows.append(Row(4, item, tv, ours, unit, cause, names.get(k, ""), valid.get(k, ""), sd=sd))
     if {"a", "b", "c"} <= set(res):
@@ -413,6 +416,38 @@ def _ch4() -> list[Row]:
                         _total_mass(res["c"].p_body, masses, ci.P_BODY_NAMES), "kg", "unknown", names["c"],
                         valid["c"]))
     return rows
+
+
+#: The Ch 4 page's section of the friction lower bound (the card links to it).
+CH4_FRICTION_HEADING = "Do the identified feet stand still? (b) and (c) with a friction lower bound"
+
+
+def _ch4_friction_causes() -> dict:
+    """"b"/"c" → what identifying with every μ ≥ the friction floor measured
+    (:func:`gaitlib.studies.contact_id.friction_identification`): the book's foot slip and mean
+    GRF RMSE beside the bounded run's; empty when not stored, and "not compared" when either
+    run is not converged or not valid."""
+    try:
+        with cache.only("the card reads stored solutions only"):
+            runs = ci.friction_identification()
+    except cache.NotCached:
+        return {}
+    t = ci.friction_table(runs)
+    where = _anchor("ch04_contact", CH4_FRICTION_HEADING)
+    f = fidelity.FRICTION_FLOOR
+    out = {}
+    for k in ("b", "c"):
+        r0, r1 = t.loc[ci.APPROACHES[k]], t.loc[ci.friction_label(k, f)]
+        usable = all(r["status"] in validity.CONVERGED_STATUSES and r["gates"] == "valid" for r in (r0, r1))
+        if not usable:
+            out[k] = f"({k}) with every μ ≥ {f:g}: not compared ({r1['status']}, {r1['gates']}) [{where}]"
+            continue
+        out[k] = (f"its feet slide {r0['foot slip (m/s)']:.2f} m/s under load (ball μ_d {r0['ball mu_d']:.3f}); "
+                  f"identified with every μ ≥ {f:g} they "
+                  f"{'stand' if r1['foot slip (m/s)'] <= fidelity.SLIP_V else 'still slide'} "
+                  f"({r1['foot slip (m/s)']:.2f} m/s) and the mean GRF "
+                  f"RMSE goes {r0['mean GRF RMSE (N)']:.1f} → {r1['mean GRF RMSE (N)']:.1f} N [{where}]")
+    return out
 
 
 #: The Ch 4 page's section of the (c) ablation (the card links to it).

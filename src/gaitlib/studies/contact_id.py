@@ -86,7 +86,8 @@ __all__ = [
     "body_table", "at_bounds", "friction_ratios", "residual_rms", "grf_fit", "dynamic_consistency", "grf_error_by_phase",
     "save_identified", "identified_vs_result", "THESIS_RANKING", "ranking", "findings",
     "C_TARGET_FACTOR", "C_BASE_ROW", "C_GRF_SCAN", "C_GRF_LEFT", "c_changes", "c_ablation_specs", "c_ablation", "c_ablation_table",
-    "c_ablation_findings", "left_leg_table", "LEFT_SHIFTED_ROW", "left_leg_findings",
+    "c_ablation_findings", "friction_label", "friction_identification", "friction_table", "friction_findings",
+    "left_leg_table", "LEFT_SHIFTED_ROW", "left_leg_findings",
 ]
 
 
@@ -794,11 +795,12 @@ def friction_ratios(results: dict[str, ApproachResult]) -> pd.DataFrame:
 # --------------------------------------------------------------------------------------
 
 
-def save_identified(res: ApproachResult, path=None) -> Path:
+def save_identified(res: ApproachResult, path=None, name: str = "ch4_child") -> Path:
     """Write (c)'s identified parameters with their provenance (:mod:`gaitlib.params` format).
 
     Refuses a result that did not converge (IPOPT status other than Solve_Succeeded).
-    ``path`` default: :func:`gaitlib.params.identified_path` (``data/identified/ch4_child.json``).
+    ``name``: the set's name (a value of :data:`gaitlib.params.IDENTIFIED_CH4`); ``path``
+    default: :func:`gaitlib.params.identified_path` of it (``data/identified/<name>.json``).
     Note: data JSON files are part of the solution-cache fingerprint, so writing this file
     makes every stored solution unreachable (they are recomputed on next use).
     """
@@ -806,16 +808,24 @@ def save_identified(res: ApproachResult, path=None) -> Path:
         raise ValueError("save_identified: expects the approach (c) result")
     if not res.success:
         raise ValueError(f"save_identified: approach (c) did not converge ({res.stats['status']}); not saving")
-    path = Path(path) if path is not None else params_mod.identified_path("ch4_child")
+    if name not in params_mod.IDENTIFIED_CH4.values():
+        raise ValueError(f"save_identified: name must be one of {tuple(params_mod.IDENTIFIED_CH4.values())}, got {name!r}")
+    path = Path(path) if path is not None else params_mod.identified_path(name)
+    fl = res.solution.spec.friction_floor
     m = ChildModel()
     clo, chi = contact_mod.bounds()
+    if fl is not None:  # the bounds the identification had (GaitSpec.friction_floor)
+        clo = contact_mod.with_friction_floor(clo, fl)
+        chi = np.maximum(chi, clo)
     blo, bhi = m.p_body_bounds()
     st = res.stats
     out = {
-        "name": "ch4_child",
+        "name": name,
         "description": ("Contact (39, left foot) and body/joint (25) parameters identified by approach (c) of "
                         "thesis Sec 4.4 (optimal control, Eq 4.13, per-ellipsoid normal force >= 0, Table 4.7 and "
-                        "Table 4.14 bounds) on the Schwartz 2008 Free-speed data, both legs."),
+                        "Table 4.14 bounds"
+                        + (f", every friction coefficient's lower bound raised to {fl:g}" if fl is not None else "")
+                        + ") on the Schwartz 2008 Free-speed data, both legs."),
         "p_contact": {n: float(v) for n, v in zip(contact_mod.param_names(), res.p_contact)},
         "p_body": {n: float(v) for n, v in zip(P_BODY_NAMES, res.p_body)},
         "units": {"p_contact": {n: u for n, u in zip(contact_mod.param_names(),
@@ -932,7 +942,8 @@ def c_changes() -> dict[str, dict]:
     right with every harmonic the data carry (:data:`LEFT_SHIFTED_ROW`: the right leg's
     samples shifted) instead of Eqs 4.1–4.3's five. Then the GRF weight raised further
     (:data:`C_GRF_SCAN`: the vertical error's trade-off against the other terms), and raised
-    weights combined with the shifted left leg (:data:`C_GRF_LEFT`)."""
+    weights combined with the shifted left leg (:data:`C_GRF_LEFT`). (The friction bound is
+    its own experiment, (b) included: :func:`friction_identification`.)"""
     w = dict(gait_ocp.COST_FUNCTIONS["SK"][spec_c().cost])
     exact = gait_ocp.EXACT_FOURIER_ORDER
     return {
@@ -990,6 +1001,7 @@ def c_ablation_table(runs: dict[str, ApproachResult]) -> pd.DataFrame:
         row["worst angle RMSE (deg)"] = float(kinds.get("angle", np.nan))
         row["worst torque RMSE (N·m)"] = float(kinds.get("torque", np.nan))
         row["vertical floor per foot (N)"] = float(dynamic_consistency({"c": r}).iloc[0]["floor per foot, y (N)"])
+        row["foot slip (m/s)"] = gait_study.foot_slip(r.solution)["slip"]
         rows.append(row)
     return pd.DataFrame(rows).set_index("run")
 
@@ -1024,6 +1036,90 @@ def c_ablation_findings(table: pd.DataFrame) -> list[str]:
         out.append(f"{k}: grf_y R/L {r['grf_y R (N)']:.1f} / {r['grf_y L (N)']:.1f} N, of which its kinematics "
                    f"force at least {r['vertical floor per foot (N)']:.1f} N per foot; worst angle "
                    f"{r['worst angle RMSE (deg)']:.1f}°, worst torque {r['worst torque RMSE (N·m)']:.1f} N·m.")
+    return out
+
+
+# --------------------------------------------------------------------------------------
+# Do the identified feet stand still? (b) and (c) again with a friction lower bound
+# --------------------------------------------------------------------------------------
+
+
+def friction_label(key: str, floor: float) -> str:
+    """The row label of approach ``key`` ("b"/"c") identified with every μ ≥ ``floor``."""
+    return f"{APPROACHES[key]}, friction ≥ {floor:g}"
+
+
+def friction_identification(floor: float | None = None, *, use_cache: bool = True, root=None,
+                            progress: bool = False) -> dict[str, ApproachResult]:
+    """(b) and (c) as the book identifies them, and again with one change: every ellipsoid's
+    μ_s and μ_d bounded below by ``floor`` (default :data:`~gaitlib.studies.gait.FRICTION_FLOOR`,
+    Table 4.18's largest coefficient) instead of Table 4.7's 0.01
+    (:attr:`~gaitlib.problems.gait.GaitSpec.friction_floor` with ``free_contact``). The
+    bounded (b) is the same multistart (:data:`B_STARTS`, each through the continuation,
+    the converged valid start with the lowest objective kept); the bounded (c) is
+    warm-started from it, as (c) from (b). Returns label → result: the book's (b), the
+    bounded (b), the book's (c), the bounded (c) (:func:`friction_label`)."""
+    floor = gait_study.FRICTION_FLOOR if floor is None else float(floor)
+    kw = {"use_cache": use_cache, "root": root, "progress": progress}
+    b = optimal_control_multistart(**kw)
+    c = optimal_control_body(warm=b, **kw)
+    fb = optimal_control_multistart(replace(spec_b(), friction_floor=floor), **kw)
+    fc = optimal_control_body(replace(spec_c(), friction_floor=floor), warm=fb, **kw)
+    return {APPROACHES["b"]: b, friction_label("b", floor): fb, APPROACHES["c"]: c, friction_label("c", floor): fc}
+
+
+def friction_table(runs: dict[str, ApproachResult]) -> pd.DataFrame:
+    """One row per run of :func:`friction_identification`: status, gates, iterations,
+    objective, the (b) start kept, each foot force's RMSE and their mean (N), the worst angle
+    (deg) and torque (N·m) RMSE, the force-weighted foot slip (m/s) and the share of the load
+    carried sliding faster than v_tr (%; :func:`gaitlib.studies.gait.foot_slip`), and the
+    ball's identified μ_s, μ_d."""
+    rows = {}
+    for k, r in runs.items():
+        rm = r.rmse.set_index("channel")
+        fs = gait_study.foot_slip(r.solution)
+        row = {"status": r.stats["status"], "gates": validity.label(r), "iterations": r.stats["iterations"],
+               "objective": r.stats["objective"], "start kept": r.stats.get("start", "warm: (b)")}
+        for g in gait_ocp.GRF_CHANNELS:
+            row[f"{g} (N)"] = float(rm.loc[g, "rmse"])
+        row["mean GRF RMSE (N)"] = float(np.mean([row[f"{g} (N)"] for g in gait_ocp.GRF_CHANNELS]))
+        kinds = rm.groupby("kind")["rmse"].max()
+        row["worst angle RMSE (deg)"] = float(kinds.get("angle", np.nan))
+        row["worst torque RMSE (N·m)"] = float(kinds.get("torque", np.nan))
+        row["foot slip (m/s)"] = fs["slip"]
+        row[f"load sliding > {gait_study.SLIP_V:g} m/s (%)"] = 100 * fs["sliding"]
+        for m in ("mu_s", "mu_d"):
+            row[f"ball {m}"] = float(r.p_contact[contact_mod.param_index("ball", m)])
+        rows[k] = row
+    return pd.DataFrame.from_dict(rows, orient="index").rename_axis("run")
+
+
+def friction_findings(table: pd.DataFrame, floor: float | None = None) -> list[str]:
+    """What the friction bound measured, every number from ``table`` (:func:`friction_table`):
+    for (b) and (c), the bounded run beside the book's — mean GRF RMSE, worst angle RMSE,
+    foot slip and objective — or why it is not compared (not converged / not valid)."""
+    floor = gait_study.FRICTION_FLOOR if floor is None else float(floor)
+    v = gait_study.SLIP_V
+    out = []
+    for key in ("b", "c"):
+        base, bound = APPROACHES[key], friction_label(key, floor)
+        if base not in table.index or bound not in table.index:
+            continue
+        r0, r1 = table.loc[base], table.loc[bound]
+        bad = [f"{k} ({r['status']}, {r['gates']})" for k, r in ((base, r0), (bound, r1))
+               if r["status"] not in validity.CONVERGED_STATUSES or r["gates"] != "valid"]
+        if bad:
+            out.append(f"{bound}: not compared — {'; '.join(bad)}.")
+            continue
+        g0, g1 = r0["mean GRF RMSE (N)"], r1["mean GRF RMSE (N)"]
+        out.append(f"{bound} (start kept: {r1['start kept']}): mean GRF RMSE {g0:.1f} → {g1:.1f} N "
+                   f"({100 * (g1 / g0 - 1):+.0f} %), worst angle {r0['worst angle RMSE (deg)']:.2f} → "
+                   f"{r1['worst angle RMSE (deg)']:.2f}°, worst torque {r0['worst torque RMSE (N·m)']:.2f} → "
+                   f"{r1['worst torque RMSE (N·m)']:.2f} N·m, objective {r0['objective']:.4f} → {r1['objective']:.4f}; "
+                   f"the feet slide {r0['foot slip (m/s)']:.3f} → {r1['foot slip (m/s)']:.3f} m/s (force-weighted; "
+                   f"load carried sliding > {v:g} m/s {r0[f'load sliding > {v:g} m/s (%)']:.0f} → "
+                   f"{r1[f'load sliding > {v:g} m/s (%)']:.0f} %), the ball's μ_d {r0['ball mu_d']:.4f} → "
+                   f"{r1['ball mu_d']:.4f}.")
     return out
 
 

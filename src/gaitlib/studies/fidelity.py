@@ -737,36 +737,9 @@ def cot_findings(readings: pd.DataFrame, readings_unloaded: pd.DataFrame, sol, s
 # Ch 7: the COT–speed curve of one consistent problem on valid gaits
 # ======================================================================================
 
-#: The slip speed above which the friction law models sliding, m/s: its transition velocity
-#: v_tr (:class:`gaitlib.contact.Smoothing`; Brown & McPhee's 0.1 m/s, thesis Sec 3.4.3).
-SLIP_V = contact_mod.Smoothing.v_transition
-
-
-def foot_slip(sol, v: float = SLIP_V) -> dict:
-    """How fast a gait solution's loaded feet slide (a measurement, not a validity gate).
-
-    From ``sol.ellipsoids`` (``fn_<label>``, N; ``vs_<label>``: the tangential velocity of
-    the body point the friction law reads, m/s — :meth:`gaitlib.model.ChildModel.slip`),
-    each node weighted by the share of the cycle it stands for: ``slip`` — the mean of |vs|
-    weighted by the normal force (m/s); ``sliding`` — the share of the load (force × time)
-    carried while sliding faster than ``v`` (0…1); ``speed`` — the walking speed the spec's
-    data give (m/s), for scale; ``worst`` — the ellipsoid carrying the most slip × load;
-    ``ball`` — the share of the load (force × time) on the two ball ellipsoids (0…1). A
-    stance foot stands still: in the friction law anything slower than v_tr is sticking."""
-    e = sol.ellipsoids
-    cols = [c for c in e.columns if c.startswith("vs_")]
-    if not cols:
-        raise ValueError(f"{getattr(sol, 'name', 'solution')}: no slip velocities (vs_ columns) in its ellipsoids frame")
-    fn = np.clip(e[["fn_" + c[3:] for c in cols]].to_numpy(float), 0.0, None)
-    vs = np.abs(e[cols].to_numpy(float))
-    t = e.index.to_numpy(float)
-    tf = float(sol.stats.get("tf_s", t[-1]))
-    w = (np.diff(np.append(t, tf)) / (tf - t[0]))[:, None]
-    load = float((w * fn).sum())
-    gd = data_mod.load_gait_data(sol.spec.speed_class, sol.spec.source)
-    return {"slip": float((w * fn * vs).sum() / load), "sliding": float((w * fn * (vs > v)).sum() / load),
-            "speed": float(gd.speed), "worst": cols[int(np.argmax((w * fn * vs).sum(axis=0)))][3:],
-            "ball": float(sum((w * fn[:, [j]]).sum() for j, c in enumerate(cols) if c.startswith("vs_ball")) / load)}
+# foot_slip, SLIP_V (gaitlib.studies.gait): the Ch 4 identification's ablation reads them too
+SLIP_V = gait_study.SLIP_V
+foot_slip = gait_study.foot_slip
 
 
 def slip_table(solutions: dict, v: float = SLIP_V) -> pd.DataFrame:
@@ -791,10 +764,8 @@ def ball_friction(which: str = "default") -> tuple[float, float]:
     return tuple(float(p[contact_mod.param_index("ball", k)]) for k in ("mu_s", "mu_d"))
 
 
-#: The friction floor of the sliding ablation (:attr:`GaitSpec.friction_floor`): the largest
-#: dynamic friction coefficient the thesis's final identification gives any ellipsoid
-#: (Table 4.18: the toe's μ_d), read from the thesis's contact set.
-FRICTION_FLOOR = max(float(contact_mod.default_params()[contact_mod.param_index(e, "mu_d")]) for e in cv.ELLIPSOIDS)
+#: The friction floor of the sliding ablations (:data:`gaitlib.studies.gait.FRICTION_FLOOR`).
+FRICTION_FLOOR = gait_study.FRICTION_FLOOR
 
 
 def consistent_speed_study(friction_floor: float | None = None, **kw):

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .. import contact as contact_mod
 from .. import conventions as cv
 from ..problems import gait as gait_ocp
 from ..problems.gait import solve_cached, tracking_data
@@ -28,7 +29,8 @@ from .. import plots
 from .. import validity
 
 __all__ = ["READINGS", "reading_options", "THESIS_RMSE", "natural_gait", "natural_gait_spec", "rmse_beside_thesis",
-           "channels_frame", "sims_and_marks", "write_outputs", "stats_table"]
+           "channels_frame", "sims_and_marks", "write_outputs", "stats_table", "SLIP_V", "foot_slip",
+           "FRICTION_FLOOR"]
 
 #: Thesis RMSEs (different data, Bovi 2011): (kind, joint/component, side) → value.
 #: Table 4.9, optimal control row (SK, contact parameters identified), torques N·m, GRF N.
@@ -162,3 +164,45 @@ def write_outputs(sol: gait_ocp.GaitSolution, out, figures: bool = True) -> Path
     summary["files"] = sorted(p.name for p in out.iterdir())
     (out / "summary.json").write_text(json.dumps(summary, indent=1, default=str))
     return out
+
+
+# ======================================================================================
+# Do the loaded feet stand still? (a measurement; Ch 4–7 and the card read it)
+# ======================================================================================
+
+#: The slip speed above which the friction law models sliding, m/s: its transition velocity
+#: v_tr (:class:`gaitlib.contact.Smoothing`; Brown & McPhee's 0.1 m/s, thesis Sec 3.4.3).
+SLIP_V = contact_mod.Smoothing.v_transition
+
+
+def foot_slip(sol, v: float = SLIP_V) -> dict:
+    """How fast a gait solution's loaded feet slide (a measurement, not a validity gate).
+
+    From ``sol.ellipsoids`` (``fn_<label>``, N; ``vs_<label>``: the tangential velocity of
+    the body point the friction law reads, m/s — :meth:`gaitlib.model.ChildModel.slip`),
+    each node weighted by the share of the cycle it stands for: ``slip`` — the mean of |vs|
+    weighted by the normal force (m/s); ``sliding`` — the share of the load (force × time)
+    carried while sliding faster than ``v`` (0…1); ``speed`` — the walking speed the spec's
+    data give (m/s), for scale; ``worst`` — the ellipsoid carrying the most slip × load;
+    ``ball`` — the share of the load (force × time) on the two ball ellipsoids (0…1). A
+    stance foot stands still: in the friction law anything slower than v_tr is sticking."""
+    e = sol.ellipsoids
+    cols = [c for c in e.columns if c.startswith("vs_")]
+    if not cols:
+        raise ValueError(f"{getattr(sol, 'name', 'solution')}: no slip velocities (vs_ columns) in its ellipsoids frame")
+    fn = np.clip(e[["fn_" + c[3:] for c in cols]].to_numpy(float), 0.0, None)
+    vs = np.abs(e[cols].to_numpy(float))
+    t = e.index.to_numpy(float)
+    tf = float(sol.stats.get("tf_s", t[-1]))
+    w = (np.diff(np.append(t, tf)) / (tf - t[0]))[:, None]
+    load = float((w * fn).sum())
+    gd = data_mod.load_gait_data(sol.spec.speed_class, sol.spec.source)
+    return {"slip": float((w * fn * vs).sum() / load), "sliding": float((w * fn * (vs > v)).sum() / load),
+            "speed": float(gd.speed), "worst": cols[int(np.argmax((w * fn * vs).sum(axis=0)))][3:],
+            "ball": float(sum((w * fn[:, [j]]).sum() for j, c in enumerate(cols) if c.startswith("vs_ball")) / load)}
+
+
+#: The friction floor of the sliding ablations (:attr:`~gaitlib.problems.gait.GaitSpec.friction_floor`; Ch 4, 5, 7): the largest
+#: dynamic friction coefficient the thesis's final identification gives any ellipsoid
+#: (Table 4.18: the toe's μ_d), read from the thesis's contact set.
+FRICTION_FLOOR = max(float(contact_mod.default_params()[contact_mod.param_index(e, "mu_d")]) for e in cv.ELLIPSOIDS)
