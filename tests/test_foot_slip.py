@@ -116,24 +116,69 @@ def test_friction_floor_and_ball_friction_read_the_parameter_sets():
     assert fidelity.FRICTION_FLOOR == 0.2819
 
 
-def _friction_row(status, gates, grf, angle, torque, obj, slip, sliding, mu_d, start="neutral"):
+def _friction_row(status, gates, grf, angle, torque, obj, slip, sliding, mu_d, start="neutral", sink=20.0):
     v = gait_study.SLIP_V
     return {"status": status, "gates": gates, "iterations": 1, "objective": obj, "start kept": start,
             "mean GRF RMSE (N)": grf, "worst angle RMSE (deg)": angle, "worst torque RMSE (N·m)": torque,
-            "foot slip (m/s)": slip, f"load sliding > {v:g} m/s (%)": sliding, "ball mu_s": mu_d, "ball mu_d": mu_d}
+            "foot slip (m/s)": slip, f"load sliding > {v:g} m/s (%)": sliding, "ball mu_s": mu_d, "ball mu_d": mu_d,
+            "deepest sink (mm)": sink}
 
 
 def test_friction_findings_compare_the_bounded_identification_by_hand():
     f = 0.2819
     t = pd.DataFrame.from_dict({
         ci_study.APPROACHES["b"]: _friction_row("Solve_Succeeded", "valid", 12.5, 2.0, 1.0, 0.013, 0.115, 35.0, 0.0261),
-        ci_study.friction_label("b", f): _friction_row("Solve_Succeeded", "valid", 15.0, 3.0, 1.5, 0.026, 0.013, 1.0, 0.2819),
-        ci_study.APPROACHES["c"]: _friction_row("Solve_Succeeded", "valid", 10.0, 2.0, 1.0, 0.014, 0.114, 30.0, 0.01),
+        ci_study.friction_label("b", f): _friction_row("Solve_Succeeded", "valid", 15.0, 3.0, 1.5, 0.026, 0.013, 1.0, 0.2819,
+                                                       sink=40.25),
+        ci_study.APPROACHES["c"]: _friction_row("Solve_Succeeded", "valid", 10.0, 2.0, 1.0, 0.014, 0.114, 30.0, 0.01,
+                                                "(b)'s solution"),
         ci_study.friction_label("c", f): _friction_row("Maximum_Iterations_Exceeded", "not converged", 99.0, 9.0, 9.0,
                                                        1.0, 0.0, 0.0, 0.2819, "warm: (b)")}, orient="index")
-    out = ci_study.friction_findings(t, f)
+    out = ci_study.friction_findings(t)
     assert len(out) == 2
     # (b): 12.5 → 15.0 N is +20 %; slip 0.115 → 0.013 m/s; load sliding 35 → 1 %
     assert "12.5 → 15.0 N (+20 %)" in out[0] and "0.115 → 0.013 m/s" in out[0] and "35 → 1 %" in out[0]
-    assert "start kept: neutral" in out[0] and "0.0261 → 0.2819" in out[0]
+    assert "start kept: neutral" in out[0] and "0.0261 → 0.2819" in out[0] and "20.0 → 40.2 mm" in out[0]
     assert out[1].startswith(ci_study.friction_label("c", f) + ": not compared") and "99.0" not in out[1]
+
+
+def test_foot_sink_is_the_lowest_ellipsoid_depth_by_construction():
+    # pose_from_data puts the lowest ellipsoid `penetration` below the ground at every row;
+    # lowering the pelvis by 3 mm more sinks it 3 mm deeper; raising it 1 m lifts every foot
+    gd = data_mod.load_gait_data("Free")
+    m, p = ChildModel(), contact.default_params()
+    t = gd.time[::10]
+    q = pd.DataFrame(kinematics.pose_from_data(m, gd, t, p, penetration=0.002), columns=list(cv.COORDS))
+    assert gait_study.foot_sink(q, p) == pytest.approx(0.002, abs=1e-9)
+    assert gait_study.foot_sink(q.assign(pelvis_ty=q["pelvis_ty"] - 0.003), p) == pytest.approx(0.005, abs=1e-9)
+    assert gait_study.foot_sink(q.assign(pelvis_ty=q["pelvis_ty"] + 1.0), p) == 0.0
+
+
+def test_max_sink_bounds_every_ellipsoid_depth_at_every_node():
+    # GaitSpec.max_sink adds the path constraint depth ≤ max_sink (the contact law's depth of
+    # each of the six ellipsoids); the depth is the lowest point's distance below y = 0
+    sp = gait_ocp.GaitSpec(model="SK", n_intervals=2, degree=2)
+    assert "max_sink" not in sp.to_dict()
+    gp = gait_ocp.build(replace(sp, max_sink=0.018))
+    (c,) = [c for c in gp.problem.phases[0].path_constraints if c.name == "sink"]
+    assert c.upper == 0.018 and c.lower == -np.inf
+    assert not [c for c in gait_ocp.build(sp).problem.phases[0].path_constraints if c.name == "sink"]
+    m, p = ChildModel(), contact.default_params()
+    gd = data_mod.load_gait_data("Free")
+    q = kinematics.pose_from_data(m, gd, gd.time[:3], p, penetration=0.004)[1]
+    depth = np.asarray(m.function("contact")(q=q, qd=np.zeros(11), p_contact=p)["depth"]).ravel()
+    np.testing.assert_allclose(depth, -kinematics.ellipsoid_bottoms(m, q, p), atol=1e-12)
+    assert depth.max() == pytest.approx(0.004, abs=1e-9)
+    for bad in (0.0, -0.01, 0.2, "0.01", True):
+        with pytest.raises(ValueError, match="max_sink"):
+            replace(sp, max_sink=bad)
+
+
+def test_reference_slip_findings_name_the_cause_by_the_anchored_slip():
+    r = {"slip": 0.228, "sliding": 0.38, "anchored_slip": 0.209, "anchored_sliding": 0.40, "hat_speed_min": 0.34,
+         "hat_speed_max": 1.46, "speed": 1.178}
+    (a,) = ci_study.reference_slip_findings({"ours": r})
+    assert "slide 0.228 m/s" in a and "38 %" in a and "0.34–1.46 m/s" in a and "0.209 m/s remain (40 %)" in a
+    assert "against each other" in a
+    (b,) = ci_study.reference_slip_findings({"ours": {**r, "anchored_slip": 0.05}})
+    assert "constant-speed HAT reference is what asks the feet to slide" in b

@@ -785,7 +785,7 @@ class ChildModel:
                                          [Inertia(0.0, (0.0, 0.0), 0.0)] * len(BODIES),
                                          loads, 0.0, states=st)
             outs = {k: ca.vertcat(*[r[k] for r in res])
-                    for k in ("fx", "fy", "fn", "fn_raw", "px", "py", "mz")}
+                    for k in ("fx", "fy", "fn", "fn_raw", "px", "py", "mz", "depth")}
             grf_x, grf_y, cop_x = [], [], []
             for i in range(2):
                 sl = slice(3 * i, 3 * i + 3)
@@ -879,7 +879,7 @@ class ChildModel:
         * ``mass_matrix``: (q, p_body) -> M (11, 11)
         * ``bias``: (q, qd, p_body) -> h (11,)
         * ``forward_dynamics``: (q, qd, tau, R, p_body, p_contact) -> qdd (11,)
-        * ``contact``: (q, qd, p_contact) -> fx, fy, fn, fn_raw, px, py, mz (6,) each,
+        * ``contact``: (q, qd, p_contact) -> fx, fy, fn, fn_raw, px, py, mz, depth (6,) each,
           grf_x, grf_y, cop_x (2,) each (right, left), Q (11,)
         * ``com``: (q, qd, p_body) -> com (2,), com_vel (2,), mass
         * ``energies``: (q, qd, p_body) -> kinetic, potential_gravity, potential_spring

@@ -229,7 +229,7 @@ for _name, _w in _T62_NMSK.items():
 #: Spec options that are left out of :meth:`GaitSpec.to_dict` (hence of every cache key)
 #: while unset: added after the store was written, they must not change existing keys.
 KEY_STABLE_OPTIONS = ("swing_load_max", "derivatives", "jerk_ranges", "track_mtp", "activation_params",
-                      "fourier_order", "defects", "track_norm", "friction_floor")
+                      "fourier_order", "defects", "track_norm", "friction_floor", "max_sink")
 #: The Fourier order of the left leg generated from the right (thesis Eqs 4.1–4.3: 5).
 FOURIER_ORDER = 5
 #: The highest order a cycle of the data's 51 samples (50 distinct) carries: the left leg is
@@ -354,6 +354,12 @@ class GaitSpec:
         ``free_contact`` (Ch 4 (b)/(c)): the lower bound of every μ_s and μ_d raised from
         Table 4.7's 0.01 to the floor (the identification ablation of
         :func:`gaitlib.studies.contact_id.c_changes`).
+    max_sink : ``None`` (the thesis: no such constraint) or a bound, m, on how deep any
+        ellipsoid sinks into the ground at every node (the contact law's penetration depth δ
+        of its lowest point, :func:`gaitlib.contact.ellipsoid_plane`). Volumetric contact
+        carries load by penetration; an identification free to choose soft ellipsoids can
+        trade a sliding foot for a sinking one (the Ch 4 friction experiment,
+        :func:`gaitlib.studies.contact_id.friction_identification`).
     fourier_order : ``None`` (the thesis's Eqs 4.1–4.3: :data:`FOURIER_ORDER`, 5) or the order
         of the least-squares Fourier series that generates the left leg's data from the right
         leg's (:func:`gaitlib.data.fourier_shift`); :data:`EXACT_FOURIER_ORDER` reproduces the
@@ -403,6 +409,7 @@ class GaitSpec:
     defects: str | None = None
     track_norm: str | None = None
     friction_floor: float | None = None
+    max_sink: float | None = None
 
     def __post_init__(self):
         if self.fourier_order is not None:
@@ -418,6 +425,9 @@ class GaitSpec:
                     or not 0.0 < float(self.friction_floor) <= 2.0):
                 raise ValueError(f"friction_floor must be None or a friction coefficient in (0, 2], "
                                  f"got {self.friction_floor!r}")
+        if self.max_sink is not None and (isinstance(self.max_sink, bool) or not isinstance(self.max_sink, (int, float))
+                                          or not 0.0 < float(self.max_sink) <= 0.1):
+            raise ValueError(f"max_sink must be None or a depth in (0, 0.1] m, got {self.max_sink!r}")
         if self.track_norm not in (None,) + TRACK_NORMS:
             raise ValueError(f"track_norm must be None or one of {TRACK_NORMS}, got {self.track_norm!r}")
         if self.derivatives not in (None, "graph", "nodes"):
@@ -1105,7 +1115,7 @@ def build(spec: GaitSpec) -> GaitProblem:
         tau_net = tau_in + f_pas(q, qd, pb)
         out = {"tau_id": tau_id, "R_id": R_id, "tau_in": tau_in, "R_in": R_in, "tau_net": tau_net,
                "grf": ca.vertcat(ct["grf_x"][0], ct["grf_y"][0], ct["grf_x"][1], ct["grf_y"][1]),
-               "fn_raw": ct["fn_raw"], **extra}
+               "fn_raw": ct["fn_raw"], "depth": ct["depth"], **extra}
         cache[key] = out
         return out
 
@@ -1115,6 +1125,8 @@ def build(spec: GaitSpec) -> GaitProblem:
                            0.0, 0.0)]
     if spec.normal_force_constraint:
         path.append(PathConstraint("normal_force", lambda x, u, p, t: node(x, u, p)["fn_raw"], 0.0, np.inf))
+    if spec.max_sink is not None:  # ablation: no ellipsoid deeper than max_sink in the ground
+        path.append(PathConstraint("sink", lambda x, u, p, t: node(x, u, p)["depth"], -np.inf, float(spec.max_sink)))
     if spec.swing_load_max is not None:  # ablation: no vertical load on a foot the data say swings
         windows = data_mod.swing_windows(gait.events, gait.left_shift)
 

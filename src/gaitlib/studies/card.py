@@ -442,10 +442,10 @@ def _ch4_friction_causes() -> dict:
         if not usable:
             out[k] = f"({k}) with every μ ≥ {f:g}: not compared ({r1['status']}, {r1['gates']}) [{where}]"
             continue
-        out[k] = (f"its feet slide {r0['foot slip (m/s)']:.2f} m/s under load (ball μ_d {r0['ball mu_d']:.3f}); "
+        out[k] = (f"its feet slide {r0[sg.SLIP_COLUMN]:.2f} m/s under load (ball μ_d {r0['ball mu_d']:.3f}); "
                   f"identified with every μ ≥ {f:g} they "
-                  f"{'stand' if r1['foot slip (m/s)'] <= fidelity.SLIP_V else 'still slide'} "
-                  f"({r1['foot slip (m/s)']:.2f} m/s) and the mean GRF "
+                  f"{'stand' if r1[sg.SLIP_COLUMN] <= fidelity.SLIP_V else 'still slide'} "
+                  f"({r1[sg.SLIP_COLUMN]:.2f} m/s) and the mean GRF "
                   f"RMSE goes {r0['mean GRF RMSE (N)']:.1f} → {r1['mean GRF RMSE (N)']:.1f} N [{where}]")
     return out
 

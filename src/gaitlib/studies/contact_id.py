@@ -86,7 +86,7 @@ __all__ = [
     "body_table", "at_bounds", "friction_ratios", "residual_rms", "grf_fit", "dynamic_consistency", "grf_error_by_phase",
     "save_identified", "identified_vs_result", "THESIS_RANKING", "ranking", "findings",
     "C_TARGET_FACTOR", "C_BASE_ROW", "C_GRF_SCAN", "C_GRF_LEFT", "c_changes", "c_ablation_specs", "c_ablation", "c_ablation_table",
-    "c_ablation_findings", "friction_label", "friction_identification", "friction_table", "friction_findings",
+    "c_ablation_findings", "SINK_LIMIT", "friction_label", "friction_identification", "friction_table", "friction_findings", "reference_slip_findings",
     "left_leg_table", "LEFT_SHIFTED_ROW", "left_leg_findings",
 ]
 
@@ -1001,7 +1001,7 @@ def c_ablation_table(runs: dict[str, ApproachResult]) -> pd.DataFrame:
         row["worst angle RMSE (deg)"] = float(kinds.get("angle", np.nan))
         row["worst torque RMSE (N·m)"] = float(kinds.get("torque", np.nan))
         row["vertical floor per foot (N)"] = float(dynamic_consistency({"c": r}).iloc[0]["floor per foot, y (N)"])
-        row["foot slip (m/s)"] = gait_study.foot_slip(r.solution)["slip"]
+        row[gait_study.SLIP_COLUMN] = gait_study.foot_slip(r.solution)["slip"]
         rows.append(row)
     return pd.DataFrame(rows).set_index("run")
 
@@ -1044,83 +1044,115 @@ def c_ablation_findings(table: pd.DataFrame) -> list[str]:
 # --------------------------------------------------------------------------------------
 
 
-def friction_label(key: str, floor: float) -> str:
-    """The row label of approach ``key`` ("b"/"c") identified with every μ ≥ ``floor``."""
-    return f"{APPROACHES[key]}, friction ≥ {floor:g}"
+#: The sink bound (m) of the friction experiment's second variant: our choice, about the
+#: deepest the book's own (c) sinks (its table shows it), so that the friction bound cannot
+#: be met by softer, deeper-sinking ellipsoids instead (:attr:`GaitSpec.max_sink`).
+SINK_LIMIT = 0.018
 
 
-def friction_identification(floor: float | None = None, *, use_cache: bool = True, root=None,
-                            progress: bool = False) -> dict[str, ApproachResult]:
-    """(b) and (c) as the book identifies them, and again with one change: every ellipsoid's
-    μ_s and μ_d bounded below by ``floor`` (default :data:`~gaitlib.studies.gait.FRICTION_FLOOR`,
-    Table 4.18's largest coefficient) instead of Table 4.7's 0.01
-    (:attr:`~gaitlib.problems.gait.GaitSpec.friction_floor` with ``free_contact``). The
-    bounded (b) is the same multistart (:data:`B_STARTS`, each through the continuation,
-    the converged valid start with the lowest objective kept); the bounded (c) is
-    warm-started from it, as (c) from (b). Returns label → result: the book's (b), the
-    bounded (b), the book's (c), the bounded (c) (:func:`friction_label`)."""
+def friction_label(key: str, floor: float, max_sink: float | None = None) -> str:
+    """The row label of approach ``key`` ("b"/"c") identified with every μ ≥ ``floor`` (and no
+    ellipsoid deeper than ``max_sink`` m)."""
+    return f"{APPROACHES[key]}, friction ≥ {floor:g}" + (f", sink ≤ {1e3 * max_sink:g} mm" if max_sink else "")
+
+
+def friction_identification(floor: float | None = None, max_sinks: tuple = (None, SINK_LIMIT), *,
+                            use_cache: bool = True, root=None, progress: bool = False) -> dict[str, ApproachResult]:
+    """(b) and (c) as the book identifies them, and again with every ellipsoid's μ_s and μ_d
+    bounded below by ``floor`` (default :data:`~gaitlib.studies.gait.FRICTION_FLOOR`, Table
+    4.18's largest coefficient) instead of Table 4.7's 0.01
+    (:attr:`~gaitlib.problems.gait.GaitSpec.friction_floor` with ``free_contact``) — once for
+    each of ``max_sinks``: ``None`` that change alone; a depth (m) with every ellipsoid also
+    kept that shallow at every node (:attr:`~gaitlib.problems.gait.GaitSpec.max_sink`). Each
+    bounded (b) is the same multistart (:data:`B_STARTS`, each through the continuation, the
+    converged valid start with the lowest objective kept); each bounded (c) is warm-started
+    from its (b), as (c) from (b). Returns label → result (:func:`friction_label`): the book's
+    (b), the bounded (b)s, the book's (c), the bounded (c)s."""
     floor = gait_study.FRICTION_FLOOR if floor is None else float(floor)
     kw = {"use_cache": use_cache, "root": root, "progress": progress}
     b = optimal_control_multistart(**kw)
-    c = optimal_control_body(warm=b, **kw)
-    fb = optimal_control_multistart(replace(spec_b(), friction_floor=floor), **kw)
-    fc = optimal_control_body(replace(spec_c(), friction_floor=floor), warm=fb, **kw)
-    return {APPROACHES["b"]: b, friction_label("b", floor): fb, APPROACHES["c"]: c, friction_label("c", floor): fc}
+    out_b, out_c = {APPROACHES["b"]: b}, {APPROACHES["c"]: optimal_control_body(warm=b, **kw)}
+    for sink in max_sinks:
+        ch = {"friction_floor": floor, "max_sink": sink}
+        fb = optimal_control_multistart(replace(spec_b(), **ch), **kw)
+        out_b[friction_label("b", floor, sink)] = fb
+        out_c[friction_label("c", floor, sink)] = optimal_control_body(replace(spec_c(), **ch), warm=fb, **kw)
+    return {**out_b, **out_c}
 
 
 def friction_table(runs: dict[str, ApproachResult]) -> pd.DataFrame:
     """One row per run of :func:`friction_identification`: status, gates, iterations,
     objective, the (b) start kept, each foot force's RMSE and their mean (N), the worst angle
     (deg) and torque (N·m) RMSE, the force-weighted foot slip (m/s) and the share of the load
-    carried sliding faster than v_tr (%; :func:`gaitlib.studies.gait.foot_slip`), and the
+    carried sliding faster than v_tr (%; :func:`gaitlib.studies.gait.foot_slip`), the deepest
+    any ellipsoid sinks into the ground (mm, :func:`gaitlib.studies.gait.foot_sink`), and the
     ball's identified μ_s, μ_d."""
     rows = {}
     for k, r in runs.items():
         rm = r.rmse.set_index("channel")
         fs = gait_study.foot_slip(r.solution)
         row = {"status": r.stats["status"], "gates": validity.label(r), "iterations": r.stats["iterations"],
-               "objective": r.stats["objective"], "start kept": r.stats.get("start", "warm: (b)")}
+               "objective": r.stats["objective"], "start kept": r.stats.get("start", "(b)'s solution")}
         for g in gait_ocp.GRF_CHANNELS:
             row[f"{g} (N)"] = float(rm.loc[g, "rmse"])
         row["mean GRF RMSE (N)"] = float(np.mean([row[f"{g} (N)"] for g in gait_ocp.GRF_CHANNELS]))
         kinds = rm.groupby("kind")["rmse"].max()
         row["worst angle RMSE (deg)"] = float(kinds.get("angle", np.nan))
         row["worst torque RMSE (N·m)"] = float(kinds.get("torque", np.nan))
-        row["foot slip (m/s)"] = fs["slip"]
+        row[gait_study.SLIP_COLUMN] = fs["slip"]
         row[f"load sliding > {gait_study.SLIP_V:g} m/s (%)"] = 100 * fs["sliding"]
+        row["deepest sink (mm)"] = 1e3 * gait_study.foot_sink(r.q, r.p_contact)
         for m in ("mu_s", "mu_d"):
             row[f"ball {m}"] = float(r.p_contact[contact_mod.param_index("ball", m)])
         rows[k] = row
     return pd.DataFrame.from_dict(rows, orient="index").rename_axis("run")
 
 
-def friction_findings(table: pd.DataFrame, floor: float | None = None) -> list[str]:
+def friction_findings(table: pd.DataFrame) -> list[str]:
     """What the friction bound measured, every number from ``table`` (:func:`friction_table`):
-    for (b) and (c), the bounded run beside the book's — mean GRF RMSE, worst angle RMSE,
-    foot slip and objective — or why it is not compared (not converged / not valid)."""
-    floor = gait_study.FRICTION_FLOOR if floor is None else float(floor)
+    each bounded run beside the book's run of its approach — mean GRF RMSE, worst angle and
+    torque RMSE, objective, foot slip, the ball's μ_d and the deepest sink — or why it is not
+    compared (not converged / not valid)."""
     v = gait_study.SLIP_V
     out = []
     for key in ("b", "c"):
-        base, bound = APPROACHES[key], friction_label(key, floor)
-        if base not in table.index or bound not in table.index:
+        base = APPROACHES[key]
+        if base not in table.index:
             continue
-        r0, r1 = table.loc[base], table.loc[bound]
-        bad = [f"{k} ({r['status']}, {r['gates']})" for k, r in ((base, r0), (bound, r1))
-               if r["status"] not in validity.CONVERGED_STATUSES or r["gates"] != "valid"]
-        if bad:
-            out.append(f"{bound}: not compared — {'; '.join(bad)}.")
-            continue
-        g0, g1 = r0["mean GRF RMSE (N)"], r1["mean GRF RMSE (N)"]
-        out.append(f"{bound} (start kept: {r1['start kept']}): mean GRF RMSE {g0:.1f} → {g1:.1f} N "
-                   f"({100 * (g1 / g0 - 1):+.0f} %), worst angle {r0['worst angle RMSE (deg)']:.2f} → "
-                   f"{r1['worst angle RMSE (deg)']:.2f}°, worst torque {r0['worst torque RMSE (N·m)']:.2f} → "
-                   f"{r1['worst torque RMSE (N·m)']:.2f} N·m, objective {r0['objective']:.4f} → {r1['objective']:.4f}; "
-                   f"the feet slide {r0['foot slip (m/s)']:.3f} → {r1['foot slip (m/s)']:.3f} m/s (force-weighted; "
-                   f"load carried sliding > {v:g} m/s {r0[f'load sliding > {v:g} m/s (%)']:.0f} → "
-                   f"{r1[f'load sliding > {v:g} m/s (%)']:.0f} %), the ball's μ_d {r0['ball mu_d']:.4f} → "
-                   f"{r1['ball mu_d']:.4f}.")
+        r0 = table.loc[base]
+        for bound in [k for k in table.index if k.startswith(base + ", friction")]:
+            r1 = table.loc[bound]
+            bad = [f"{k} ({r['status']}, {r['gates']})" for k, r in ((base, r0), (bound, r1))
+                   if r["status"] not in validity.CONVERGED_STATUSES or r["gates"] != "valid"]
+            if bad:
+                out.append(f"{bound}: not compared — {'; '.join(bad)}.")
+                continue
+            g0, g1 = r0["mean GRF RMSE (N)"], r1["mean GRF RMSE (N)"]
+            out.append(f"{bound} (start kept: {r1['start kept']}): mean GRF RMSE {g0:.1f} → {g1:.1f} N "
+                       f"({100 * (g1 / g0 - 1):+.0f} %), worst angle {r0['worst angle RMSE (deg)']:.2f} → "
+                       f"{r1['worst angle RMSE (deg)']:.2f}°, worst torque {r0['worst torque RMSE (N·m)']:.2f} → "
+                       f"{r1['worst torque RMSE (N·m)']:.2f} N·m, objective {r0['objective']:.4f} → "
+                       f"{r1['objective']:.4f}; the feet slide {r0[gait_study.SLIP_COLUMN]:.3f} → "
+                       f"{r1[gait_study.SLIP_COLUMN]:.3f} m/s (force-weighted; load carried sliding > {v:g} m/s "
+                       f"{r0[f'load sliding > {v:g} m/s (%)']:.0f} → {r1[f'load sliding > {v:g} m/s (%)']:.0f} %), "
+                       f"the ball's μ_d {r0['ball mu_d']:.4f} → {r1['ball mu_d']:.4f}; the deepest an ellipsoid sinks "
+                       f"{r0['deepest sink (mm)']:.1f} → {r1['deepest sink (mm)']:.1f} mm.")
     return out
+
+
+def reference_slip_findings(refs: dict[str, dict]) -> list[str]:
+    """One sentence per contact set (label → :func:`gaitlib.studies.gait.reference_slip`): how
+    fast the feet of the tracking reference itself slide — the data's kinematics on this
+    model, no solve — and what is left with the HAT's speed free to anchor the loaded feet."""
+    v = gait_study.SLIP_V
+    return [f"The tracking reference itself ({k} contact set): its loaded feet slide {r['slip']:.3f} m/s "
+            f"(force-weighted; {100 * r['sliding']:.0f} % of the load sliding > {v:g} m/s) while the HAT moves at a "
+            f"constant {r['speed']:.2f} m/s; with the HAT's speed changed at every instant to anchor the loaded feet "
+            f"(it then ranges {r['hat_speed_min']:.2f}–{r['hat_speed_max']:.2f} m/s) {r['anchored_slip']:.3f} m/s remain "
+            f"({100 * r['anchored_sliding']:.0f} %)"
+            + (": the data's joint angles on this model's legs move the loaded feet against each other, so a gait "
+               "that tracked them exactly would slide." if r["anchored_slip"] > v else
+               ": the constant-speed HAT reference is what asks the feet to slide.") for k, r in refs.items()]
 
 
 def findings(results: dict[str, ApproachResult], widened: ApproachResult, fit: pd.DataFrame,

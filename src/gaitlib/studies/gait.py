@@ -20,6 +20,8 @@ import numpy as np
 import pandas as pd
 
 from .. import contact as contact_mod
+from .. import kinematics
+from .. import params as params_mod
 from .. import conventions as cv
 from ..problems import gait as gait_ocp
 from ..problems.gait import solve_cached, tracking_data
@@ -27,9 +29,10 @@ from .. import marks
 from .. import data as data_mod
 from .. import plots
 from .. import validity
+from ..model import ChildModel
 
 __all__ = ["READINGS", "reading_options", "THESIS_RMSE", "natural_gait", "natural_gait_spec", "rmse_beside_thesis",
-           "channels_frame", "sims_and_marks", "write_outputs", "stats_table", "SLIP_V", "foot_slip",
+           "channels_frame", "sims_and_marks", "write_outputs", "stats_table", "SLIP_V", "SLIP_COLUMN", "foot_slip", "foot_sink", "reference_slip",
            "FRICTION_FLOOR"]
 
 #: Thesis RMSEs (different data, Bovi 2011): (kind, joint/component, side) → value.
@@ -175,6 +178,10 @@ def write_outputs(sol: gait_ocp.GaitSolution, out, figures: bool = True) -> Path
 SLIP_V = contact_mod.Smoothing.v_transition
 
 
+#: The tables' column of the force-weighted foot slip (m/s, :func:`foot_slip`).
+SLIP_COLUMN = "foot slip (m/s)"
+
+
 def foot_slip(sol, v: float = SLIP_V) -> dict:
     """How fast a gait solution's loaded feet slide (a measurement, not a validity gate).
 
@@ -206,3 +213,48 @@ def foot_slip(sol, v: float = SLIP_V) -> dict:
 #: dynamic friction coefficient the thesis's final identification gives any ellipsoid
 #: (Table 4.18: the toe's μ_d), read from the thesis's contact set.
 FRICTION_FLOOR = max(float(contact_mod.default_params()[contact_mod.param_index(e, "mu_d")]) for e in cv.ELLIPSOIDS)
+
+
+def foot_sink(q: pd.DataFrame, p_contact) -> float:
+    """The deepest any ellipsoid sinks into the ground over a motion (m, ≥ 0): the largest
+    depth of an ellipsoid's lowest point below y = 0 at the rows of ``q`` (time × the 11
+    coordinates, SI) with the contact parameters ``p_contact`` (39,). Volumetric contact
+    carries load by penetration; a soft set that stops the feet sliding may sink them."""
+    m = ChildModel()
+    Q = q[list(cv.COORDS)].to_numpy(float)
+    return float(max(0.0, max(-kinematics.ellipsoid_bottoms(m, row, p_contact).min() for row in Q)))
+
+
+
+def reference_slip(contact_params: str = "ch4", speed_class: str = "Free", v: float = SLIP_V) -> dict:
+    """How fast the loaded feet of the tracking reference itself slide: the data's
+    kinematics as the Q term tracks them (:func:`gaitlib.problems.gait.reference`: the data's
+    joint angles, the HAT upright, moving at the walking speed, at the height where the
+    contact carries the data's vertical load at rest) with the contact set ``contact_params``
+    (:func:`gaitlib.params.contact_params`), each ellipsoid weighted by its normal force at
+    rest in that pose. No solve: what a gait that tracked its reference exactly would ask of
+    its feet. Returns ``slip`` (force-weighted mean |v_slip|, m/s), ``sliding`` (share of the
+    load on ellipsoids sliding faster than ``v``, 0…1), and the same two (``anchored_slip``,
+    ``anchored_sliding``) with the HAT's horizontal speed changed at every instant so that
+    the load-weighted mean slip is zero — what is left cannot come from the constant-speed
+    HAT reference — with that speed's range (``hat_speed_min``, ``hat_speed_max``, m/s)."""
+    m = ChildModel()
+    pc = params_mod.contact_params(contact_params)
+    gd = data_mod.load_gait_data(speed_class)
+    ref = gait_ocp.reference(gd, m, pc)
+    der = {c: ref.deriv[c](gd.time) for c in cv.COORDS}
+    q = np.array([der[c][0] for c in cv.COORDS]).T
+    qd = np.array([der[c][1] for c in cv.COORDS]).T
+    vs = gait_ocp.slip_velocities(m, q, qd, pc)
+    f_ct = m.function("contact")
+    fn = np.clip(np.array([np.asarray(f_ct(q=row, qd=np.zeros(len(cv.COORDS)), p_contact=pc)["fn"]).ravel()
+                           for row in q]).T, 0.0, None)
+    tot = fn.sum(axis=0)
+    dv = np.where(tot > 0, (fn * vs).sum(axis=0) / np.where(tot > 0, tot, 1.0), 0.0)
+    anchored = vs - dv[None, :]
+    load = fn.sum()
+    hat = qd[:, 0] - dv
+    return {"slip": float((fn * np.abs(vs)).sum() / load), "sliding": float((fn * (np.abs(vs) > v)).sum() / load),
+            "anchored_slip": float((fn * np.abs(anchored)).sum() / load),
+            "anchored_sliding": float((fn * (np.abs(anchored) > v)).sum() / load),
+            "hat_speed_min": float(hat.min()), "hat_speed_max": float(hat.max()), "speed": float(gd.speed)}
