@@ -116,12 +116,13 @@ def test_friction_floor_and_ball_friction_read_the_parameter_sets():
     assert fidelity.FRICTION_FLOOR == 0.2819
 
 
-def _friction_row(status, gates, grf, angle, torque, obj, slip, sliding, mu_d, start="neutral", sink=20.0):
+def _friction_row(status, gates, grf, angle, torque, obj, slip, sliding, mu_d, start="neutral", sink=20.0,
+                  rest="carried"):
     v = gait_study.SLIP_V
     return {"status": status, "gates": gates, "iterations": 1, "objective": obj, "start kept": start,
             "mean GRF RMSE (N)": grf, "worst angle RMSE (deg)": angle, "worst torque RMSE (N·m)": torque,
             "foot slip (m/s)": slip, f"load sliding > {v:g} m/s (%)": sliding, "ball mu_s": mu_d, "ball mu_d": mu_d,
-            "deepest sink (mm)": sink}
+            "deepest sink (mm)": sink, ci_study.REST_COLUMN: rest}
 
 
 def test_friction_findings_compare_the_bounded_identification_by_hand():
@@ -129,7 +130,7 @@ def test_friction_findings_compare_the_bounded_identification_by_hand():
     t = pd.DataFrame.from_dict({
         ci_study.APPROACHES["b"]: _friction_row("Solve_Succeeded", "valid", 12.5, 2.0, 1.0, 0.013, 0.115, 35.0, 0.0261),
         ci_study.friction_label("b", f): _friction_row("Solve_Succeeded", "valid", 15.0, 3.0, 1.5, 0.026, 0.013, 1.0, 0.2819,
-                                                       sink=40.25),
+                                                       sink=40.25, rest="row 6: a load of 444.1 N needs more"),
         ci_study.APPROACHES["c"]: _friction_row("Solve_Succeeded", "valid", 10.0, 2.0, 1.0, 0.014, 0.114, 30.0, 0.01,
                                                 "(b)'s solution"),
         ci_study.friction_label("c", f): _friction_row("Maximum_Iterations_Exceeded", "not converged", 99.0, 9.0, 9.0,
@@ -139,6 +140,7 @@ def test_friction_findings_compare_the_bounded_identification_by_hand():
     # (b): 12.5 → 15.0 N is +20 %; slip 0.115 → 0.013 m/s; load sliding 35 → 1 %
     assert "12.5 → 15.0 N (+20 %)" in out[0] and "0.115 → 0.013 m/s" in out[0] and "35 → 1 %" in out[0]
     assert "start kept: neutral" in out[0] and "0.0261 → 0.2819" in out[0] and "20.0 → 40.2 mm" in out[0]
+    assert "cannot carry the data's load (row 6: a load of 444.1 N needs more)" in out[0]
     assert out[1].startswith(ci_study.friction_label("c", f) + ": not compared") and "99.0" not in out[1]
 
 

@@ -637,6 +637,15 @@ def contact_params_of(spec: GaitSpec) -> np.ndarray:
     return p if spec.friction_floor is None else contact_mod.with_friction_floor(p, spec.friction_floor)
 
 
+def solved_contact_params(sol) -> np.ndarray:
+    """The 39 contact parameters a solved gait ran with (SI): the identified ones when its
+    spec left them free (``c.<name>`` static parameters of ``sol.solution``), else
+    :func:`contact_params_of` its spec. (Effects that change the contact are not applied.)"""
+    if sol.spec.free_contact:
+        return np.array([sol.solution.parameters[f"c.{n}"] for n in contact_mod.param_names()], dtype=float)
+    return contact_params_of(sol.spec)
+
+
 def slip_velocities(model: ChildModel, q: np.ndarray, qd: np.ndarray, p_contact) -> np.ndarray:
     """Each ellipsoid's slip velocity (m/s, +x forward; :meth:`gaitlib.model.ChildModel.slip`)
     at every row of ``q``, ``qd`` (n, 11; SI) → (6, n), order :data:`gaitlib.model.ELLIPSOID_LABELS`."""

@@ -54,7 +54,6 @@ from .. import ocp
 from ..problems import gait as gait_ocp
 from .. import validity
 from . import jump
-from .. import contact
 from ..model import ELLIPSOID_LABELS, ChildModel
 from . import contact_id as ci
 from .. import mtg
@@ -211,10 +210,7 @@ class StoredGait:
         e, q, qd = self.ellipsoids, self.q, self.qd
         if e is None or q is None or qd is None or any(c.startswith("vs_") for c in e.columns) or self.spec.effects:
             return
-        if self.spec.free_contact:
-            pc = np.array([self.solution.parameters[f"c.{n}"] for n in contact.param_names()])
-        else:
-            pc = gait_ocp.contact_params_of(self.spec)
+        pc = gait_ocp.solved_contact_params(self)
         vs = gait_ocp.slip_velocities(ChildModel(), q[list(cv.COORDS)].to_numpy(), qd[list(cv.COORDS)].to_numpy(), pc)
         self.ellipsoids = e.assign(**{f"vs_{lab}": vs[i] for i, lab in enumerate(ELLIPSOID_LABELS)})
 
@@ -424,9 +420,10 @@ CH4_FRICTION_HEADING = "Do the identified feet stand still? (b) and (c) with a f
 
 def _ch4_friction_causes() -> dict:
     """"b"/"c" → what identifying with every μ ≥ the friction floor measured
-    (:func:`gaitlib.studies.contact_id.friction_identification`): the book's foot slip and mean
-    GRF RMSE beside the bounded run's; empty when not stored, and "not compared" when either
-    run is not converged or not valid."""
+    (:func:`gaitlib.studies.contact_id.friction_identification`, the floor alone): the book's
+    foot slip and mean GRF RMSE beside the bounded run's, and how deep each sinks; with how
+    fast the tracking reference's own feet slide (:func:`gaitlib.studies.gait.reference_slip`).
+    Empty when not stored; "not compared" when either run is not converged or not valid."""
     try:
         with cache.only("the card reads stored solutions only"):
             runs = ci.friction_identification()
@@ -435,6 +432,7 @@ def _ch4_friction_causes() -> dict:
     t = ci.friction_table(runs)
     where = _anchor("ch04_contact", CH4_FRICTION_HEADING)
     f = fidelity.FRICTION_FLOOR
+    ref = sg.reference_slip("ch4")
     out = {}
     for k in ("b", "c"):
         r0, r1 = t.loc[ci.APPROACHES[k]], t.loc[ci.friction_label(k, f)]
@@ -442,11 +440,12 @@ def _ch4_friction_causes() -> dict:
         if not usable:
             out[k] = f"({k}) with every μ ≥ {f:g}: not compared ({r1['status']}, {r1['gates']}) [{where}]"
             continue
-        out[k] = (f"its feet slide {r0[sg.SLIP_COLUMN]:.2f} m/s under load (ball μ_d {r0['ball mu_d']:.3f}); "
-                  f"identified with every μ ≥ {f:g} they "
+        out[k] = (f"its feet slide {r0[sg.SLIP_COLUMN]:.2f} m/s under load (ball μ_d {r0['ball mu_d']:.3f}; the "
+                  f"tracking reference's own feet slide {ref['slip']:.2f} m/s); identified with every μ ≥ {f:g} they "
                   f"{'stand' if r1[sg.SLIP_COLUMN] <= fidelity.SLIP_V else 'still slide'} "
-                  f"({r1[sg.SLIP_COLUMN]:.2f} m/s) and the mean GRF "
-                  f"RMSE goes {r0['mean GRF RMSE (N)']:.1f} → {r1['mean GRF RMSE (N)']:.1f} N [{where}]")
+                  f"({r1[sg.SLIP_COLUMN]:.2f} m/s) but sink {r1['deepest sink (mm)']:.0f} mm (vs "
+                  f"{r0['deepest sink (mm)']:.0f}) and the mean GRF RMSE goes {r0['mean GRF RMSE (N)']:.1f} → "
+                  f"{r1['mean GRF RMSE (N)']:.1f} N [{where}]")
     return out
 
 

@@ -1050,6 +1050,10 @@ def c_ablation_findings(table: pd.DataFrame) -> list[str]:
 SINK_LIMIT = 0.018
 
 
+#: The friction table's column: does the identified set carry the data's load at rest?
+REST_COLUMN = "data's load at rest"
+
+
 def friction_label(key: str, floor: float, max_sink: float | None = None) -> str:
     """The row label of approach ``key`` ("b"/"c") identified with every μ ≥ ``floor`` (and no
     ellipsoid deeper than ``max_sink`` m)."""
@@ -1085,8 +1089,9 @@ def friction_table(runs: dict[str, ApproachResult]) -> pd.DataFrame:
     objective, the (b) start kept, each foot force's RMSE and their mean (N), the worst angle
     (deg) and torque (N·m) RMSE, the force-weighted foot slip (m/s) and the share of the load
     carried sliding faster than v_tr (%; :func:`gaitlib.studies.gait.foot_slip`), the deepest
-    any ellipsoid sinks into the ground (mm, :func:`gaitlib.studies.gait.foot_sink`), and the
-    ball's identified μ_s, μ_d."""
+    any ellipsoid sinks into the ground (mm, :func:`gaitlib.studies.gait.foot_sink`), whether
+    the identified set carries the data's load at rest in the data's poses (what the Ch 5
+    reference needs, :func:`gaitlib.studies.gait.static_support`), and the ball's μ_s, μ_d."""
     rows = {}
     for k, r in runs.items():
         rm = r.rmse.set_index("channel")
@@ -1102,6 +1107,7 @@ def friction_table(runs: dict[str, ApproachResult]) -> pd.DataFrame:
         row[gait_study.SLIP_COLUMN] = fs["slip"]
         row[f"load sliding > {gait_study.SLIP_V:g} m/s (%)"] = 100 * fs["sliding"]
         row["deepest sink (mm)"] = 1e3 * gait_study.foot_sink(r.q, r.p_contact)
+        row[REST_COLUMN] = gait_study.static_support(r.p_contact) or "carried"
         for m in ("mu_s", "mu_d"):
             row[f"ball {m}"] = float(r.p_contact[contact_mod.param_index("ball", m)])
         rows[k] = row
@@ -1136,7 +1142,10 @@ def friction_findings(table: pd.DataFrame) -> list[str]:
                        f"{r1[gait_study.SLIP_COLUMN]:.3f} m/s (force-weighted; load carried sliding > {v:g} m/s "
                        f"{r0[f'load sliding > {v:g} m/s (%)']:.0f} → {r1[f'load sliding > {v:g} m/s (%)']:.0f} %), "
                        f"the ball's μ_d {r0['ball mu_d']:.4f} → {r1['ball mu_d']:.4f}; the deepest an ellipsoid sinks "
-                       f"{r0['deepest sink (mm)']:.1f} → {r1['deepest sink (mm)']:.1f} mm.")
+                       f"{r0['deepest sink (mm)']:.1f} → {r1['deepest sink (mm)']:.1f} mm"
+                       + ("." if r1[REST_COLUMN] == "carried" else
+                          f"; at rest in the data's poses the set cannot carry the data's load ({r1[REST_COLUMN]}), "
+                          "so no tracking reference (Ch 5) can be built on it."))
     return out
 
 

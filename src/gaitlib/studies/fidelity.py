@@ -116,8 +116,9 @@ def ablation_specs(model: str = "MSK", bound_bw: float = SWING_BOUND_BW) -> dict
 
 
 def ablation_row(label: str, sol: gait_ocp.GaitSolution) -> dict:
-    """One row of the ablation table: convergence, the gates that the swing concerns, and
-    the worst RMSE per channel kind (deg, N·m, N)."""
+    """One row of the ablation table: convergence, the gates that the swing concerns, the
+    force-weighted foot slip (m/s, :func:`foot_slip`), the deepest any ellipsoid sinks (mm,
+    :func:`gaitlib.studies.gait.foot_sink`), and the worst RMSE per channel kind (deg, N·m, N)."""
     g = validity.check(sol)
     tab = g.table.set_index("check")
     worst = sol.rmse.groupby("kind")["rmse"].max()
@@ -126,6 +127,7 @@ def ablation_row(label: str, sol: gait_ocp.GaitSolution) -> dict:
             "swing load (N)": float(tab.loc["swing_load", "value"]),
             "double support (%)": float(tab.loc["double_support", "value"]),
             SLIP_COLUMN: foot_slip(sol)["slip"],
+            "deepest sink (mm)": 1e3 * gait_study.foot_sink(sol.q, gait_ocp.solved_contact_params(sol)),
             "worst angle RMSE (deg)": float(worst.get("angle", np.nan)),
             "worst torque RMSE (N·m)": float(worst.get("torque", np.nan)),
             "worst GRF RMSE (N)": float(worst.get("grf", np.nan)),
@@ -287,9 +289,6 @@ METATARSAL_FREE = "metatarsal untracked"
 SD_NORM = "tracking normalised by the data's SD"
 #: The Ch 5 ablation's row with every ellipsoid's friction at least :data:`FRICTION_FLOOR`.
 FRICTION_ROW = "friction at least Table 4.18's toe μ_d (no skating ball)"
-#: The Ch 5 ablation's row with the parameter sets Ch 4 (c) identifies with every friction
-#: coefficient ≥ :data:`FRICTION_FLOOR` (``data/identified/ch4_friction.json``).
-CH4_FRICTION_ROW = f"Ch 4 sets identified with friction ≥ {gait_study.FRICTION_FLOOR:g} (feet that stand)"
 #: The Ch 5 ablation's row of the same problem with its defects in integral form.
 INTEGRAL_DEFECTS = "defects in integral form (the same NLP)"
 
@@ -311,9 +310,7 @@ def ch5_changes(model: str = "MSK") -> dict[str, dict]:
     shifted instead of Eqs 4.1–4.3's five-harmonic series (:attr:`GaitSpec.fourier_order`;
     the row the Ch 4 (c) ablation also has); and :data:`FRICTION_ROW`, every ellipsoid's
     friction coefficients at least :data:`FRICTION_FLOOR` (the ball's identified μ ≈ 0.01 lets
-    a loaded foot slide, :func:`foot_slip`), and :data:`CH4_FRICTION_ROW`, the contact and
-    body parameters Ch 4 (c) identifies with that floor as the friction's lower bound
-    (:func:`gaitlib.studies.contact_id.friction_identification`) instead of ours. The last row,
+    a loaded foot slide, :func:`foot_slip`). The last row,
     :data:`INTEGRAL_DEFECTS`, changes no problem: the same NLP with its collocation defects in
     integral form (:attr:`GaitSpec.defects`, an invertible linear map of the rows, so the same
     feasible set and optima), which IPOPT walks along another path — how much of the misfit
@@ -334,7 +331,6 @@ def ch5_changes(model: str = "MSK") -> dict[str, dict]:
             {"track_mtp": False, "weights": (("Q", MTB_FREE_Q), ("Mtb", 0.0))}} if "Mtb" in w else {}),
         SD_NORM: {"track_norm": "sd"},
         FRICTION_ROW: {"friction_floor": FRICTION_FLOOR},
-        CH4_FRICTION_ROW: {"contact_params": "ch4_friction", "body_params": "ch4_friction"},
         ci_study.LEFT_SHIFTED_ROW: {"fourier_order": gait_ocp.EXACT_FOURIER_ORDER},
         INTEGRAL_DEFECTS: {"defects": "integral"},
     }
@@ -443,7 +439,7 @@ def ch5_ablation_findings(table: pd.DataFrame, per_channel: pd.DataFrame, floor:
 
 
 def single_change_findings(table: pd.DataFrame, per_channel: pd.DataFrame,
-                           rows: tuple = (SD_NORM, ci_study.LEFT_SHIFTED_ROW, FRICTION_ROW, CH4_FRICTION_ROW),
+                           rows: tuple = (SD_NORM, ci_study.LEFT_SHIFTED_ROW, FRICTION_ROW),
                            n_moves: int = 4) -> list[str]:
     """One sentence per ``rows`` entry of a Ch 5 ablation (:func:`ch5_ablation`; ``per_channel``:
     its :func:`channel_table` over the usable runs) beside the book's run (:data:`CH5_BASE_ROW`):

@@ -32,7 +32,7 @@ from .. import validity
 from ..model import ChildModel
 
 __all__ = ["READINGS", "reading_options", "THESIS_RMSE", "natural_gait", "natural_gait_spec", "rmse_beside_thesis",
-           "channels_frame", "sims_and_marks", "write_outputs", "stats_table", "SLIP_V", "SLIP_COLUMN", "foot_slip", "foot_sink", "reference_slip",
+           "channels_frame", "sims_and_marks", "write_outputs", "stats_table", "SLIP_V", "SLIP_COLUMN", "foot_slip", "foot_sink", "reference_slip", "static_support",
            "FRICTION_FLOOR"]
 
 #: Thesis RMSEs (different data, Bovi 2011): (kind, joint/component, side) → value.
@@ -258,3 +258,17 @@ def reference_slip(contact_params: str = "ch4", speed_class: str = "Free", v: fl
             "anchored_slip": float((fn * np.abs(anchored)).sum() / load),
             "anchored_sliding": float((fn * (np.abs(anchored) > v)).sum() / load),
             "hat_speed_min": float(hat.min()), "hat_speed_max": float(hat.max()), "speed": float(gd.speed)}
+
+
+def static_support(p_contact, speed_class: str = "Free") -> str | None:
+    """Whether a contact set (39,) carries the data's vertical load at rest in the data's
+    poses, as the tracking reference's HAT height needs (:func:`gaitlib.kinematics.
+    height_for_load` inside :func:`gaitlib.problems.gait.reference`): None if it does, else
+    why not (the pose and load it cannot carry). A set that cannot has no Ch 5 reference."""
+    try:
+        gait_ocp.reference(data_mod.load_gait_data(speed_class), ChildModel(), p_contact)
+    except ValueError as e:
+        if "penetration" not in str(e):
+            raise
+        return str(e)
+    return None
