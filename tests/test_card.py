@@ -190,3 +190,15 @@ def test_time_ratio_row_sums_the_runs_and_splits_the_ratio():
     assert row.thesis == 3.0 and row.ours == pytest.approx(1.0)
     assert row.cause == ("MSK 300 s in 200 iterations, NMSK 300 s in 100: iterations ×2.00, time per iteration "
                          "×0.50 (sums over the runs)")
+
+
+def test_slip_lines_by_hand():
+    t = pd.DataFrame({"slip (m/s)": [0.05, 0.2, 0.9], "rows": [2, 3, 4], "rows counted as reproduced": [1, 2, 1],
+                      "reference's slip (m/s)": [0.23, 0.23, 0.47]})
+    (line,) = card.slip_lines(t)
+    # two solutions above v_tr = 0.1 m/s, backing 3 + 4 rows, 2 + 1 of them counted as agreeing
+    assert "Of the 3 stored gait solutions behind the card's rows, 2 carry their load" in line
+    assert "slip 0.05–0.90 m/s" in line and "They back 7 rows, 3 of them" in line
+    # references 0.23–0.47; faster than their reference: 0.9 > 0.47 only
+    assert "already slide 0.23–0.47 m/s; 1 of the 3 solutions slide faster than their reference." in line
+    assert card.slip_lines(t.iloc[:0]) == []

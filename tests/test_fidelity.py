@@ -340,3 +340,11 @@ def test_skating_findings_by_hand():
     # the marked Fast run is left out of the minimum: Free 5.5 < Slow 6.0
     assert "minimum at **Free**, the natural speed." in b and "Left out (marked): Fast (NOT CONVERGED" in b
     assert "Still sliding faster than 0.1 m/s: Free — the minimum's own run" in b
+    # with each run's reference slip: runs faster than their reference are named
+    ref = {"Slow": {"slip": 0.3}, "Free": {"slip": 0.9}, "Fast": {"slip": 0.4}}
+    a, r, b = fidelity.skating_findings(cot, slip, cot_f, slip_f, pd.DataFrame(), floor=0.3, reference=ref)
+    assert "already slide: Slow 0.30 m/s, Free 0.90 m/s, Fast 0.40 m/s" in r
+    assert "faster than their own reference at Slow, Fast." in r and "every speed" not in r
+    _, r, _ = fidelity.skating_findings(cot, slip, cot_f, slip_f, pd.DataFrame(), floor=0.3,
+                                        reference={k: {"slip": 0.1} for k in ref})
+    assert "at Slow, Free, Fast — every speed: the extra slide is the prediction's, not the data's." in r

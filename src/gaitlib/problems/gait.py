@@ -999,15 +999,22 @@ COST_TERMS = {"Jrk": goal_jrk, "Rsd": goal_rsd, "Imp": goal_imp, "HAT": goal_hat
               "Mtb": goal_mtb, "Trq": goal_trq, "Ang": goal_ang, "GRF": goal_grf, "Q": goal_q}
 
 
-def build(spec: GaitSpec) -> GaitProblem:
-    """Turn a :class:`GaitSpec` into an :class:`ocp.Problem` with mesh, options, guess."""
-    model = ChildModel()
+def spec_gait_data(spec: GaitSpec) -> tuple[data_mod.GaitData, data_mod.GaitData]:
+    """(the speed class's data, the data the spec tracks): the same unless ``track_class``
+    is set (then that class's data scaled in time to the speed class's cycle)."""
     # the default call unless the spec asks for another order (a gap diagnosis on a user's
     # data set substitutes load_gait_data for its default arguments: gaitlib.studies.gap.own_data)
     order = {"fourier_order": spec.fourier_order} if spec.fourier_order else {}
     gait_class = data_mod.load_gait_data(spec.speed_class, spec.source, **order)
     gait = (data_mod.time_scaled(data_mod.load_gait_data(spec.track_class, spec.source, **order), gait_class)
             if spec.track_class else gait_class)
+    return gait_class, gait
+
+
+def build(spec: GaitSpec) -> GaitProblem:
+    """Turn a :class:`GaitSpec` into an :class:`ocp.Problem` with mesh, options, guess."""
+    model = ChildModel()
+    gait_class, gait = spec_gait_data(spec)
     p_body = params_mod.body_params(spec.body_params, model)
     p_contact = contact_params_of(spec)
     ref = reference(gait, model, p_contact, jerk_ranges=spec.jerk_ranges or "reference",

@@ -1368,17 +1368,24 @@ def slip_table(card: pd.DataFrame) -> pd.DataFrame:
     gate) of every stored gait solution a card row names (``gait/<key>`` in its ``solution``
     column): chapter, the solution, its rows, the force-weighted slip speed of the loaded
     feet (m/s), the share of the load carried while sliding faster than the friction law's
-    v_tr (%), the walking speed (m/s) and the row verdicts it carries."""
+    v_tr (%), how fast the feet of its tracking reference alone slide (m/s, no solve:
+    :func:`gaitlib.studies.gait.reference_slip` of its spec), the walking speed (m/s) and the
+    row verdicts it carries."""
     out = []
+    refs: dict = {}
     ids = card["solution"].str.extract(r"^(gait/[0-9a-f]{16})", expand=False)
     for sid, part in card.groupby(ids, sort=False):
         sol = stored_gait(cache.default_dir() / sid)
         if sol is None:
             continue
         f = fidelity.foot_slip(sol)
+        sp = sol.spec
+        rk = (sp.speed_class, sp.track_class, sp.source, sp.fourier_order, sp.contact_params, sp.friction_floor)
+        if rk not in refs:  # the reference depends on the data and the contact set only
+            refs[rk] = sg.reference_slip(sp)["slip"]
         out.append({"chapter": int(part["chapter"].iloc[0]), "solution": part["solution"].iloc[0], "rows": len(part),
                     "slip (m/s)": f["slip"], f"load sliding > {fidelity.SLIP_V:g} m/s (%)": 100 * f["sliding"],
-                    "walking speed (m/s)": f["speed"],
+                    "reference's slip (m/s)": refs[rk], "walking speed (m/s)": f["speed"],
                     "verdicts": ", ".join(f"{k} {v}" for k, v in part["verdict"].value_counts().items()),
                     "rows counted as reproduced": int(part["verdict"].isin(_AGREE).sum())})
     return pd.DataFrame(out)
@@ -1391,13 +1398,17 @@ def slip_lines(table: pd.DataFrame) -> list[str]:
     if table.empty:
         return []
     v = fidelity.SLIP_V
+    ref = "reference's slip (m/s)"
     over = table[table["slip (m/s)"] > v]
     carried = int(over["rows counted as reproduced"].sum())
     return [f"Of the {len(table)} stored gait solutions behind the card's rows, {len(over)} carry their load on feet "
             f"that slide faster than the friction law's sticking limit v_tr = {v:g} m/s on average (force-weighted "
             f"slip {table['slip (m/s)'].min():.2f}–{table['slip (m/s)'].max():.2f} m/s; a standing foot does not "
             f"slide). They back {int(over['rows'].sum())} rows, {carried} of them now reproduced, within data SD or "
-            "qualitatively reproduced. Foot slip is measured here, not yet a validity gate."]
+            "qualitatively reproduced. Foot slip is measured here, not yet a validity gate."
+            + (f" Their tracking references alone — the data on the model, no solve — already slide "
+               f"{table[ref].min():.2f}–{table[ref].max():.2f} m/s; {int((table['slip (m/s)'] > table[ref]).sum())} of "
+               f"the {len(table)} solutions slide faster than their reference." if ref in table.columns else "")]
 
 
 def build(chapters=(3, 4, 5, 6, 7)) -> pd.DataFrame:

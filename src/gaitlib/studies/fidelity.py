@@ -800,13 +800,16 @@ def cot_terms(cot: pd.DataFrame, solutions: dict) -> pd.DataFrame:
 
 
 def skating_findings(cot: pd.DataFrame, slip: pd.DataFrame, cot_f: pd.DataFrame, slip_f: pd.DataFrame,
-                     terms_f: pd.DataFrame, floor: float = FRICTION_FLOOR, reruns: tuple = ()) -> list[str]:
+                     terms_f: pd.DataFrame, floor: float = FRICTION_FLOOR, reruns: tuple = (),
+                     reference: dict | None = None) -> list[str]:
     """The consistent curve's runs (``cot``, ``slip``: :func:`gaitlib.studies.predictive.cot_table`
     and :func:`slip_table`, rows by class) beside the same problem with every ellipsoid's
     friction at least ``floor`` (``cot_f``, ``slip_f``, ``terms_f``: :func:`cot_terms`): how
     fast the loaded feet slide at each speed, and where the curve's minimum is once they
     cannot skate. Runs marked (not converged or failing a gate) are named and left out;
-    ``reruns``: the classes whose 3000-iteration rerun stands in (named)."""
+    ``reruns``: the classes whose 3000-iteration rerun stands in (named); ``reference``: class →
+    :func:`gaitlib.studies.gait.reference_slip` of that run's spec (how fast its tracking
+    reference's own feet slide, no solve), said beside the runs' slip."""
     col = "slip, force-weighted (m/s)"
     share = [c for c in slip.columns if c.startswith("load carried")][0]
     ok = [c for c in cot.index if not cot.loc[c, "mark"] and c in slip.index]
@@ -821,6 +824,15 @@ def skating_findings(cot: pd.DataFrame, slip: pd.DataFrame, cot_f: pd.DataFrame,
                    f"friction law models sticking below {SLIP_V:g} m/s, and a standing foot does not slide. The ball "
                    f"ellipsoids{share_txt} have μ_s {ts:.4f}, μ_d {td:.4f} in the thesis's Table 4.18 and μ_s {os_:.4f}, "
                    f"μ_d {od:.4f} in our Ch 4 identification (Table 4.7's lower bound: 0.01).")
+        ref = [c for c in ok if reference and c in reference]
+        if ref:
+            faster = [c for c in ref if slip.loc[c, col] > reference[c]["slip"]]
+            out.append("The data each run tracks, placed on the model as its reference (no solve; "
+                       "`gait.reference_slip`), already slide: "
+                       + ", ".join(f"{c} {reference[c]['slip']:.2f} m/s" for c in ref)
+                       + (f". The runs slide faster than their own reference at {', '.join(faster)}"
+                          + (" — every speed: the extra slide is the prediction's, not the data's." if len(faster) == len(ref)
+                             else ".") if faster else ". No run slides faster than its reference."))
     okf = [c for c in cot_f.index if not cot_f.loc[c, "mark"] and c in slip_f.index]
     bad = [f"{c} ({cot_f.loc[c, 'mark']})" for c in cot_f.index if cot_f.loc[c, "mark"]]
     if okf:

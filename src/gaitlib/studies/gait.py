@@ -21,7 +21,6 @@ import pandas as pd
 
 from .. import contact as contact_mod
 from .. import kinematics
-from .. import params as params_mod
 from .. import conventions as cv
 from ..problems import gait as gait_ocp
 from ..problems.gait import solve_cached, tracking_data
@@ -226,21 +225,22 @@ def foot_sink(q: pd.DataFrame, p_contact) -> float:
 
 
 
-def reference_slip(contact_params: str = "ch4", speed_class: str = "Free", v: float = SLIP_V) -> dict:
-    """How fast the loaded feet of the tracking reference itself slide: the data's
-    kinematics as the Q term tracks them (:func:`gaitlib.problems.gait.reference`: the data's
+def reference_slip(spec: gait_ocp.GaitSpec, v: float = SLIP_V) -> dict:
+    """How fast the loaded feet of a spec's tracking reference itself slide: the data the
+    spec tracks as its Q term tracks them (:func:`gaitlib.problems.gait.reference`: the data's
     joint angles, the HAT upright, moving at the walking speed, at the height where the
-    contact carries the data's vertical load at rest) with the contact set ``contact_params``
-    (:func:`gaitlib.params.contact_params`), each ellipsoid weighted by its normal force at
-    rest in that pose. No solve: what a gait that tracked its reference exactly would ask of
-    its feet. Returns ``slip`` (force-weighted mean |v_slip|, m/s), ``sliding`` (share of the
-    load on ellipsoids sliding faster than ``v``, 0…1), and the same two (``anchored_slip``,
-    ``anchored_sliding``) with the HAT's horizontal speed changed at every instant so that
-    the load-weighted mean slip is zero — what is left cannot come from the constant-speed
-    HAT reference — with that speed's range (``hat_speed_min``, ``hat_speed_max``, m/s)."""
+    contact carries the data's vertical load at rest) with the spec's contact set
+    (:func:`gaitlib.problems.gait.contact_params_of`), each ellipsoid weighted by its normal
+    force at rest in that pose. No solve: what a gait that tracked its reference exactly
+    would ask of its feet. Returns ``slip`` (force-weighted mean |v_slip|, m/s), ``sliding``
+    (share of the load on ellipsoids sliding faster than ``v``, 0…1), the same two
+    (``anchored_slip``, ``anchored_sliding``) with the HAT's horizontal speed changed at every
+    instant so that the load-weighted mean slip is zero — what is left cannot come from the
+    constant-speed HAT reference — that speed's range (``hat_speed_min``, ``hat_speed_max``)
+    and the walking speed (``speed``), m/s."""
     m = ChildModel()
-    pc = params_mod.contact_params(contact_params)
-    gd = data_mod.load_gait_data(speed_class)
+    pc = gait_ocp.contact_params_of(spec)
+    _, gd = gait_ocp.spec_gait_data(spec)
     ref = gait_ocp.reference(gd, m, pc)
     der = {c: ref.deriv[c](gd.time) for c in cv.COORDS}
     q = np.array([der[c][0] for c in cv.COORDS]).T
