@@ -184,3 +184,20 @@ def test_reference_slip_findings_name_the_cause_by_the_anchored_slip():
     assert "against each other" in a
     (b,) = ci_study.reference_slip_findings({"ours": {**r, "anchored_slip": 0.05}})
     assert "constant-speed HAT reference is what asks the feet to slide" in b
+
+
+def test_friction_starts_findings_name_a_feasible_better_start_by_hand():
+    f, sink = 0.2819, 0.018
+    cols = ["converged", "valid", "objective", "deepest sink (mm)", gait_study.SLIP_COLUMN, "kept"]
+    only = pd.DataFrame([[True, True, 0.026, 40.3, 0.013, True], [True, True, 0.039, 17.6, 0.024, False],
+                         [True, False, 0.030, 10.0, 0.01, False]], index=["neutral", "ch4_child", "bad"], columns=cols)
+    both = pd.DataFrame([[True, True, 0.36, 18.0, 0.14, False], [True, True, 0.101, 13.5, 0.017, True]],
+                        index=["neutral", "ch4_child"], columns=cols)
+    runs = {ci_study.friction_label("b", f): SimpleNamespace(starts=only),
+            ci_study.friction_label("b", f, sink): SimpleNamespace(starts=both)}
+    (line,) = ci_study.friction_starts_findings(runs, f, sink)
+    # neutral sinks 40.3 mm > 18; 'bad' is not valid; ch4_child: 17.6 mm ≤ 18 and 0.039 < 0.101
+    assert "start 'ch4_child'" in line and "objective 0.0390" in line and "sinking 17.6 mm (within the 18 mm bound)" in line
+    assert "below the 0.1010 its multistart kept ('ch4_child')" in line
+    both.loc["ch4_child", "objective"] = 0.03
+    assert ci_study.friction_starts_findings(runs, f, sink) == []

@@ -86,7 +86,7 @@ __all__ = [
     "body_table", "at_bounds", "friction_ratios", "residual_rms", "grf_fit", "dynamic_consistency", "grf_error_by_phase",
     "save_identified", "identified_vs_result", "THESIS_RANKING", "ranking", "findings",
     "C_TARGET_FACTOR", "C_BASE_ROW", "C_GRF_SCAN", "C_GRF_LEFT", "c_changes", "c_ablation_specs", "c_ablation", "c_ablation_table",
-    "c_ablation_findings", "SINK_LIMIT", "friction_label", "friction_identification", "friction_table", "friction_findings", "reference_slip_findings",
+    "c_ablation_findings", "SINK_LIMIT", "friction_label", "friction_identification", "friction_table", "friction_findings", "friction_starts_findings", "reference_slip_findings",
     "left_leg_table", "LEFT_SHIFTED_ROW", "left_leg_findings",
 ]
 
@@ -434,12 +434,16 @@ def optimal_control_multistart(spec: gait_ocp.GaitSpec | None = None, starts=B_S
 
 def starts_table(runs: dict[str, ApproachResult]) -> pd.DataFrame:
     """One row per start of (b): status, converged, valid (:func:`gaitlib.validity.check`),
-    iterations (all stages), objective, the Eq 4.5 part, each ellipsoid's k_v (N/m³)."""
+    iterations (all stages), objective, the Eq 4.5 part, the force-weighted foot slip (m/s,
+    :func:`gaitlib.studies.gait.foot_slip`), the deepest sink (mm,
+    :func:`gaitlib.studies.gait.foot_sink`), each ellipsoid's k_v (N/m³)."""
     rows = {}
     for name, r in runs.items():
         g = validity.check(r.solution)
         row = {"status": r.stats["status"], "converged": bool(r.success), "valid": bool(g.passed), "gates": g.label(),
-               "iterations": r.stats["iterations"], "objective": r.stats["objective"], "Eq 4.5 part": r.stats["eq4_5"]}
+               "iterations": r.stats["iterations"], "objective": r.stats["objective"], "Eq 4.5 part": r.stats["eq4_5"],
+               gait_study.SLIP_COLUMN: gait_study.foot_slip(r.solution)["slip"],
+               "deepest sink (mm)": 1e3 * gait_study.foot_sink(r.q, r.p_contact)}
         for e in cv.ELLIPSOIDS:
             row[f"k_v {e} (N/m³)"] = float(r.p_contact[contact_mod.param_index(e, "k_v")])
         rows[name] = row
@@ -1147,6 +1151,27 @@ def friction_findings(table: pd.DataFrame) -> list[str]:
                           f"; at rest in the data's poses the set cannot carry the data's load ({r1[REST_COLUMN]}), "
                           "so no tracking reference (Ch 5) can be built on it."))
     return out
+
+
+def friction_starts_findings(runs: dict[str, ApproachResult], floor: float | None = None,
+                             max_sink: float = SINK_LIMIT) -> list[str]:
+    """Local optima of the bounded identifications (``runs``: :func:`friction_identification`):
+    a start of the friction-only (b) whose converged, valid solution already sinks no deeper
+    than ``max_sink`` (m) yet has a lower objective than the one the sink-bounded multistart
+    kept is a feasible point of the sink-bounded problem that its own starts did not reach —
+    named with both objectives. Empty when there is none (or a run is missing)."""
+    floor = gait_study.FRICTION_FLOOR if floor is None else float(floor)
+    only, both = runs.get(friction_label("b", floor)), runs.get(friction_label("b", floor, max_sink))
+    if only is None or both is None or only.starts is None or both.starts is None:
+        return []
+    st, kept = only.starts, both.starts[both.starts["kept"]].iloc[0]
+    ok = st[st["converged"] & st["valid"] & (st["deepest sink (mm)"] <= 1e3 * max_sink)
+            & (st["objective"] < kept["objective"])]
+    return [f"Local optima: from the start '{k}' the friction-only (b) reaches objective {r['objective']:.4f} with its "
+            f"feet sinking {r['deepest sink (mm)']:.1f} mm (within the {1e3 * max_sink:g} mm bound) and sliding "
+            f"{r[gait_study.SLIP_COLUMN]:.3f} m/s — a feasible point of the sink-bounded problem below the "
+            f"{kept['objective']:.4f} its multistart kept ('{both.starts.index[both.starts['kept']][0]}'). The "
+            "sink-bounded numbers are an upper bound on what the bound costs." for k, r in ok.iterrows()]
 
 
 def reference_slip_findings(refs: dict[str, dict]) -> list[str]:
