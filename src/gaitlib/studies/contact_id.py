@@ -1170,8 +1170,8 @@ def friction_starts_findings(runs: dict[str, ApproachResult], floor: float | Non
     return [f"Local optima: from the start '{k}' the friction-only (b) reaches objective {r['objective']:.4f} with its "
             f"feet sinking {r['deepest sink (mm)']:.1f} mm (within the {1e3 * max_sink:g} mm bound) and sliding "
             f"{r[gait_study.SLIP_COLUMN]:.3f} m/s — a feasible point of the sink-bounded problem below the "
-            f"{kept['objective']:.4f} its multistart kept ('{both.starts.index[both.starts['kept']][0]}'). The "
-            "sink-bounded numbers are an upper bound on what the bound costs." for k, r in ok.iterrows()]
+            f"{kept['objective']:.4f} its multistart kept ('{both.starts.index[both.starts['kept']][0]}'), so the "
+            "sink-bounded rows overstate what the bound costs." for k, r in ok.iterrows()]
 
 
 def reference_slip_findings(refs: dict[str, dict]) -> list[str]:
