@@ -64,8 +64,10 @@ print("Ch 3 jumps (the thesis's bounds, kept on purpose): " + "; ".join(
 # friction acts on the tangential velocity of each ellipsoid's body point at its penetration
 # centroid, and models sticking below its transition velocity v_tr = 0.1 m/s; a standing
 # foot does not slide. For every stored gait solution a row below names, the force-weighted
-# mean slip speed of the loaded feet (`card.slip_table`, `fidelity.foot_slip`); Ch 7
-# measures what happens when the feet cannot skate.
+# mean slip speed of the loaded feet (`card.slip_table`, `fidelity.foot_slip`), beside how
+# fast the feet of its tracking reference alone slide — the data it tracks placed on the
+# model, no solve (`gait.reference_slip`); Ch 4 identifies the contact again with feet that
+# cannot slide, Ch 7 solves its speeds again with feet that cannot skate.
 
 # %%
 slips = card.slip_table(c)

@@ -218,10 +218,13 @@ display(Markdown("\n\n".join(fidelity.cot_curve_findings(cot_u, terms_u))))
 # any ellipsoid: the toe's μ_d, 0.2819; `GaitSpec(friction_floor=…)`,
 # the Ch 5 start solved with the same floor) — **our change**, labelled, everything else as
 # above. A run that stops at the 1000-iteration limit counts through its converged, valid
-# 3000-iteration rerun from the same start (the chapter's rule), named below.
+# 3000-iteration rerun from the same start (the chapter's rule), named below. For scale, the
+# data each run tracks (Free scaled in time), placed on the model as its reference, slide
+# too (`gait.reference_slip`, no solve): the sentences say which runs slide faster than that.
 
 # %%
 slip_u = fidelity.slip_table({s.spec.speed_class: s for s in res_u.solutions.values()})
+ref_u = {s.spec.speed_class: gait.reference_slip(s.spec) for s in res_u.solutions.values()}
 try:
     with cache.only("the runs with the friction floor are read from the store "
                     "(fidelity.consistent_speed_study(friction_floor=...) solves them)"):
@@ -244,7 +247,8 @@ if res_f is not None:
     display(pd.concat({"as identified": slip_u, f"friction ≥ {fidelity.FRICTION_FLOOR:g}": slip_f}, axis=1),
             cot_f, terms_f)
     display(Markdown("\n\n".join(fidelity.skating_findings(cot_u, slip_u, cot_f, slip_f, terms_f,
-                                                            reruns=tuple(k.split()[-1] for k in res_f.rerun_used))
+                                                            reruns=tuple(k.split()[-1] for k in res_f.rerun_used),
+                                                            reference=ref_u)
                                   + fidelity.cot_curve_findings(cot_f, terms_f, name="The curve with the friction floor"))))
 else:
     display(slip_u)

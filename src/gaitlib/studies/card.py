@@ -432,7 +432,8 @@ def _ch4_friction_causes() -> dict:
     t = ci.friction_table(runs)
     where = _anchor("ch04_contact", CH4_FRICTION_HEADING)
     f = fidelity.FRICTION_FLOOR
-    ref = sg.reference_slip("ch4")
+    ref = sg.reference_slip(replace(ci.spec_c(), contact_params="ch4"))
+    local = bool(ci.friction_starts_findings(runs))
     out = {}
     for k in ("b", "c"):
         r0, r1 = t.loc[ci.APPROACHES[k]], t.loc[ci.friction_label(k, f)]
@@ -445,7 +446,12 @@ def _ch4_friction_causes() -> dict:
                   f"{'stand' if r1[sg.SLIP_COLUMN] <= fidelity.SLIP_V else 'still slide'} "
                   f"({r1[sg.SLIP_COLUMN]:.2f} m/s) but sink {r1['deepest sink (mm)']:.0f} mm (vs "
                   f"{r0['deepest sink (mm)']:.0f}) and the mean GRF RMSE goes {r0['mean GRF RMSE (N)']:.1f} → "
-                  f"{r1['mean GRF RMSE (N)']:.1f} N [{where}]")
+                  f"{r1['mean GRF RMSE (N)']:.1f} N")
+        sk = ci.friction_label(k, f, ci.SINK_LIMIT)
+        if sk in t.index and t.loc[sk, "status"] in validity.CONVERGED_STATUSES and t.loc[sk, "gates"] == "valid":
+            out[k] += (f"; sinking ≤ {1e3 * ci.SINK_LIMIT:g} mm as well, {t.loc[sk, 'mean GRF RMSE (N)']:.1f} N"
+                       + (" (from a (b) multistart that stops in a local optimum: an upper bound)" if local else ""))
+        out[k] += f" [{where}]"
     return out
 
 
