@@ -1179,13 +1179,22 @@ def reference_slip_findings(refs: dict[str, dict]) -> list[str]:
     fast the feet of the tracking reference itself slide — the data's kinematics on this
     model, no solve — and what is left with the HAT's speed free to anchor the loaded feet."""
     v = gait_study.SLIP_V
+
+    def parts(r):
+        b = r.get("by_ellipsoid")
+        return ("; by ellipsoid " + ", ".join(f"{e} {x:.2f}" for e, x in b.items()) + " m/s") if b else ""
+
+    def most(r):
+        b = r.get("by_ellipsoid")
+        return f" (most at the {max(b, key=b.get)} ellipsoids)" if b else ""
+
     return [f"The tracking reference itself ({k} contact set): its loaded feet slide {r['slip']:.3f} m/s "
-            f"(force-weighted; {100 * r['sliding']:.0f} % of the load sliding > {v:g} m/s) while the HAT moves at a "
+            f"(force-weighted{parts(r)}; {100 * r['sliding']:.0f} % of the load sliding > {v:g} m/s) while the HAT moves at a "
             f"constant {r['speed']:.2f} m/s; with the HAT's speed changed at every instant to anchor the loaded feet "
             f"(it then ranges {r['hat_speed_min']:.2f}–{r['hat_speed_max']:.2f} m/s) {r['anchored_slip']:.3f} m/s remain "
             f"({100 * r['anchored_sliding']:.0f} %)"
-            + (": the data's joint angles on this model's legs move the loaded feet against each other, so a gait "
-               "that tracked them exactly would slide." if r["anchored_slip"] > v else
+            + (f": the data's joint angles on this model's legs move the loaded feet over the ground{most(r)}, so a "
+               "gait that tracked them exactly would slide." if r["anchored_slip"] > v else
                ": the constant-speed HAT reference is what asks the feet to slide.") for k, r in refs.items()]
 
 

@@ -28,7 +28,7 @@ from .. import marks
 from .. import data as data_mod
 from .. import plots
 from .. import validity
-from ..model import ChildModel
+from ..model import ELLIPSOID_LABELS, ChildModel
 
 __all__ = ["READINGS", "reading_options", "THESIS_RMSE", "natural_gait", "natural_gait_spec", "rmse_beside_thesis",
            "channels_frame", "sims_and_marks", "write_outputs", "stats_table", "SLIP_V", "SLIP_COLUMN", "foot_slip", "foot_sink", "reference_slip", "static_support",
@@ -237,7 +237,8 @@ def reference_slip(spec: gait_ocp.GaitSpec, v: float = SLIP_V) -> dict:
     (``anchored_slip``, ``anchored_sliding``) with the HAT's horizontal speed changed at every
     instant so that the load-weighted mean slip is zero — what is left cannot come from the
     constant-speed HAT reference — that speed's range (``hat_speed_min``, ``hat_speed_max``)
-    and the walking speed (``speed``), m/s."""
+    and the walking speed (``speed``), m/s; ``by_ellipsoid``: the force-weighted slip of each
+    ellipsoid kind (toe, ball, heel; both feet), m/s."""
     m = ChildModel()
     pc = gait_ocp.contact_params_of(spec)
     _, gd = gait_ocp.spec_gait_data(spec)
@@ -257,7 +258,10 @@ def reference_slip(spec: gait_ocp.GaitSpec, v: float = SLIP_V) -> dict:
     return {"slip": float((fn * np.abs(vs)).sum() / load), "sliding": float((fn * (np.abs(vs) > v)).sum() / load),
             "anchored_slip": float((fn * np.abs(anchored)).sum() / load),
             "anchored_sliding": float((fn * (np.abs(anchored) > v)).sum() / load),
-            "hat_speed_min": float(hat.min()), "hat_speed_max": float(hat.max()), "speed": float(gd.speed)}
+            "hat_speed_min": float(hat.min()), "hat_speed_max": float(hat.max()), "speed": float(gd.speed),
+            "by_ellipsoid": {e: float(sum((fn[i] * np.abs(vs[i])).sum() for i in idx) / max(sum(fn[i].sum() for i in idx), 1e-12))
+                             for e in cv.ELLIPSOIDS
+                             for idx in [[i for i, lab in enumerate(ELLIPSOID_LABELS) if lab.startswith(e)]]}}
 
 
 def static_support(p_contact, speed_class: str = "Free") -> str | None:
