@@ -1190,8 +1190,9 @@ def reference_slip_findings(refs: dict[str, dict]) -> list[str]:
 
     return [f"The tracking reference itself ({k} contact set): its loaded feet slide {r['slip']:.3f} m/s "
             f"(force-weighted{parts(r)}; {100 * r['sliding']:.0f} % of the load sliding > {v:g} m/s) while the HAT moves at a "
-            f"constant {r['speed']:.2f} m/s; with the HAT's speed changed at every instant to anchor the loaded feet "
-            f"(it then ranges {r['hat_speed_min']:.2f}–{r['hat_speed_max']:.2f} m/s) {r['anchored_slip']:.3f} m/s remain "
+            f"constant {r['speed']:.2f} m/s; with the HAT's speed changed at every instant so that the loaded feet's "
+            f"load-weighted mean slip is zero "
+            f"(it then ranges {r['hat_speed_min']:.2f}–{r['hat_speed_max']:.2f} m/s) the slip is {r['anchored_slip']:.3f} m/s "
             f"({100 * r['anchored_sliding']:.0f} %)"
             + (f": the data's joint angles on this model's legs move the loaded feet over the ground{most(r)}, so a "
                "gait that tracked them exactly would slide." if r["anchored_slip"] > v else
