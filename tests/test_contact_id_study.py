@@ -167,34 +167,6 @@ def test_identified_file_round_trip_with_provenance(tmp_path, monkeypatch):
     assert cmp["max_rel_diff_contact"] == 0 and cmp["max_rel_diff_body"] == 0
 
 
-def test_friction_bounded_set_round_trip_records_its_bounds(tmp_path, monkeypatch):
-    # (c) identified with every μ ≥ 0.3: saved under its own name, with the bounds it had
-    # (Table 4.7's 0.01 raised to 0.3 for the 12 friction coefficients, nothing else), and a
-    # gait spec reads it as contact_params/body_params "ch4_friction" (its own cache set)
-    pc = contact.with_friction_floor(contact.default_params(), 0.3)
-    pb = ChildModel().default_p_body()
-    r = _fake_c_result(pc, pb)
-    r.solution.spec = dataclasses.replace(r.solution.spec, friction_floor=0.3)
-    monkeypatch.setattr(params, "IDENTIFIED_DIR", tmp_path)
-    path = ci.save_identified(r, name="ch4_friction")
-    assert path == tmp_path / "ch4_friction.json"
-    raw = json.loads(path.read_text())
-    lo, hi = contact.bounds()
-    for n, (a, b) in raw["bounds"]["p_contact"].items():
-        i = contact.param_names().index(n)
-        if n.endswith((".mu_s", ".mu_d")):
-            assert lo[i] == 0.01 and a == 0.3 and b == max(hi[i], 0.3)
-        else:
-            assert (a, b) == (lo[i], hi[i])
-    assert "lower bound raised to 0.3" in raw["description"]
-    np.testing.assert_array_equal(params.contact_params("ch4_friction"), pc)
-    np.testing.assert_array_equal(params.body_params("ch4_friction"), pb)
-    spec = gait_ocp.GaitSpec(model="SK", contact_params="ch4_friction", body_params="ch4_friction")
-    assert spec.identified_sets() == ("ch4_friction",)
-    with pytest.raises(ValueError, match="name must be one of"):
-        ci.save_identified(r, name="other")
-
-
 def test_identified_file_missing_or_bad_is_a_clear_error(tmp_path, monkeypatch):
     monkeypatch.setattr(params, "IDENTIFIED_DIR", tmp_path)
     with pytest.raises(FileNotFoundError, match="ch4_child.json"):

@@ -203,3 +203,16 @@ def test_friction_starts_findings_name_a_feasible_better_start_by_hand():
     assert "below the 0.1010 its multistart kept ('ch4_child')" in line
     both.loc["ch4_child", "objective"] = 0.03
     assert ci_study.friction_starts_findings(runs, f, sink) == []
+
+
+def test_static_support_names_the_pose_a_soft_set_cannot_carry():
+    # the thesis's set carries the data's load at rest; at 2 % of its stiffness the first
+    # pose's 413 N (data: total vertical GRF at 0 % of the Free cycle) needs > 6 cm of penetration
+    p = contact.default_params()
+    assert gait_study.static_support(p) is None
+    soft = p.copy()
+    for e in cv.ELLIPSOIDS:
+        soft[contact.param_index(e, "k_v")] *= 0.02
+    gd = data_mod.load_gait_data("Free")
+    load0 = float(gd.mean["grf_y_r"].iloc[0] + gd.mean["grf_y_l"].iloc[0])
+    assert gait_study.static_support(soft) == f"row 0: a load of {load0:.1f} N needs more than 0.06 m of penetration"

@@ -30,6 +30,7 @@ __all__ = [
     "pose_from_data",
     "settle_height",
     "height_for_load",
+    "LoadNotCarried",
 ]
 
 
@@ -149,6 +150,10 @@ def settle_height(model, q, p_body=None, p_contact=None, below: float = 0.04,
     return float(brentq(R_y, touch - below, touch + above, xtol=1e-12))
 
 
+class LoadNotCarried(ValueError):
+    """A contact set cannot carry a pose's load at rest within the searched penetration."""
+
+
 def height_for_load(model, Q, load, p_contact=None, below: float = 0.06, above: float = 0.002) -> np.ndarray:
     """``pelvis_ty`` (m) of each pose at which the six ellipsoids carry a given vertical load.
 
@@ -158,7 +163,7 @@ def height_for_load(model, Q, load, p_contact=None, below: float = 0.06, above: 
     both feet. The contact force falls monotonically as the body rises, so the root is
     unique; it is bracketed between ``above`` m over the height where the lowest ellipsoid
     touches the ground (no load) and ``below`` m under it. A load that needs more than
-    ``below`` of penetration raises ``ValueError`` naming the row.
+    ``below`` of penetration raises :class:`LoadNotCarried` (a ``ValueError``) naming the row.
 
     This estimates the HAT height that the thesis took from a pelvis marker (Sec 4.2.1),
     which the public data do not include.
@@ -185,7 +190,7 @@ def height_for_load(model, Q, load, p_contact=None, below: float = 0.06, above: 
 
         lo, hi = touch - below, touch + above
         if excess(lo) < 0:
-            raise ValueError(f"row {i}: a load of {load[i]:.1f} N needs more than {below} m of penetration")
+            raise LoadNotCarried(f"row {i}: a load of {load[i]:.1f} N needs more than {below} m of penetration")
         out[i] = brentq(excess, lo, hi, xtol=1e-13)
     return out
 

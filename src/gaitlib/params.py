@@ -35,7 +35,7 @@ from . import contact
 from .model import P_BODY_NAMES
 from .model import ChildModel
 
-__all__ = ["IDENTIFIED_DIR", "IDENTIFIED_CH4", "identified_path", "load_identified", "contact_params", "body_params"]
+__all__ = ["IDENTIFIED_DIR", "identified_path", "load_identified", "contact_params", "body_params"]
 
 #: Where identified parameter sets live (``data/identified/<name>.json``).
 IDENTIFIED_DIR = Path(data_mod.DATA_DIR) / "identified"
@@ -107,34 +107,26 @@ def load_identified(name: str = "ch4_child") -> dict:
     return {**out, "p_contact": out["p_contact"].copy(), "p_body": out["p_body"].copy()}
 
 
-#: Our Ch 4 (c) identifications a spec can name (``contact_params`` / ``body_params``) →
-#: their file stem under ``data/identified/``: ``"ch4"`` the book's (c) (Table 4.7's bounds),
-#: ``"ch4_friction"`` (c) identified with every friction coefficient ≥ the friction floor
-#: (:func:`gaitlib.studies.contact_id.friction_identification`; an ablation's set).
-IDENTIFIED_CH4 = {"ch4": "ch4_child", "ch4_friction": "ch4_friction"}
-
-
 def contact_params(which: str = "default") -> np.ndarray:
     """The 39 contact parameters (SI, left foot): ``"default"`` — the thesis's identified
     values (Tables 4.17–4.18, :func:`gaitlib.contact.default_params`); ``"ch4"`` — ours
-    (approach (c) of Ch 4, :func:`load_identified`); ``"ch4_friction"`` — ours with the
-    friction bound (:data:`IDENTIFIED_CH4`)."""
+    (approach (c) of Ch 4, :func:`load_identified`)."""
     if which == "default":
         return contact.default_params()
-    if which in IDENTIFIED_CH4:
-        return load_identified(IDENTIFIED_CH4[which])["p_contact"]
-    raise ValueError(f"contact parameters must be 'default' or one of {tuple(IDENTIFIED_CH4)}, got {which!r}")
+    if which == "ch4":
+        return load_identified("ch4_child")["p_contact"]
+    raise ValueError(f"contact parameters must be 'default' or 'ch4', got {which!r}")
 
 
 def body_params(which: str = "default", model=None) -> np.ndarray:
     """The 25 body/joint parameters (SI): ``"default"`` — Tables 4.1–4.3 scaled (Sec 4.1.1);
     ``"thesis"`` — the thesis's identified values (Tables 4.15–4.16); ``"ch4"`` — ours
-    (approach (c) of Ch 4, :func:`load_identified`); ``"ch4_friction"`` (:data:`IDENTIFIED_CH4`)."""
+    (approach (c) of Ch 4, :func:`load_identified`)."""
     model = ChildModel() if model is None else model
     if which == "default":
         return model.default_p_body()
     if which == "thesis":
         return model.p_body_identified()
-    if which in IDENTIFIED_CH4:
-        return load_identified(IDENTIFIED_CH4[which])["p_body"]
-    raise ValueError(f"body parameters must be 'default', 'thesis' or one of {tuple(IDENTIFIED_CH4)}, got {which!r}")
+    if which == "ch4":
+        return load_identified("ch4_child")["p_body"]
+    raise ValueError(f"body parameters must be 'default', 'thesis' or 'ch4', got {which!r}")

@@ -267,8 +267,7 @@ class GaitSpec:
         ``"ch4"`` (ours, Ch 4 approach (c), ``data/identified/ch4_child.json``,
         :func:`gaitlib.params.load_identified`). The fixed values, or the guess when free.
     contact_params : ``"default"`` (the thesis's Tables 4.17–4.18) or ``"ch4"`` (ours, as
-        ``body_params``; ``"ch4_friction"`` for both: ours identified with every friction
-        coefficient ≥ the friction floor, :data:`gaitlib.params.IDENTIFIED_CH4`). The fixed values, or the guess when free; also the geometry of the
+        ``body_params``). The fixed values, or the guess when free; also the geometry of the
         HAT-height reference.
     mtg_params : MSK/NMSK MTG fitting parameters (Eq 5.9) of the 12 generators (left leg =
         right leg): ``"default"`` — Eq 5.22, the adult Gymnast curves scaled to the child
@@ -352,8 +351,8 @@ class GaitSpec:
         load — at μ ≈ 0.01, so a loaded foot can slide almost for free; an ablation of the
         Fidelity II study measures what a floor on the friction changes. With
         ``free_contact`` (Ch 4 (b)/(c)): the lower bound of every μ_s and μ_d raised from
-        Table 4.7's 0.01 to the floor (the identification ablation of
-        :func:`gaitlib.studies.contact_id.c_changes`).
+        Table 4.7's 0.01 to the floor (the identification experiment of
+        :func:`gaitlib.studies.contact_id.friction_identification`).
     max_sink : ``None`` (the thesis: no such constraint) or a bound, m, on how deep any
         ellipsoid sinks into the ground at every node (the contact law's penetration depth δ
         of its lowest point, :func:`gaitlib.contact.ellipsoid_plane`). Volumetric contact
@@ -445,14 +444,12 @@ class GaitSpec:
             raise ValueError(f"activation_params must be None or 'ch5', got {self.activation_params!r}")
         if self.activation_params is not None and self.free_activation:
             raise ValueError("activation_params fixes γ; free_activation identifies it: choose one")
-        if self.body_params not in ("default", "thesis", *params_mod.IDENTIFIED_CH4):
-            raise ValueError(f"body_params must be 'default', 'thesis' or one of {tuple(params_mod.IDENTIFIED_CH4)}, "
-                             f"got {self.body_params!r}")
+        if self.body_params not in ("default", "thesis", "ch4"):
+            raise ValueError(f"body_params must be 'default', 'thesis' or 'ch4', got {self.body_params!r}")
         if self.mtg_params not in MTG_PARAM_SETS:
             raise ValueError(f"mtg_params must be one of {MTG_PARAM_SETS}, got {self.mtg_params!r}")
-        if self.contact_params not in ("default", *params_mod.IDENTIFIED_CH4):
-            raise ValueError(f"contact_params must be 'default' or one of {tuple(params_mod.IDENTIFIED_CH4)}, "
-                             f"got {self.contact_params!r}")
+        if self.contact_params not in ("default", "ch4"):
+            raise ValueError(f"contact_params must be 'default' or 'ch4', got {self.contact_params!r}")
         if self.contact_bounds not in ("widened", "table4.7"):
             raise ValueError(f"contact_bounds must be 'widened' or 'table4.7', got {self.contact_bounds!r}")
         if self.excitation_guess not in ("mtg", "emg"):
@@ -485,13 +482,11 @@ class GaitSpec:
 
     def identified_sets(self) -> tuple[str, ...]:
         """Names of the identified parameter sets (``data/identified/<name>.json``) this spec
-        reads: ``"ch4_child"`` for ``contact_params``/``body_params`` ``"ch4"`` (``"ch4_friction"``
-        for ``"ch4_friction"``, :data:`gaitlib.params.IDENTIFIED_CH4`), ``"ch5_mtg"``
+        reads: ``"ch4_child"`` for ``contact_params``/``body_params`` ``"ch4"``, ``"ch5_mtg"``
         for ``mtg_params="ch5"``. Cache keys hash exactly these (:func:`gaitlib.cache.fingerprint`)."""
         sets = []
-        for name, stem in params_mod.IDENTIFIED_CH4.items():
-            if name in (self.contact_params, self.body_params):
-                sets.append(stem)
+        if "ch4" in (self.contact_params, self.body_params):
+            sets.append("ch4_child")
         if self.mtg_params == "ch5":
             sets.append("ch5_mtg")
         if self.activation_params == "ch5":

@@ -799,12 +799,11 @@ def friction_ratios(results: dict[str, ApproachResult]) -> pd.DataFrame:
 # --------------------------------------------------------------------------------------
 
 
-def save_identified(res: ApproachResult, path=None, name: str = "ch4_child") -> Path:
+def save_identified(res: ApproachResult, path=None) -> Path:
     """Write (c)'s identified parameters with their provenance (:mod:`gaitlib.params` format).
 
     Refuses a result that did not converge (IPOPT status other than Solve_Succeeded).
-    ``name``: the set's name (a value of :data:`gaitlib.params.IDENTIFIED_CH4`); ``path``
-    default: :func:`gaitlib.params.identified_path` of it (``data/identified/<name>.json``).
+    ``path`` default: :func:`gaitlib.params.identified_path` (``data/identified/ch4_child.json``).
     Note: data JSON files are part of the solution-cache fingerprint, so writing this file
     makes every stored solution unreachable (they are recomputed on next use).
     """
@@ -812,24 +811,16 @@ def save_identified(res: ApproachResult, path=None, name: str = "ch4_child") -> 
         raise ValueError("save_identified: expects the approach (c) result")
     if not res.success:
         raise ValueError(f"save_identified: approach (c) did not converge ({res.stats['status']}); not saving")
-    if name not in params_mod.IDENTIFIED_CH4.values():
-        raise ValueError(f"save_identified: name must be one of {tuple(params_mod.IDENTIFIED_CH4.values())}, got {name!r}")
-    path = Path(path) if path is not None else params_mod.identified_path(name)
-    fl = res.solution.spec.friction_floor
+    path = Path(path) if path is not None else params_mod.identified_path("ch4_child")
     m = ChildModel()
     clo, chi = contact_mod.bounds()
-    if fl is not None:  # the bounds the identification had (GaitSpec.friction_floor)
-        clo = contact_mod.with_friction_floor(clo, fl)
-        chi = np.maximum(chi, clo)
     blo, bhi = m.p_body_bounds()
     st = res.stats
     out = {
-        "name": name,
+        "name": "ch4_child",
         "description": ("Contact (39, left foot) and body/joint (25) parameters identified by approach (c) of "
                         "thesis Sec 4.4 (optimal control, Eq 4.13, per-ellipsoid normal force >= 0, Table 4.7 and "
-                        "Table 4.14 bounds"
-                        + (f", every friction coefficient's lower bound raised to {fl:g}" if fl is not None else "")
-                        + ") on the Schwartz 2008 Free-speed data, both legs."),
+                        "Table 4.14 bounds) on the Schwartz 2008 Free-speed data, both legs."),
         "p_contact": {n: float(v) for n, v in zip(contact_mod.param_names(), res.p_contact)},
         "p_body": {n: float(v) for n, v in zip(P_BODY_NAMES, res.p_body)},
         "units": {"p_contact": {n: u for n, u in zip(contact_mod.param_names(),

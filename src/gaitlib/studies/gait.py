@@ -31,8 +31,8 @@ from .. import validity
 from ..model import ELLIPSOID_LABELS, ChildModel
 
 __all__ = ["READINGS", "reading_options", "THESIS_RMSE", "natural_gait", "natural_gait_spec", "rmse_beside_thesis",
-           "channels_frame", "sims_and_marks", "write_outputs", "stats_table", "SLIP_V", "SLIP_COLUMN", "foot_slip", "foot_sink", "reference_slip", "static_support",
-           "FRICTION_FLOOR"]
+           "channels_frame", "sims_and_marks", "write_outputs", "stats_table", "SLIP_V", "SLIP_COLUMN", "foot_slip",
+           "foot_sink", "reference_slip", "static_support", "FRICTION_FLOOR"]
 
 #: Thesis RMSEs (different data, Bovi 2011): (kind, joint/component, side) → value.
 #: Table 4.9, optimal control row (SK, contact parameters identified), torques N·m, GRF N.
@@ -224,7 +224,6 @@ def foot_sink(q: pd.DataFrame, p_contact) -> float:
     return float(max(0.0, max(-kinematics.ellipsoid_bottoms(m, row, p_contact).min() for row in Q)))
 
 
-
 def reference_slip(spec: gait_ocp.GaitSpec, v: float = SLIP_V) -> dict:
     """How fast the loaded feet of a spec's tracking reference itself slide: the data the
     spec tracks as its Q term tracks them (:func:`gaitlib.problems.gait.reference`: the data's
@@ -271,8 +270,6 @@ def static_support(p_contact, speed_class: str = "Free") -> str | None:
     why not (the pose and load it cannot carry). A set that cannot has no Ch 5 reference."""
     try:
         gait_ocp.reference(data_mod.load_gait_data(speed_class), ChildModel(), p_contact)
-    except ValueError as e:
-        if "penetration" not in str(e):
-            raise
+    except kinematics.LoadNotCarried as e:
         return str(e)
     return None
