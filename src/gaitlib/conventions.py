@@ -138,7 +138,7 @@ DATA_SIGN = {
 }
 
 
-def leg_length(body_height: float = BODY_HEIGHT) -> float:
+def leg_length(body_height: float = BODY_HEIGHT, leg_scale: float = 1.0) -> float:
     """Standing leg length (hip joint centre to ground), m.
 
     Uses the model's own geometry in the standing posture: thigh (0.245 BH) + shank
@@ -146,8 +146,9 @@ def leg_length(body_height: float = BODY_HEIGHT) -> float:
     foot segments of Table 4.3 (AM = 0.065 BH, HA = 0.044 BH, β = 106°) with the heel and
     metatarsal points on the ground. This is the length used to turn the dimensionless
     speed and cadence of Schwartz et al. 2008 (v* = v / sqrt(g L)) into SI units.
+    ``leg_scale`` multiplies the thigh and shank (:attr:`gaitlib.model.ChildModel.leg_scale`).
     """
-    return body_height * (0.245 + 0.246) + ankle_height(body_height)
+    return body_height * (0.245 + 0.246) * leg_scale + ankle_height(body_height)
 
 
 def ankle_height(body_height: float = BODY_HEIGHT, beta_deg: float = 106.0) -> float:

@@ -680,11 +680,12 @@ def _convert(kind: str, values: np.ndarray, sign: float, body_mass: float) -> np
 
 
 def speed_and_cycle_time(speed_class: str, body_height: float = cv.BODY_HEIGHT,
-                         path: str | Path | None = None) -> dict:
+                         path: str | Path | None = None, leg_scale: float = 1.0) -> dict:
     """Speed (m/s) and cycle time (s) of a Schwartz 2008 class, with their SDs.
 
     v = v* sqrt(g L); f_step = f* sqrt(g / L); T = 2 / f_step; L = the model's standing leg
-    length (:func:`gaitlib.conventions.leg_length`). SDs are propagated to first order.
+    length (:func:`gaitlib.conventions.leg_length`, thigh and shank × ``leg_scale``). SDs are
+    propagated to first order.
     """
     path = Path(path) if path is not None else DATA_DIR / "schwartz2008_speed.csv"
     if speed_class not in cv.SPEED_CLASSES:
@@ -699,7 +700,7 @@ def speed_and_cycle_time(speed_class: str, body_height: float = cv.BODY_HEIGHT,
         if p not in sel.index or not np.isfinite(sel.loc[p, "mean"]):
             raise DataError(f"{path}: parameter {p!r} missing or NaN for speed class {speed_class!r} "
                             "(expected a dimensionless value)")
-    L = cv.leg_length(body_height)
+    L = cv.leg_length(body_height, leg_scale)
     vs, vs_sd = sel.loc["dimensionless_speed", ["mean", "sd"]]
     fs, fs_sd = sel.loc["dimensionless_cadence", ["mean", "sd"]]
     scale_v = math.sqrt(cv.G * L)
@@ -726,7 +727,8 @@ def load_gait_data(speed_class: str = "Free", source: str = "schwartz2008",
                    body_mass: float = cv.BODY_MASS, body_height: float = cv.BODY_HEIGHT,
                    data_dir: str | Path | None = None, n_points: int | None = None,
                    fourier_order: int = 5, left_shift: float | None = None,
-                   include_emg: bool = True, allow_no_sd: bool | None = None) -> GaitData:
+                   include_emg: bool = True, allow_no_sd: bool | None = None,
+                   leg_scale: float = 1.0) -> GaitData:
     """The model's view of one data set and speed class (see :class:`GaitData`).
 
     Calls with the same arguments on unchanged files (same size and modification time of
@@ -735,7 +737,7 @@ def load_gait_data(speed_class: str = "Free", source: str = "schwartz2008",
     :func:`_read_gait_data`'s.
     """
     args = (speed_class, source, float(body_mass), float(body_height), n_points, fourier_order,
-            left_shift, include_emg, allow_no_sd)
+            left_shift, include_emg, allow_no_sd, float(leg_scale))
     directory = Path(data_dir) if data_dir is not None else DATA_DIR
     files = tuple(sorted((f.name, f.stat().st_size, f.stat().st_mtime_ns)
                          for f in directory.glob("*.csv"))) if directory.is_dir() else ()
@@ -744,7 +746,7 @@ def load_gait_data(speed_class: str = "Free", source: str = "schwartz2008",
         if len(_LOADED) >= _LOADED_MAX:
             _LOADED.pop(next(iter(_LOADED)))
         _LOADED[key] = _read_gait_data(speed_class, source, body_mass, body_height, data_dir, n_points,
-                                       fourier_order, left_shift, include_emg, allow_no_sd)
+                                       fourier_order, left_shift, include_emg, allow_no_sd, leg_scale)
     return _LOADED[key]
 
 
@@ -757,7 +759,8 @@ def _read_gait_data(speed_class: str = "Free", source: str = "schwartz2008",
                     body_mass: float = cv.BODY_MASS, body_height: float = cv.BODY_HEIGHT,
                     data_dir: str | Path | None = None, n_points: int | None = None,
                     fourier_order: int = 5, left_shift: float | None = None,
-                    include_emg: bool = True, allow_no_sd: bool | None = None) -> GaitData:
+                    include_emg: bool = True, allow_no_sd: bool | None = None,
+                    leg_scale: float = 1.0) -> GaitData:
     """Read and derive one data set and speed class (:func:`load_gait_data`, uncached).
 
     Parameters
@@ -773,6 +776,9 @@ def _read_gait_data(speed_class: str = "Free", source: str = "schwartz2008",
         opposite-foot-contact event (≈ 0.5), i.e. the thesis's T_sh = t_DSP + t_SSP.
     allow_no_sd : accept curves whose SD is 0 everywhere (:mod:`gaitlib.plausibility`);
         default only for ``gaitutils``, whose EMG envelopes come without SD.
+    leg_scale : the model's thigh and shank lengths × this (:attr:`gaitlib.model.ChildModel.
+        leg_scale`): the leg length that turns Schwartz's dimensionless speed and cadence into
+        m/s and s (gaitutils' measured speed and stride time do not depend on it).
 
     The class's rows pass :func:`gaitlib.plausibility.check_tidy` (physiological ranges,
     complete curves) before anything is derived from them; a failure raises
@@ -793,14 +799,14 @@ def _read_gait_data(speed_class: str = "Free", source: str = "schwartz2008",
     check_tidy(sel, curves_path, allow_no_sd=(source == "gaitutils") if allow_no_sd is None else allow_no_sd)
     notes = []
     if source == "schwartz2008":
-        sp = speed_and_cycle_time(speed_class, body_height, data_dir / "schwartz2008_speed.csv")
+        sp = speed_and_cycle_time(speed_class, body_height, data_dir / "schwartz2008_speed.csv", leg_scale)
         ev = pd.read_csv(data_dir / "schwartz2008_events.csv")
         ev = ev[ev["speed_class"] == speed_class].set_index("event")["mean"].to_dict()
     else:
         td = pd.read_csv(data_dir / "gaitutils_timedist.csv").set_index("parameter")["value"]
         sp = {"speed": float(td["Walking Speed"]), "speed_sd": float("nan"),
               "cycle_time": float(td["Stride Time"]), "cycle_time_sd": float("nan"),
-              "leg_length": cv.leg_length(body_height)}
+              "leg_length": cv.leg_length(body_height, leg_scale)}
         ev = {"foot_off": td["Foot Off"] / 100, "opposite_foot_off": td["Opposite Foot Off"] / 100,
               "opposite_foot_contact": td["Opposite Foot Contact"] / 100}
         notes.append("gaitutils: speed and stride time are the lab's measured values (no SD).")

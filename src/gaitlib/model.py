@@ -518,6 +518,8 @@ _K = (2.8762, 1.5928, 6.0390, 6.0390)
 _B = (0.0003, 2.9794, 3.6841, 3.6841)
 
 _P = {n: i for i, n in enumerate(P_BODY_NAMES)}
+#: The segments :attr:`ChildModel.leg_scale` lengthens.
+_LEG_SEGMENTS = ("thigh", "shank")
 
 
 def foot_angles(body_height: float = cv.BODY_HEIGHT, beta_deg: float = 106.0):
@@ -547,6 +549,11 @@ class ChildModel:
         Smoothing of the contact model (``None``: ``contact.Smoothing()``).
     g : float
         Gravity, m/s².
+    leg_scale : float
+        The thigh and shank lengths of Table 4.1 × this (1: the thesis's proportions; 0.5–2).
+        Their COM distances scale with it and their moments of inertia with its square
+        (:meth:`leg_scaled`); masses, the feet and the HAT are unchanged. A kinematic probe of
+        the Fidelity study (:attr:`gaitlib.problems.gait.GaitSpec.leg_scale`).
 
     Segment lengths, beta and the HAT COM are fixed per instance; the 25 body/joint
     parameters ``p_body`` and the 39 contact parameters ``p_contact`` are inputs of every
@@ -562,6 +569,7 @@ class ChildModel:
     beta_deg: float = 106.0
     smoothing: Any = None
     g: float = cv.G
+    leg_scale: float = 1.0
 
     coords = cv.COORDS
     joints = cv.JOINTS
@@ -574,7 +582,21 @@ class ChildModel:
     @cached_property
     def lengths(self) -> dict:
         """Segment lengths, m: hat, thigh, shank, toe (MT), forefoot (AM), hindfoot (HA)."""
-        return {k: v[1] * self.body_height for k, v in _ANTHRO.items()}
+        return {k: v[1] * self.body_height * (self.leg_scale if k in _LEG_SEGMENTS else 1.0)
+                for k, v in _ANTHRO.items()}
+
+    def __post_init__(self):
+        if not 0.5 <= self.leg_scale <= 2.0:
+            raise ValueError(f"ChildModel: leg_scale {self.leg_scale!r} outside 0.5–2")
+
+    def leg_scaled(self, p_body) -> np.ndarray:
+        """A ``p_body`` (25,) given for the thesis's legs, with the thigh's and shank's COM
+        distances × :attr:`leg_scale` and their moments of inertia × its square (a copy)."""
+        p = np.array(p_body, dtype=float)
+        for seg in _LEG_SEGMENTS:
+            p[_P[f"com_{seg}"]] *= self.leg_scale
+            p[_P[f"moi_{seg}"]] *= self.leg_scale ** 2
+        return p
 
     @cached_property
     def foot_geometry(self) -> dict:
@@ -615,7 +637,7 @@ class ChildModel:
         mass = [_ANTHRO[s][0] * BM for s in seg]
         moi = [m * (_ANTHRO[s][2] * _ANTHRO[s][1] * BH) ** 2 for m, s in zip(mass, seg)]
         com = [_ANTHRO[s][3] * _ANTHRO[s][1] * BH for s in seg[1:]]
-        return np.array(mass + moi + com + list(_K) + list(_B), dtype=float)
+        return self.leg_scaled(np.array(mass + moi + com + list(_K) + list(_B), dtype=float))
 
     def p_body_bounds(self, p0=None) -> tuple[np.ndarray, np.ndarray]:
         """Bounds of Table 4.14 around ``p0`` (default :meth:`default_p_body`):

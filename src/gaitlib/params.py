@@ -121,12 +121,13 @@ def contact_params(which: str = "default") -> np.ndarray:
 def body_params(which: str = "default", model=None) -> np.ndarray:
     """The 25 body/joint parameters (SI): ``"default"`` — Tables 4.1–4.3 scaled (Sec 4.1.1);
     ``"thesis"`` — the thesis's identified values (Tables 4.15–4.16); ``"ch4"`` — ours
-    (approach (c) of Ch 4, :func:`load_identified`)."""
+    (approach (c) of Ch 4, :func:`load_identified`). With ``model.leg_scale`` ≠ 1 the thigh's
+    and shank's COM distances and inertias follow (:meth:`~gaitlib.model.ChildModel.leg_scaled`)."""
     model = ChildModel() if model is None else model
     if which == "default":
         return model.default_p_body()
     if which == "thesis":
-        return model.p_body_identified()
+        return model.leg_scaled(model.p_body_identified())
     if which == "ch4":
-        return load_identified("ch4_child")["p_body"]
+        return model.leg_scaled(load_identified("ch4_child")["p_body"])
     raise ValueError(f"body parameters must be 'default', 'thesis' or 'ch4', got {which!r}")

@@ -442,6 +442,8 @@ def _tracked_data(spec, data=None):
     overrides the events' source: a :class:`gaitlib.data.GaitData`)."""
     own = _gait_data(spec.speed_class, spec.source)
     tracked = data if data is not None else (_gait_data(spec.track_class, spec.source) if spec.track_class else own)
+    if spec.leg_scale is not None:  # the longer legs' speed and cycle time (the events are fractions)
+        own = gait_ocp.spec_gait_data(spec)[0]
     return dict(tracked.events), float(tracked.left_shift), float(own.speed * own.cycle_time), data_rom(tracked)
 
 
@@ -457,9 +459,10 @@ def data_rom(gait) -> dict:
     return out
 
 
-def _com_height(q: pd.DataFrame, body_params: str = "default") -> float:
-    """Mean COM height over the frames (m), model COM with the spec's body parameters."""
-    m = ChildModel()
+def _com_height(q: pd.DataFrame, body_params: str = "default", model: ChildModel | None = None) -> float:
+    """Mean COM height over the frames (m), model COM with the spec's body parameters (and
+    the spec's model, :func:`gaitlib.problems.gait.spec_model`; default the thesis's)."""
+    m = ChildModel() if model is None else model
     pb = params_mod.body_params(body_params, m)
     f = m.function("com").map(len(q))
     Q = q[list(cv.COORDS)].to_numpy(float).T
@@ -491,7 +494,7 @@ def _check_gait(sol, kind, data, name) -> Gates:
     return check_frames(status=sol.stats["status"], q=sol.q[list(cv.JOINTS)], torques=torques, grf=sol.grf,
                         residuals=sol.residuals, tf=float(sol.stats["tf_s"]), kind=kind, events=events,
                         left_shift=shift, strength=strength_limits(params), strength_source=src,
-                        com_height=_com_height(sol.q, spec.body_params), periodicity=per,
+                        com_height=_com_height(sol.q, spec.body_params, gait_ocp.spec_model(spec)), periodicity=per,
                         periodicity_note=per_note, rom_data=rom, name=name)
 
 

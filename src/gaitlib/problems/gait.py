@@ -229,7 +229,8 @@ for _name, _w in _T62_NMSK.items():
 #: Spec options that are left out of :meth:`GaitSpec.to_dict` (hence of every cache key)
 #: while unset: added after the store was written, they must not change existing keys.
 KEY_STABLE_OPTIONS = ("swing_load_max", "derivatives", "jerk_ranges", "track_mtp", "activation_params",
-                      "fourier_order", "defects", "track_norm", "friction_floor", "max_sink")
+                      "fourier_order", "defects", "track_norm", "friction_floor", "max_sink",
+                      "leg_scale")
 #: The Fourier order of the left leg generated from the right (thesis Eqs 4.1–4.3: 5).
 FOURIER_ORDER = 5
 #: The highest order a cycle of the data's 51 samples (50 distinct) carries: the left leg is
@@ -359,6 +360,12 @@ class GaitSpec:
         carries load by penetration; an identification free to choose soft ellipsoids can
         trade a sliding foot for a sinking one (the Ch 4 friction experiment,
         :func:`gaitlib.studies.contact_id.friction_identification`).
+    leg_scale : ``None`` (the thesis's Table 4.1 legs) or a factor in [0.8, 1.3] on the thigh
+        and shank lengths (:attr:`gaitlib.model.ChildModel.leg_scale`: their COM distances and
+        inertias follow, masses unchanged); the data's dimensionless speed and cadence are
+        turned into m/s and s with the longer leg (:func:`gaitlib.data.speed_and_cycle_time`).
+        A kinematic probe of the Fidelity study: how far the data's joint angles on the
+        model's legs slide the loaded feet (:func:`gaitlib.studies.gait.leg_scale_slip`).
     fourier_order : ``None`` (the thesis's Eqs 4.1–4.3: :data:`FOURIER_ORDER`, 5) or the order
         of the least-squares Fourier series that generates the left leg's data from the right
         leg's (:func:`gaitlib.data.fourier_shift`); :data:`EXACT_FOURIER_ORDER` reproduces the
@@ -409,6 +416,7 @@ class GaitSpec:
     track_norm: str | None = None
     friction_floor: float | None = None
     max_sink: float | None = None
+    leg_scale: float | None = None
 
     def __post_init__(self):
         if self.fourier_order is not None:
@@ -427,6 +435,9 @@ class GaitSpec:
         if self.max_sink is not None and (isinstance(self.max_sink, bool) or not isinstance(self.max_sink, (int, float))
                                           or not 0.0 < float(self.max_sink) <= 0.1):
             raise ValueError(f"max_sink must be None or a depth in (0, 0.1] m, got {self.max_sink!r}")
+        if self.leg_scale is not None and (isinstance(self.leg_scale, bool) or not isinstance(self.leg_scale, (int, float))
+                                           or not 0.8 <= float(self.leg_scale) <= 1.3):
+            raise ValueError(f"leg_scale must be None or a factor in [0.8, 1.3], got {self.leg_scale!r}")
         if self.track_norm not in (None,) + TRACK_NORMS:
             raise ValueError(f"track_norm must be None or one of {TRACK_NORMS}, got {self.track_norm!r}")
         if self.derivatives not in (None, "graph", "nodes"):
@@ -1000,15 +1011,22 @@ def spec_gait_data(spec: GaitSpec) -> tuple[data_mod.GaitData, data_mod.GaitData
     # the default call unless the spec asks for another order (a gap diagnosis on a user's
     # data set substitutes load_gait_data for its default arguments: gaitlib.studies.gap.own_data)
     order = {"fourier_order": spec.fourier_order} if spec.fourier_order else {}
+    if spec.leg_scale is not None:
+        order["leg_scale"] = float(spec.leg_scale)
     gait_class = data_mod.load_gait_data(spec.speed_class, spec.source, **order)
     gait = (data_mod.time_scaled(data_mod.load_gait_data(spec.track_class, spec.source, **order), gait_class)
             if spec.track_class else gait_class)
     return gait_class, gait
 
 
+def spec_model(spec: GaitSpec) -> ChildModel:
+    """The child model a spec is solved on (the thesis's, or its legs × ``spec.leg_scale``)."""
+    return ChildModel() if spec.leg_scale is None else ChildModel(leg_scale=float(spec.leg_scale))
+
+
 def build(spec: GaitSpec) -> GaitProblem:
     """Turn a :class:`GaitSpec` into an :class:`ocp.Problem` with mesh, options, guess."""
-    model = ChildModel()
+    model = spec_model(spec)
     gait_class, gait = spec_gait_data(spec)
     p_body = params_mod.body_params(spec.body_params, model)
     p_contact = contact_params_of(spec)

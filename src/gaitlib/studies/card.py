@@ -211,7 +211,7 @@ class StoredGait:
         if e is None or q is None or qd is None or any(c.startswith("vs_") for c in e.columns) or self.spec.effects:
             return
         pc = gait_ocp.solved_contact_params(self)
-        vs = gait_ocp.slip_velocities(ChildModel(), q[list(cv.COORDS)].to_numpy(), qd[list(cv.COORDS)].to_numpy(), pc)
+        vs = gait_ocp.slip_velocities(gait_ocp.spec_model(self.spec), q[list(cv.COORDS)].to_numpy(), qd[list(cv.COORDS)].to_numpy(), pc)
         self.ellipsoids = e.assign(**{f"vs_{lab}": vs[i] for i, lab in enumerate(ELLIPSOID_LABELS)})
 
     @property

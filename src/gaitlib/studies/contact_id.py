@@ -1190,6 +1190,38 @@ def reference_slip_findings(refs: dict[str, dict]) -> list[str]:
                ": the constant-speed HAT reference is what asks the feet to slide.") for k, r in refs.items()]
 
 
+def leg_scale_findings(tables: dict[str, pd.DataFrame]) -> list[str]:
+    """One sentence per contact set (label → :func:`gaitlib.studies.gait.leg_scale_slip`):
+    the reference's slip at the thesis's legs and at the scan's lowest, where its signed mean
+    slip changes sign (linear interpolation between the two scan scales around it: there
+    the data's stride and the legs' sweep agree), and the scales with no reference."""
+    out = []
+    for k, t in tables.items():
+        ok = t[t["note"] == ""]
+        if 1.0 not in ok.index:
+            out.append(f"{k} contact set: no reference at the thesis's legs ({t.loc[1.0, 'note'] if 1.0 in t.index else 'not scanned'}).")
+            continue
+        s0, best = ok.loc[1.0], ok["reference slip (m/s)"].idxmin()
+        sm = ok["signed mean slip (m/s)"]
+        cross = [(a, b) for a, b in zip(ok.index[:-1], ok.index[1:]) if sm[a] * sm[b] <= 0 and sm[a] != sm[b]]
+        if cross:
+            a, b = cross[0]
+            x = a + (b - a) * sm[a] / (sm[a] - sm[b])
+            agree = (f"its signed mean slip changes sign between ×{a:g} and ×{b:g} (≈ ×{x:.2f} by interpolation: there "
+                     f"the data's stride and the legs' sweep agree)")
+        else:
+            agree = f"its signed mean slip keeps one sign over the scan ({sm.min():+.3f} to {sm.max():+.3f} m/s)"
+        missing = [f"×{s:g}" for s in t.index if t.loc[s, "note"]]
+        out.append(f"{k} contact set: the reference slides {s0['reference slip (m/s)']:.3f} m/s with the thesis's legs "
+                   f"(thigh + shank {s0['thigh + shank (m)']:.3f} m; signed mean {s0['signed mean slip (m/s)']:+.3f} m/s, "
+                   f"anchored {s0['anchored slip (m/s)']:.3f}); lowest in the scan {ok.loc[best, 'reference slip (m/s)']:.3f} m/s "
+                   f"at ×{best:g} ({ok.loc[best, 'thigh + shank (m)']:.3f} m, anchored {ok.loc[best, 'anchored slip (m/s)']:.3f}, "
+                   f"{100 * (ok.loc[best, 'reference slip (m/s)'] / s0['reference slip (m/s)'] - 1):+.0f} %); {agree}"
+                   + (f"; no reference at {', '.join(missing)} (the set cannot carry the data's load at rest)" if missing else "")
+                   + ".")
+    return out
+
+
 def findings(results: dict[str, ApproachResult], widened: ApproachResult, fit: pd.DataFrame,
              consistency: pd.DataFrame, by_phase: pd.DataFrame) -> list[str]:
     """The chapter's findings, one sentence group per item, every number from the results:

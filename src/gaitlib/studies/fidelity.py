@@ -127,7 +127,8 @@ def ablation_row(label: str, sol: gait_ocp.GaitSolution) -> dict:
             "swing load (N)": float(tab.loc["swing_load", "value"]),
             "double support (%)": float(tab.loc["double_support", "value"]),
             SLIP_COLUMN: foot_slip(sol)["slip"],
-            "deepest sink (mm)": 1e3 * gait_study.foot_sink(sol.q, gait_ocp.solved_contact_params(sol)),
+            "deepest sink (mm)": 1e3 * gait_study.foot_sink(sol.q, gait_ocp.solved_contact_params(sol),
+                                                            gait_ocp.spec_model(sol.spec)),
             "worst angle RMSE (deg)": float(worst.get("angle", np.nan)),
             "worst torque RMSE (N·m)": float(worst.get("torque", np.nan)),
             "worst GRF RMSE (N)": float(worst.get("grf", np.nan)),
@@ -289,6 +290,10 @@ METATARSAL_FREE = "metatarsal untracked"
 SD_NORM = "tracking normalised by the data's SD"
 #: The Ch 5 ablation's row with every ellipsoid's friction at least :data:`FRICTION_FLOOR`.
 FRICTION_ROW = "friction at least Table 4.18's toe μ_d (no skating ball)"
+#: The thigh and shank scale of the Ch 5 ablation's :data:`LEG_ROW` (:attr:`GaitSpec.leg_scale`).
+LEG_SCALE = 1.1
+#: The Ch 5 ablation's row with the legs longer (:func:`gaitlib.studies.gait.leg_scale_slip`).
+LEG_ROW = f"thigh and shank ×{LEG_SCALE:g}"
 #: The Ch 5 ablation's row of the same problem with its defects in integral form.
 INTEGRAL_DEFECTS = "defects in integral form (the same NLP)"
 
@@ -310,7 +315,10 @@ def ch5_changes(model: str = "MSK") -> dict[str, dict]:
     shifted instead of Eqs 4.1–4.3's five-harmonic series (:attr:`GaitSpec.fourier_order`;
     the row the Ch 4 (c) ablation also has); and :data:`FRICTION_ROW`, every ellipsoid's
     friction coefficients at least :data:`FRICTION_FLOOR` (the ball's identified μ ≈ 0.01 lets
-    a loaded foot slide, :func:`foot_slip`). The last row,
+    a loaded foot slide, :func:`foot_slip`); :data:`LEG_ROW`, the thigh and shank ×
+    :data:`LEG_SCALE` (:attr:`GaitSpec.leg_scale`: at that scale the reference — the data's
+    angles on the model — stops sliding its loaded feet on average,
+    :func:`gaitlib.studies.gait.leg_scale_slip`). The last row,
     :data:`INTEGRAL_DEFECTS`, changes no problem: the same NLP with its collocation defects in
     integral form (:attr:`GaitSpec.defects`, an invertible linear map of the rows, so the same
     feasible set and optima), which IPOPT walks along another path — how much of the misfit
@@ -332,6 +340,7 @@ def ch5_changes(model: str = "MSK") -> dict[str, dict]:
         SD_NORM: {"track_norm": "sd"},
         FRICTION_ROW: {"friction_floor": FRICTION_FLOOR},
         ci_study.LEFT_SHIFTED_ROW: {"fourier_order": gait_ocp.EXACT_FOURIER_ORDER},
+        LEG_ROW: {"leg_scale": LEG_SCALE},
         INTEGRAL_DEFECTS: {"defects": "integral"},
     }
 
@@ -439,7 +448,7 @@ def ch5_ablation_findings(table: pd.DataFrame, per_channel: pd.DataFrame, floor:
 
 
 def single_change_findings(table: pd.DataFrame, per_channel: pd.DataFrame,
-                           rows: tuple = (SD_NORM, ci_study.LEFT_SHIFTED_ROW, FRICTION_ROW),
+                           rows: tuple = (SD_NORM, ci_study.LEFT_SHIFTED_ROW, FRICTION_ROW, LEG_ROW),
                            n_moves: int = 4) -> list[str]:
     """One sentence per ``rows`` entry of a Ch 5 ablation (:func:`ch5_ablation`; ``per_channel``:
     its :func:`channel_table` over the usable runs) beside the book's run (:data:`CH5_BASE_ROW`):
@@ -474,6 +483,50 @@ def single_change_findings(table: pd.DataFrame, per_channel: pd.DataFrame,
                    f"book's {a['objective']:.4g}): worst RMSE {worst}; the largest moves relative to their targets: "
                    f"{moves}; channels within target: {n_row} of {len(per_channel)} (the book's run: {n_base}){slip}.")
     return out
+
+
+def leg_row_references(model: str = "MSK") -> tuple[dict, dict]:
+    """:func:`gaitlib.studies.gait.reference_slip` (no solve) of the Ch 5 problem in the book's
+    reading and of its :data:`LEG_ROW` change: the input of :func:`leg_row_findings`."""
+    spec = msk.ch5_spec(model, reading="book")
+    return (gait_study.reference_slip(spec),
+            gait_study.reference_slip(replace(spec, **ch5_changes(model)[LEG_ROW])))
+
+
+def leg_row_findings(table: pd.DataFrame, ref_base: dict, ref_leg: dict) -> list[str]:
+    """The :data:`LEG_ROW` of a Ch 5 ablation table (:func:`ch5_ablation`) beside the book's
+    run (:data:`CH5_BASE_ROW`) and the same NLP along another path (:data:`INTEGRAL_DEFECTS`,
+    the spread a run shows without any change of problem): whether the solution's feet stop
+    sliding once its reference's do (``ref_base``, ``ref_leg``: :func:`gaitlib.studies.gait.
+    reference_slip` of the two specs). Empty when a row is missing; a row that did not
+    converge or fails a gate is said so and nothing is concluded from it."""
+    if LEG_ROW not in table.index or CH5_BASE_ROW not in table.index:
+        return []
+    a, b = table.loc[CH5_BASE_ROW], table.loc[LEG_ROW]
+    bad = [f"{k} ({r['status']}, {r['gates']})" for k, r in ((CH5_BASE_ROW, a), (LEG_ROW, b))
+           if r["status"] not in validity.CONVERGED_STATUSES or r["gates"] != "valid"]
+    if bad:
+        return [f"- Longer legs: not compared — {'; '.join(bad)}."]
+    c = table.loc[INTEGRAL_DEFECTS] if INTEGRAL_DEFECTS in table.index else None
+    c_ok = c is not None and c["status"] in validity.CONVERGED_STATUSES and c["gates"] == "valid"
+    spread = {k: abs(float(c[k]) - float(a[k])) for k in (SLIP_COLUMN, "worst angle RMSE (deg)")} if c_ok else {}
+    d_ref = float(ref_leg["slip"]) - float(ref_base["slip"])
+    d_sol = float(b[SLIP_COLUMN]) - float(a[SLIP_COLUMN])
+    d_ang = float(b["worst angle RMSE (deg)"]) - float(a["worst angle RMSE (deg)"])
+
+    def beyond(d, k):
+        if k not in spread:
+            return ""
+        return (f" (the same NLP along another path moves it {spread[k]:.3g}: "
+                f"{'beyond' if abs(d) > spread[k] else 'within'} that)")
+    verdict = ("so the reference's own slip is not what makes the solution slide"
+               if abs(d_sol) < 0.5 * abs(d_ref) else "so the solution's slip follows its reference's")
+    return [f"- **Longer legs** (thigh and shank ×{LEG_SCALE:g}): the reference's loaded feet slide "
+            f"{ref_base['slip']:.3f} → {ref_leg['slip']:.3f} m/s ({100 * d_ref / ref_base['slip']:+.0f} %; signed mean "
+            f"{ref_base['mean_slip']:+.3f} → {ref_leg['mean_slip']:+.3f} m/s), the solution's {a[SLIP_COLUMN]:.3f} → "
+            f"{b[SLIP_COLUMN]:.3f} m/s ({100 * d_sol / a[SLIP_COLUMN]:+.0f} %){beyond(d_sol, SLIP_COLUMN)} — {verdict}; "
+            f"the worst angle RMSE {a['worst angle RMSE (deg)']:.2f} → {b['worst angle RMSE (deg)']:.2f}°"
+            f"{beyond(d_ang, 'worst angle RMSE (deg)')}."]
 
 
 def path_findings(table: pd.DataFrame) -> list[str]:

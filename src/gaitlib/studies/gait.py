@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
@@ -202,7 +203,8 @@ def foot_slip(sol, v: float = SLIP_V) -> dict:
     tf = float(sol.stats.get("tf_s", t[-1]))
     w = (np.diff(np.append(t, tf)) / (tf - t[0]))[:, None]
     load = float((w * fn).sum())
-    gd = data_mod.load_gait_data(sol.spec.speed_class, sol.spec.source)
+    gd = gait_ocp.spec_gait_data(sol.spec)[0] if getattr(sol.spec, "leg_scale", None) is not None else \
+        data_mod.load_gait_data(sol.spec.speed_class, sol.spec.source)
     return {"slip": float((w * fn * vs).sum() / load), "sliding": float((w * fn * (vs > v)).sum() / load),
             "speed": float(gd.speed), "worst": cols[int(np.argmax((w * fn * vs).sum(axis=0)))][3:],
             "ball": float(sum((w * fn[:, [j]]).sum() for j, c in enumerate(cols) if c.startswith("vs_ball")) / load)}
@@ -214,12 +216,13 @@ def foot_slip(sol, v: float = SLIP_V) -> dict:
 FRICTION_FLOOR = max(float(contact_mod.default_params()[contact_mod.param_index(e, "mu_d")]) for e in cv.ELLIPSOIDS)
 
 
-def foot_sink(q: pd.DataFrame, p_contact) -> float:
+def foot_sink(q: pd.DataFrame, p_contact, model: ChildModel | None = None) -> float:
     """The deepest any ellipsoid sinks into the ground over a motion (m, ≥ 0): the largest
     depth of an ellipsoid's lowest point below y = 0 at the rows of ``q`` (time × the 11
     coordinates, SI) with the contact parameters ``p_contact`` (39,). Volumetric contact
-    carries load by penetration; a soft set that stops the feet sliding may sink them."""
-    m = ChildModel()
+    carries load by penetration; a soft set that stops the feet sliding may sink them.
+    ``model``: the model the motion is of (default the thesis's; :func:`gaitlib.problems.gait.spec_model`)."""
+    m = ChildModel() if model is None else model
     Q = q[list(cv.COORDS)].to_numpy(float)
     return float(max(0.0, max(-kinematics.ellipsoid_bottoms(m, row, p_contact).min() for row in Q)))
 
@@ -237,8 +240,10 @@ def reference_slip(spec: gait_ocp.GaitSpec, v: float = SLIP_V) -> dict:
     instant so that the load-weighted mean slip is zero — what is left cannot come from the
     constant-speed HAT reference — that speed's range (``hat_speed_min``, ``hat_speed_max``)
     and the walking speed (``speed``), m/s; ``by_ellipsoid``: the force-weighted slip of each
-    ellipsoid kind (toe, ball, heel; both feet), m/s."""
-    m = ChildModel()
+    ellipsoid kind (toe, ball, heel; both feet), m/s; ``mean_slip``: the force-weighted mean
+    of the signed slip (m/s, > 0: the loaded feet move forward — the HAT outruns the legs'
+    sweep, the data's stride is longer than the angles carry the model's legs)."""
+    m = gait_ocp.spec_model(spec)
     pc = gait_ocp.contact_params_of(spec)
     _, gd = gait_ocp.spec_gait_data(spec)
     ref = gait_ocp.reference(gd, m, pc)
@@ -257,10 +262,40 @@ def reference_slip(spec: gait_ocp.GaitSpec, v: float = SLIP_V) -> dict:
     return {"slip": float((fn * np.abs(vs)).sum() / load), "sliding": float((fn * (np.abs(vs) > v)).sum() / load),
             "anchored_slip": float((fn * np.abs(anchored)).sum() / load),
             "anchored_sliding": float((fn * (np.abs(anchored) > v)).sum() / load),
+            "mean_slip": float((fn * vs).sum() / load),
             "hat_speed_min": float(hat.min()), "hat_speed_max": float(hat.max()), "speed": float(gd.speed),
             "by_ellipsoid": {e: float(sum((fn[i] * np.abs(vs[i])).sum() for i in idx) / max(sum(fn[i].sum() for i in idx), 1e-12))
                              for e in cv.ELLIPSOIDS
                              for idx in [[i for i, lab in enumerate(ELLIPSOID_LABELS) if lab.startswith(e)]]}}
+
+
+#: The leg scales of :func:`leg_scale_slip` (thigh and shank × each; 1: Table 4.1).
+LEG_SCALES = (0.95, 1.0, 1.05, 1.1, 1.15, 1.2)
+
+
+def leg_scale_slip(spec: gait_ocp.GaitSpec, scales=LEG_SCALES) -> pd.DataFrame:
+    """:func:`reference_slip` of ``spec`` with the thigh and shank × each of ``scales``
+    (:attr:`~gaitlib.problems.gait.GaitSpec.leg_scale`; the walking speed and cycle time
+    follow the longer leg through the data's dimensionless values). No solve: whether the
+    data's joint angles stop sliding the loaded feet on longer legs. One row per scale: the
+    thigh + shank length (m), the walking speed (m/s), the reference's force-weighted slip,
+    the same anchored (the HAT's speed changed at every instant), the signed mean (m/s) and
+    the share of the load sliding faster than ``SLIP_V``; ``note``: why a scale has no
+    reference (its contact cannot carry the data's load at rest in some pose), else ''."""
+    rows = []
+    for s in scales:
+        sp = replace(spec, leg_scale=None if float(s) == 1.0 else float(s))
+        m = gait_ocp.spec_model(sp)
+        row = {"leg scale": float(s), "thigh + shank (m)": m.lengths["thigh"] + m.lengths["shank"]}
+        try:
+            r = reference_slip(sp)
+        except kinematics.LoadNotCarried as e:
+            rows.append({**row, "note": f"no reference: {e}"})
+            continue
+        rows.append({**row, "speed (m/s)": r["speed"], "reference slip (m/s)": r["slip"],
+                     "anchored slip (m/s)": r["anchored_slip"], "signed mean slip (m/s)": r["mean_slip"],
+                     f"load sliding > {SLIP_V} m/s (%)": 100 * r["sliding"], "note": ""})
+    return pd.DataFrame(rows).set_index("leg scale")
 
 
 def static_support(p_contact, speed_class: str = "Free") -> str | None:

@@ -1,0 +1,116 @@
+"""The leg-length probe: longer thighs and shanks (``GaitSpec.leg_scale``) — geometry,
+inertias, the data's speed and the reference's slip, checked by hand calculations."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from gaitlib import conventions as cv
+from gaitlib import data as data_mod
+from gaitlib import params
+from gaitlib.model import P_BODY_NAMES, ChildModel
+from gaitlib.problems import gait as gait_ocp
+from gaitlib.studies import contact_id as ci
+from gaitlib.studies import fidelity
+from gaitlib.studies import gait as gait_study
+
+BH = cv.BODY_HEIGHT
+IDX = {n: i for i, n in enumerate(P_BODY_NAMES)}
+
+
+def test_leg_scale_lengthens_thigh_and_shank_only_with_their_com_and_inertia():
+    s = 1.1
+    m0, m1 = ChildModel(), ChildModel(leg_scale=s)
+    # Table 4.1: thigh 0.245 BH, shank 0.246 BH; the feet and the HAT unchanged
+    assert m1.lengths["thigh"] == pytest.approx(0.245 * BH * s, rel=1e-12)
+    assert m1.lengths["shank"] == pytest.approx(0.246 * BH * s, rel=1e-12)
+    for k in ("hat", "toe", "forefoot", "hindfoot"):
+        assert m1.lengths[k] == m0.lengths[k]
+    # the hip stands (thigh + shank) × (s − 1) higher; the standing leg length is cv.leg_length's
+    assert m1.standing_leg_length - m0.standing_leg_length == pytest.approx(0.491 * BH * (s - 1), rel=1e-12)
+    assert m1.standing_leg_length == pytest.approx(cv.leg_length(BH, s), rel=1e-9)
+    p0, p1 = m0.default_p_body(), m1.default_p_body()
+    # Table 4.1 thigh: mass 0.100 BM, ROG 0.323 SL, COM 0.433 SL, SL = 0.245 BH × s
+    mass = 0.100 * cv.BODY_MASS
+    assert p1[IDX["mass_thigh"]] == p0[IDX["mass_thigh"]] == pytest.approx(mass)
+    assert p1[IDX["com_thigh"]] == pytest.approx(0.433 * 0.245 * BH * s, rel=1e-12)
+    assert p1[IDX["moi_thigh"]] == pytest.approx(mass * (0.323 * 0.245 * BH * s) ** 2, rel=1e-12)
+    changed = {P_BODY_NAMES[i] for i in np.flatnonzero(p0 != p1)}
+    assert changed == {"com_thigh", "com_shank", "moi_thigh", "moi_shank"}
+    # identified sets scale the same way (given for the thesis's legs)
+    th = params.body_params("thesis", m1)
+    assert th[IDX["com_shank"]] == pytest.approx(0.0916 * s) and th[IDX["moi_shank"]] == pytest.approx(0.0184 * s * s)
+    with pytest.raises(ValueError, match="leg_scale"):
+        ChildModel(leg_scale=0.1)
+
+
+def test_the_data_speed_follows_the_longer_leg_and_the_stride_scales_with_it():
+    s = 1.1
+    g0, g1 = data_mod.load_gait_data("Free"), data_mod.load_gait_data("Free", leg_scale=s)
+    L0, L1 = cv.leg_length(BH), cv.leg_length(BH, s)
+    # v = v* sqrt(g L), T = 2 / (f* sqrt(g / L)): speed and cycle time × sqrt(L1/L0), stride × L1/L0
+    r = math.sqrt(L1 / L0)
+    assert g1.speed == pytest.approx(g0.speed * r, rel=1e-12)
+    assert g1.cycle_time == pytest.approx(g0.cycle_time * r, rel=1e-12)
+    assert g1.speed * g1.cycle_time == pytest.approx(g0.speed * g0.cycle_time * L1 / L0, rel=1e-12)
+    # the angles are dimensionless: unchanged
+    np.testing.assert_array_equal(g1.mean["knee_r"].to_numpy(), g0.mean["knee_r"].to_numpy())
+
+
+def test_leg_scale_spec_keeps_old_keys_validates_and_builds_its_model():
+    spec = gait_ocp.GaitSpec(model="MSK", cost="Eq5.33", n_intervals=2, degree=2)
+    assert "leg_scale" not in spec.to_dict()
+    ls = replace(spec, leg_scale=1.1)
+    assert ls.key() != spec.key() and gait_ocp.GaitSpec.from_dict(ls.to_dict()) == ls
+    assert gait_ocp.spec_model(ls).leg_scale == 1.1 and gait_ocp.spec_model(spec).leg_scale == 1.0
+    assert gait_ocp.spec_gait_data(ls)[0].speed > gait_ocp.spec_gait_data(spec)[0].speed
+    for bad in (0.5, 1.5, "1.1", True):
+        with pytest.raises(ValueError, match="leg_scale"):
+            replace(spec, leg_scale=bad)
+
+
+def test_leg_scale_slip_at_one_is_the_reference_slip_and_the_hip_rises_with_the_legs():
+    spec = gait_ocp.GaitSpec(model="MSK", cost="Eq5.33", contact_params="ch4", body_params="ch4")
+    tab = gait_study.leg_scale_slip(spec, scales=(1.0, 1.1))
+    r = gait_study.reference_slip(spec)
+    assert tab.loc[1.0, "reference slip (m/s)"] == pytest.approx(r["slip"], rel=1e-12)
+    assert tab.loc[1.0, "signed mean slip (m/s)"] == pytest.approx(r["mean_slip"], rel=1e-12)
+    assert abs(r["mean_slip"]) <= r["slip"]
+    # the reference's HAT stands higher by about the legs' extra length (same angles, same feet)
+    y = {s: gait_ocp.reference(gait_ocp.spec_gait_data(replace(spec, leg_scale=s))[1], ChildModel(leg_scale=s),
+                               gait_ocp.contact_params_of(spec)).q["pelvis_ty"].mean() for s in (1.0, 1.1)}
+    extra = 0.1 * 0.491 * BH
+    assert y[1.1] - y[1.0] == pytest.approx(extra, rel=0.1)
+    assert tab.loc[1.1, "thigh + shank (m)"] == pytest.approx(0.491 * BH * 1.1, rel=1e-12)
+
+
+def test_leg_scale_findings_interpolate_where_the_signed_slip_changes_sign_by_hand():
+    t = pd.DataFrame({"leg scale": [1.0, 1.1, 1.2], "thigh + shank (m)": [0.72, 0.79, 0.87],
+                      "reference slip (m/s)": [0.2, 0.1, np.nan], "anchored slip (m/s)": [0.18, 0.05, np.nan],
+                      "signed mean slip (m/s)": [0.09, -0.03, np.nan],
+                      "note": ["", "", "no reference: row 3: a load of 400.0 N needs more than 0.06 m"]}).set_index("leg scale")
+    (s,) = ci.leg_scale_findings({"ours": t})
+    # zero crossing: 1.0 + 0.1 × 0.09 / (0.09 + 0.03) = 1.075
+    assert "≈ ×1.07" in s or "≈ ×1.08" in s
+    assert "lowest in the scan 0.100 m/s at ×1.1" in s and "-50 %" in s
+    assert "no reference at ×1.2" in s
+
+
+def test_leg_row_findings_compare_the_reference_and_the_solution_slip_by_hand():
+    cols = {"status": "Solve_Succeeded", "gates": "valid"}
+    t = pd.DataFrame([{"run": fidelity.CH5_BASE_ROW, fidelity.SLIP_COLUMN: 0.20, "worst angle RMSE (deg)": 4.5, **cols},
+                      {"run": fidelity.LEG_ROW, fidelity.SLIP_COLUMN: 0.18, "worst angle RMSE (deg)": 4.0, **cols},
+                      {"run": fidelity.INTEGRAL_DEFECTS, fidelity.SLIP_COLUMN: 0.17, "worst angle RMSE (deg)": 4.6, **cols}]
+                     ).set_index("run")
+    (s,) = fidelity.leg_row_findings(t, {"slip": 0.2, "mean_slip": 0.1}, {"slip": 0.1, "mean_slip": 0.0})
+    # the reference −50 %, the solution −10 % (< half of it): not what makes it slide;
+    # the same-NLP spread: slip 0.03 (the move 0.02 is within), angle 0.1 (the move 0.5 is beyond)
+    assert "-50 %" in s and "-10 %" in s and "not what makes the solution slide" in s
+    assert "moves it 0.03: within that" in s and "moves it 0.1: beyond that" in s
+    t.loc[fidelity.LEG_ROW, "gates"] = "invalid: swing_load"
+    assert "not compared" in fidelity.leg_row_findings(t, {"slip": 0.2, "mean_slip": 0.1}, {"slip": 0.1, "mean_slip": 0.0})[0]
