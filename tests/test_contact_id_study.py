@@ -275,7 +275,7 @@ def test_start_params_and_the_multistart_keeps_the_lowest_valid(monkeypatch):
     monkeypatch.setattr(ci.params_mod, "contact_params", lambda which: 2 * ci.neutral_start())
     # the starts table's slip and sink columns read the solutions; stubbed with known values
     monkeypatch.setattr(ci.gait_study, "foot_slip", lambda sol: {"slip": {"neutral": 0.1}.get(sol, 0.2)})
-    monkeypatch.setattr(ci.gait_study, "foot_sink", lambda q, p: 0.015)
+    monkeypatch.setattr(ci.gait_study, "foot_sink", lambda q, p, model=None: 0.015)
     best = ci.optimal_control_multistart()
     assert best.starts.loc["neutral", "foot slip (m/s)"] == 0.1 and best.starts.loc["ch4_child", "foot slip (m/s)"] == 0.2
     assert (best.starts["deepest sink (mm)"] == 15.0).all()

@@ -108,9 +108,12 @@ def test_leg_row_findings_compare_the_reference_and_the_solution_slip_by_hand():
                       {"run": fidelity.INTEGRAL_DEFECTS, fidelity.SLIP_COLUMN: 0.17, "worst angle RMSE (deg)": 4.6, **cols}]
                      ).set_index("run")
     (s,) = fidelity.leg_row_findings(t, {"slip": 0.2, "mean_slip": 0.1}, {"slip": 0.1, "mean_slip": 0.0})
-    # the reference −50 %, the solution −10 % (< half of it): not what makes it slide;
-    # the same-NLP spread: slip 0.03 (the move 0.02 is within), angle 0.1 (the move 0.5 is beyond)
+    # the reference −50 %, the solution −10 %; the same-NLP spread: slip 0.03 (the move 0.02
+    # is within: not what makes it slide), angle 0.1 (the move 0.5 is beyond)
     assert "-50 %" in s and "-10 %" in s and "not what makes the solution slide" in s
     assert "moves it 0.03: within that" in s and "moves it 0.1: beyond that" in s
+    t.loc[fidelity.LEG_ROW, fidelity.SLIP_COLUMN] = 0.15  # moves 0.05 > 0.03: 0.05 / 0.1 of the reference's
+    (s,) = fidelity.leg_row_findings(t, {"slip": 0.2, "mean_slip": 0.1}, {"slip": 0.1, "mean_slip": 0.0})
+    assert "moves 50% as far as its reference's" in s and "beyond that" in s
     t.loc[fidelity.LEG_ROW, "gates"] = "invalid: swing_load"
     assert "not compared" in fidelity.leg_row_findings(t, {"slip": 0.2, "mean_slip": 0.1}, {"slip": 0.1, "mean_slip": 0.0})[0]

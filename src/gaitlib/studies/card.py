@@ -451,8 +451,30 @@ def _ch4_friction_causes() -> dict:
         if sk in t.index and t.loc[sk, "status"] in validity.CONVERGED_STATUSES and t.loc[sk, "gates"] == "valid":
             out[k] += (f"; sinking ≤ {1e3 * ci.SINK_LIMIT:g} mm as well, {t.loc[sk, 'mean GRF RMSE (N)']:.1f} N"
                        + (" (from a (b) multistart that stops in a local optimum: an upper bound)" if local else ""))
+        if k == "b":
+            out[k] += _ch4_leg_clause()
         out[k] += f" [{where}]"
     return out
+
+
+def _ch4_leg_clause() -> str:
+    """"; on legs × s …": (b) identified on longer legs (:func:`gaitlib.studies.contact_id.
+    leg_identification`) beside the book's (b) — the reference's slip, the identified feet's
+    slip, the ball's μ_d and the mean GRF RMSE; "" when not stored."""
+    try:
+        with cache.only("the card reads stored solutions only"):
+            runs = ci.leg_identification()
+    except cache.NotCached:
+        return ""
+    t = ci.friction_table(runs)
+    s = sg.LEG_SCALE
+    r1 = t.loc[ci.leg_label("b", s)]
+    if r1["status"] not in validity.CONVERGED_STATUSES or r1["gates"] != "valid":
+        return f"; on legs ×{s:g}: not compared ({r1['status']}, {r1['gates']})"
+    ref = sg.reference_slip(replace(ci.spec_c(), contact_params="ch4", leg_scale=s))
+    return (f"; identified on thigh and shank ×{s:g} (where the reference slides {ref['slip']:.2f} m/s) the feet "
+            f"slide {r1[sg.SLIP_COLUMN]:.2f} m/s, ball μ_d {r1['ball mu_d']:.3f}, mean GRF RMSE "
+            f"{r1['mean GRF RMSE (N)']:.1f} N")
 
 
 #: The Ch 4 page's section of the (c) ablation (the card links to it).

@@ -443,7 +443,7 @@ def starts_table(runs: dict[str, ApproachResult]) -> pd.DataFrame:
         row = {"status": r.stats["status"], "converged": bool(r.success), "valid": bool(g.passed), "gates": g.label(),
                "iterations": r.stats["iterations"], "objective": r.stats["objective"], "Eq 4.5 part": r.stats["eq4_5"],
                gait_study.SLIP_COLUMN: gait_study.foot_slip(r.solution)["slip"],
-               "deepest sink (mm)": 1e3 * gait_study.foot_sink(r.q, r.p_contact)}
+               "deepest sink (mm)": 1e3 * gait_study.foot_sink(r.q, r.p_contact, _model_of(r))}
         for e in cv.ELLIPSOIDS:
             row[f"k_v {e} (N/m³)"] = float(r.p_contact[contact_mod.param_index(e, "k_v")])
         rows[name] = row
@@ -1055,6 +1055,31 @@ def friction_label(key: str, floor: float, max_sink: float | None = None) -> str
     return f"{APPROACHES[key]}, friction ≥ {floor:g}" + (f", sink ≤ {1e3 * max_sink:g} mm" if max_sink else "")
 
 
+def _model_of(r: ApproachResult) -> ChildModel:
+    """The model a (b)/(c) result was solved on (:func:`gaitlib.problems.gait.spec_model`)."""
+    spec = getattr(r.solution, "spec", None)  # (a) has no solution: the thesis's model
+    return gait_ocp.spec_model(spec) if isinstance(spec, gait_ocp.GaitSpec) else ChildModel()
+
+
+def leg_label(key: str, scale: float) -> str:
+    """The row label of approach ``key`` ("b"/"c") identified with the thigh and shank × ``scale``."""
+    return f"{APPROACHES[key]}, thigh and shank ×{scale:g}"
+
+
+def leg_identification(scale: float | None = None, *, use_cache: bool = True, root=None,
+                       progress: bool = False) -> dict[str, ApproachResult]:
+    """(b) as the book identifies it (the multistart :data:`B_STARTS`, each through the
+    continuation), and again on legs × ``scale`` (default :data:`~gaitlib.studies.gait.
+    LEG_SCALE`; :attr:`~gaitlib.problems.gait.GaitSpec.leg_scale`: the thigh and shank longer,
+    the data's speed and cycle time following): the reference's loaded feet slide half as
+    fast there (:func:`gaitlib.studies.gait.leg_scale_slip`) — does the identified ball still
+    take Table 4.7's lowest friction, and do the feet still slide? Returns label → result."""
+    scale = gait_study.LEG_SCALE if scale is None else float(scale)
+    kw = {"use_cache": use_cache, "root": root, "progress": progress}
+    return {APPROACHES["b"]: optimal_control_multistart(**kw),
+            leg_label("b", scale): optimal_control_multistart(replace(spec_b(), leg_scale=scale), **kw)}
+
+
 def friction_identification(floor: float | None = None, max_sinks: tuple = (None, SINK_LIMIT), *,
                             use_cache: bool = True, root=None, progress: bool = False) -> dict[str, ApproachResult]:
     """(b) and (c) as the book identifies them, and again with every ellipsoid's μ_s and μ_d
@@ -1101,8 +1126,8 @@ def friction_table(runs: dict[str, ApproachResult]) -> pd.DataFrame:
         row["worst torque RMSE (N·m)"] = float(kinds.get("torque", np.nan))
         row[gait_study.SLIP_COLUMN] = fs["slip"]
         row[f"load sliding > {gait_study.SLIP_V:g} m/s (%)"] = 100 * fs["sliding"]
-        row["deepest sink (mm)"] = 1e3 * gait_study.foot_sink(r.q, r.p_contact)
-        row[REST_COLUMN] = gait_study.static_support(r.p_contact) or "carried"
+        row["deepest sink (mm)"] = 1e3 * gait_study.foot_sink(r.q, r.p_contact, _model_of(r))
+        row[REST_COLUMN] = gait_study.static_support(r.p_contact, model=_model_of(r)) or "carried"
         for m in ("mu_s", "mu_d"):
             row[f"ball {m}"] = float(r.p_contact[contact_mod.param_index("ball", m)])
         rows[k] = row
@@ -1110,10 +1135,11 @@ def friction_table(runs: dict[str, ApproachResult]) -> pd.DataFrame:
 
 
 def friction_findings(table: pd.DataFrame) -> list[str]:
-    """What the friction bound measured, every number from ``table`` (:func:`friction_table`):
-    each bounded run beside the book's run of its approach — mean GRF RMSE, worst angle and
-    torque RMSE, objective, foot slip, the ball's μ_d and the deepest sink — or why it is not
-    compared (not converged / not valid)."""
+    """What the friction bound measured, every number from ``table`` (:func:`friction_table`
+    of :func:`friction_identification` — or of :func:`leg_identification`, the same columns):
+    each variant run (a row "(b), …" / "(c), …") beside the book's run of its approach — mean
+    GRF RMSE, worst angle and torque RMSE, objective, foot slip, the ball's μ_d and the
+    deepest sink — or why it is not compared (not converged / not valid)."""
     v = gait_study.SLIP_V
     out = []
     for key in ("b", "c"):
@@ -1121,7 +1147,7 @@ def friction_findings(table: pd.DataFrame) -> list[str]:
         if base not in table.index:
             continue
         r0 = table.loc[base]
-        for bound in [k for k in table.index if k.startswith(base + ", friction")]:
+        for bound in [k for k in table.index if k.startswith(base + ", ")]:
             r1 = table.loc[bound]
             bad = [f"{k} ({r['status']}, {r['gates']})" for k, r in ((base, r0), (bound, r1))
                    if r["status"] not in validity.CONVERGED_STATUSES or r["gates"] != "valid"]

@@ -291,7 +291,7 @@ SD_NORM = "tracking normalised by the data's SD"
 #: The Ch 5 ablation's row with every ellipsoid's friction at least :data:`FRICTION_FLOOR`.
 FRICTION_ROW = "friction at least Table 4.18's toe μ_d (no skating ball)"
 #: The thigh and shank scale of the Ch 5 ablation's :data:`LEG_ROW` (:attr:`GaitSpec.leg_scale`).
-LEG_SCALE = 1.1
+LEG_SCALE = gait_study.LEG_SCALE
 #: The Ch 5 ablation's row with the legs longer (:func:`gaitlib.studies.gait.leg_scale_slip`).
 LEG_ROW = f"thigh and shank ×{LEG_SCALE:g}"
 #: The Ch 5 ablation's row of the same problem with its defects in integral form.
@@ -498,7 +498,9 @@ def leg_row_findings(table: pd.DataFrame, ref_base: dict, ref_leg: dict) -> list
     run (:data:`CH5_BASE_ROW`) and the same NLP along another path (:data:`INTEGRAL_DEFECTS`,
     the spread a run shows without any change of problem): whether the solution's feet stop
     sliding once its reference's do (``ref_base``, ``ref_leg``: :func:`gaitlib.studies.gait.
-    reference_slip` of the two specs). Empty when a row is missing; a row that did not
+    reference_slip` of the two specs) — not, when the solution's slip moves no more than the
+    same NLP moves it along another path; else how far it moves relative to the reference's
+    change. Empty when a row is missing; a row that did not
     converge or fails a gate is said so and nothing is concluded from it."""
     if LEG_ROW not in table.index or CH5_BASE_ROW not in table.index:
         return []
@@ -519,8 +521,11 @@ def leg_row_findings(table: pd.DataFrame, ref_base: dict, ref_leg: dict) -> list
             return ""
         return (f" (the same NLP along another path moves it {spread[k]:.3g}: "
                 f"{'beyond' if abs(d) > spread[k] else 'within'} that)")
-    verdict = ("so the reference's own slip is not what makes the solution slide"
-               if abs(d_sol) < 0.5 * abs(d_ref) else "so the solution's slip follows its reference's")
+    if SLIP_COLUMN in spread and abs(d_sol) <= spread[SLIP_COLUMN]:
+        verdict = "so the reference's own slip is not what makes the solution slide"
+    else:
+        verdict = (f"the solution's slip moves {d_sol / d_ref:.0%} as far as its reference's" if d_ref else
+                   "the reference's slip did not change")
     return [f"- **Longer legs** (thigh and shank ×{LEG_SCALE:g}): the reference's loaded feet slide "
             f"{ref_base['slip']:.3f} → {ref_leg['slip']:.3f} m/s ({100 * d_ref / ref_base['slip']:+.0f} %; signed mean "
             f"{ref_base['mean_slip']:+.3f} → {ref_leg['mean_slip']:+.3f} m/s), the solution's {a[SLIP_COLUMN]:.3f} → "

@@ -271,6 +271,10 @@ def reference_slip(spec: gait_ocp.GaitSpec, v: float = SLIP_V) -> dict:
 
 #: The leg scales of :func:`leg_scale_slip` (thigh and shank × each; 1: Table 4.1).
 LEG_SCALES = (0.95, 1.0, 1.05, 1.1, 1.15, 1.2)
+#: The thigh and shank scale the Ch 4 identification and the Ch 5 ablation solve with (our
+#: choice: the scan's scale nearest where the Ch 4 (c) reference's signed mean slip with
+#: our contact set changes sign, :func:`gaitlib.studies.contact_id.leg_scale_findings`).
+LEG_SCALE = 1.1
 
 
 def leg_scale_slip(spec: gait_ocp.GaitSpec, scales=LEG_SCALES) -> pd.DataFrame:
@@ -298,13 +302,15 @@ def leg_scale_slip(spec: gait_ocp.GaitSpec, scales=LEG_SCALES) -> pd.DataFrame:
     return pd.DataFrame(rows).set_index("leg scale")
 
 
-def static_support(p_contact, speed_class: str = "Free") -> str | None:
+def static_support(p_contact, speed_class: str = "Free", model: ChildModel | None = None) -> str | None:
     """Whether a contact set (39,) carries the data's vertical load at rest in the data's
     poses, as the tracking reference's HAT height needs (:func:`gaitlib.kinematics.
     height_for_load` inside :func:`gaitlib.problems.gait.reference`): None if it does, else
-    why not (the pose and load it cannot carry). A set that cannot has no Ch 5 reference."""
+    why not (the pose and load it cannot carry). A set that cannot has no Ch 5 reference.
+    ``model``: default the thesis's (:func:`gaitlib.problems.gait.spec_model`)."""
+    model = ChildModel() if model is None else model
     try:
-        gait_ocp.reference(data_mod.load_gait_data(speed_class), ChildModel(), p_contact)
+        gait_ocp.reference(data_mod.load_gait_data(speed_class, leg_scale=model.leg_scale), model, p_contact)
     except kinematics.LoadNotCarried as e:
         return str(e)
     return None
