@@ -117,3 +117,12 @@ def test_leg_row_findings_compare_the_reference_and_the_solution_slip_by_hand():
     assert "moves 50% as far as its reference's" in s and "beyond that" in s
     t.loc[fidelity.LEG_ROW, "gates"] = "invalid: swing_load"
     assert "not compared" in fidelity.leg_row_findings(t, {"slip": 0.2, "mean_slip": 0.1}, {"slip": 0.1, "mean_slip": 0.0})[0]
+
+
+def test_leg_floor_findings_name_the_joints_above_the_target_by_hand():
+    t = pd.DataFrame({"leg scale": [1.0, fidelity.LEG_SCALE], "hip_r (deg)": [2.5, 2.2], "knee_r (deg)": [2.1, 1.6],
+                      "worst (deg)": [2.5, 2.2]}).set_index("leg scale")
+    (s,) = fidelity.leg_floor_findings(t, 1.8)
+    assert "hip r 2.50 → 2.20, knee r 2.10 → 1.60°" in s
+    assert "at the thesis's legs above the 1.8° target: hip r, knee r" in s and "above the 1.8° target: hip r." in s
+    assert fidelity.leg_floor_findings(t.drop(index=1.0), 1.8) == []

@@ -274,6 +274,15 @@ display(Markdown("\n".join(fidelity.ch5_ablation_findings(abl_table, abl_channel
                            + fidelity.path_findings(abl_table))))
 
 # %% [markdown]
+# The geometric floor above is computed on the thesis's legs. On longer legs (thigh and
+# shank × 1.05 … 1.15, the data's speed and cycle time following; no dynamics, as above):
+
+# %%
+leg_floor = fidelity.leg_floor_table()
+display(leg_floor)
+display(Markdown("\n".join(fidelity.leg_floor_findings(leg_floor, float(abl_channels.loc["angle", "target"].max())))))
+
+# %% [markdown]
 # ### Figs 5.4–5.6: angles, torques and GRFs (MSK)
 #
 # Grey: data mean ± 1 SD (hip: thigh in the laboratory; mtp: the planned reference of

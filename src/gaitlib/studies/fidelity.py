@@ -964,7 +964,7 @@ def _stance(tau, gd, side: str, margin: float = data_mod.SWING_MARGIN) -> np.nda
 
 def kinematic_floor(speed_class: str = "Free", source: str = "schwartz2008", n: int = 100,
                     clearance: float = TOUCH, depth: tuple = STANCE_DEPTH,
-                    track_mtp: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
+                    track_mtp: bool = True, leg_scale: float | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The geometric part of the angle error: at each of ``n`` instants of the cycle, the
     pose closest to the tracking reference (:func:`gaitlib.problems.gait.reference`: the
     data's angles, the planned metatarsal angles, the HAT estimate) whose feet agree with the
@@ -977,10 +977,12 @@ def kinematic_floor(speed_class: str = "Free", source: str = "schwartz2008", n: 
     stay at the reference (``track_mtp=False``: the metatarsal angles, a planned trajectory
     in the reference, are left free). No dynamics and no smoothness: any motion of this model whose
     feet touch the ground when the data's do is at least this far from the data's angles,
-    instant by instant. Returns ``(table, poses)``: per leg joint the RMSE and the largest
-    change (deg); the poses (n, 11) indexed by the cycle fraction."""
-    gd = data_mod.load_gait_data(speed_class, source)
-    model = ChildModel()
+    instant by instant. ``leg_scale``: the thigh and shank × it (:attr:`~gaitlib.problems.
+    gait.GaitSpec.leg_scale`; default the thesis's legs). Returns ``(table, poses)``: per leg
+    joint the RMSE and the largest change (deg); the poses (n, 11) indexed by the cycle fraction."""
+    ls = {} if leg_scale is None else {"leg_scale": float(leg_scale)}
+    gd = data_mod.load_gait_data(speed_class, source, **ls)
+    model = ChildModel(**ls)
     ref = gait_ocp.reference(gd, model)
     tau = np.arange(n) / n
     T = gd.cycle_time
@@ -1096,6 +1098,39 @@ def jerk_findings(tables: dict[str, pd.DataFrame], gait) -> list[str]:
                        + f"HAT speed range {ra['HAT speed range (m/s)']:.3f} → {rb['HAT speed range (m/s)']:.3f} m/s; "
                        f"worst RMSE {moves}; gates: {rb['gates']}.")
     return out
+
+
+#: The leg scales of :func:`leg_floor_table` (thigh and shank × each).
+LEG_FLOOR_SCALES = (1.0, 1.05, LEG_SCALE, 1.15)
+
+
+def leg_floor_table(scales: tuple = LEG_FLOOR_SCALES, clearance: float = TOUCH) -> pd.DataFrame:
+    """:func:`kinematic_floor` (planned metatarsal angles tracked, ``clearance`` m of swing
+    clearance) with the thigh and shank × each of ``scales``: one row per scale, each leg
+    joint's RMSE and the worst (deg) — how far the angle floor is the legs' length."""
+    rows = []
+    for s in scales:
+        t, _ = kinematic_floor(clearance=clearance, leg_scale=None if float(s) == 1.0 else float(s))
+        rows.append({"leg scale": float(s), **{f"{j} (deg)": v for j, v in t["RMSE (deg)"].items()},
+                     "worst (deg)": float(t["RMSE (deg)"].max())})
+    return pd.DataFrame(rows).set_index("leg scale")
+
+
+def leg_floor_findings(table: pd.DataFrame, target_deg: float) -> list[str]:
+    """One sentence on :func:`leg_floor_table`: each joint's floor at the thesis's legs and at
+    :data:`LEG_SCALE`, and which joints' floors lie above the angle target ``target_deg``
+    (deg) at each."""
+    if 1.0 not in table.index or LEG_SCALE not in table.index:
+        return []
+    a, b = table.loc[1.0], table.loc[LEG_SCALE]
+    cols = [c for c in table.columns if c != "worst (deg)"]
+    moves = ", ".join(f"{c[:-len(' (deg)')].replace('_', ' ')} {a[c]:.2f} → {b[c]:.2f}" for c in cols)
+
+    def above(r):
+        over = [c[:-len(" (deg)")].replace("_", " ") for c in cols if r[c] > target_deg]
+        return f"above the {target_deg:.1f}° target: {', '.join(over)}" if over else f"every joint within the {target_deg:.1f}° target"
+    return [f"- **The geometric floor on longer legs** (no dynamics; thigh and shank ×{LEG_SCALE:g}, the speed following): "
+            f"{moves}° — at the thesis's legs {above(a)}; at ×{LEG_SCALE:g} {above(b)}."]
 
 
 def kinematic_floor_table(clearances: tuple = (0.0, TOUCH, 0.01)) -> pd.DataFrame:
