@@ -485,6 +485,13 @@ def single_change_findings(table: pd.DataFrame, per_channel: pd.DataFrame,
     return out
 
 
+def _unusable(table: pd.DataFrame, rows) -> list[str]:
+    """"row (status, gates)" for each of ``rows`` of an ablation table that did not converge
+    or fails a validity gate (empty: every row is usable)."""
+    return [f"{k} ({table.loc[k, 'status']}, {table.loc[k, 'gates']})" for k in rows
+            if table.loc[k, "status"] not in validity.CONVERGED_STATUSES or table.loc[k, "gates"] != "valid"]
+
+
 def leg_row_references(model: str = "MSK") -> tuple[dict, dict]:
     """:func:`gaitlib.studies.gait.reference_slip` (no solve) of the Ch 5 problem in the book's
     reading and of its :data:`LEG_ROW` change: the input of :func:`leg_row_findings`."""
@@ -505,12 +512,11 @@ def leg_row_findings(table: pd.DataFrame, ref_base: dict, ref_leg: dict) -> list
     if LEG_ROW not in table.index or CH5_BASE_ROW not in table.index:
         return []
     a, b = table.loc[CH5_BASE_ROW], table.loc[LEG_ROW]
-    bad = [f"{k} ({r['status']}, {r['gates']})" for k, r in ((CH5_BASE_ROW, a), (LEG_ROW, b))
-           if r["status"] not in validity.CONVERGED_STATUSES or r["gates"] != "valid"]
+    bad = _unusable(table, (CH5_BASE_ROW, LEG_ROW))
     if bad:
         return [f"- Longer legs: not compared — {'; '.join(bad)}."]
     c = table.loc[INTEGRAL_DEFECTS] if INTEGRAL_DEFECTS in table.index else None
-    c_ok = c is not None and c["status"] in validity.CONVERGED_STATUSES and c["gates"] == "valid"
+    c_ok = c is not None and not _unusable(table, (INTEGRAL_DEFECTS,))
     spread = {k: abs(float(c[k]) - float(a[k])) for k in (SLIP_COLUMN, "worst angle RMSE (deg)")} if c_ok else {}
     d_ref = float(ref_leg["slip"]) - float(ref_base["slip"])
     d_sol = float(b[SLIP_COLUMN]) - float(a[SLIP_COLUMN])
@@ -542,8 +548,7 @@ def path_findings(table: pd.DataFrame) -> list[str]:
     if INTEGRAL_DEFECTS not in table.index or CH5_BASE_ROW not in table.index:
         return []
     a, b = table.loc[CH5_BASE_ROW], table.loc[INTEGRAL_DEFECTS]
-    bad = [f"{k} ({r['status']}, {r['gates']})" for k, r in ((CH5_BASE_ROW, a), (INTEGRAL_DEFECTS, b))
-           if r["status"] not in validity.CONVERGED_STATUSES or r["gates"] != "valid"]
+    bad = _unusable(table, (CH5_BASE_ROW, INTEGRAL_DEFECTS))
     if bad:
         return [f"- The same NLP with its defects in integral form: not compared — {'; '.join(bad)}."]
     kinds = (("angle", "deg", "°"), ("torque", "N·m", " N·m"), ("GRF", "N", " N"))
