@@ -301,6 +301,42 @@ ref_slip = {"ours, ch4_child.json — what Chs 5–8 use": gait.reference_slip(r
             "thesis's Tables 4.17–4.18": gait.reference_slip(ci.spec_c())}
 display(Markdown("\n".join(f"- {x}" for x in ci.reference_slip_findings(ref_slip))))
 
+# %% [markdown]
+# The model's legs are Table 4.1's proportions of a 1.47 m child (thigh 0.245, shank 0.246 of
+# the height); the data are the joint angles of 83 children and a dimensionless speed and
+# cadence, which the book turns into m/s and s with the model's leg length (v = v*·√(g L),
+# Ch 1). If the data's stride is longer than the data's angles carry the model's legs, the
+# loaded feet must move forward while the HAT keeps its speed. A scan, no solve: the same
+# reference with the thigh and shank × 0.95 … 1.2 (`GaitSpec.leg_scale`; their COM
+# distances and inertias follow, masses unchanged; the speed and cycle time follow the longer
+# leg), each scale's force-weighted slip, the same anchored, and the *signed* mean slip
+# (> 0: the loaded feet move forward — the HAT outruns the legs' sweep; `gait.leg_scale_slip`).
+# A probe of the kinematics, not a body we propose: Ch 5 solves its tracking problem once
+# with the legs × 1.1 (one change, in its ablation) to see whether the solution's feet
+# follow.
+
+# %%
+leg_slip = {k: gait.leg_scale_slip(replace(ci.spec_c(), contact_params="ch4") if k.startswith("ours") else ci.spec_c())
+            for k in ref_slip}
+for k, t in leg_slip.items():
+    print(k)
+    display(t)
+display(Markdown("\n".join(f"- {x}" for x in ci.leg_scale_findings(leg_slip))))
+
+# %% [markdown]
+# Does the identification still put the ball at Table 4.7's lowest friction when the
+# reference's feet slide less? (b) and (c) identified again on the legs × 1.1, everything
+# else as the book's — (b) by the same multistart and continuation, (c) warm-started from
+# its (b) (`ci.leg_identification`):
+
+# %%
+leg_runs = ci.leg_identification()
+leg_tab = ci.friction_table(leg_runs)
+display(marks.mark_table(leg_tab, {k: marks.failure_label(r) for k, r in leg_runs.items()}))
+display(Markdown("\n".join(f"- {x}" for x in ci.friction_findings(leg_tab))))
+print(ci.leg_label("b", gait.LEG_SCALE))
+display(leg_runs[ci.leg_label("b", gait.LEG_SCALE)].starts)
+
 # %%
 fr_runs = ci.friction_identification()
 fr = ci.friction_table(fr_runs)

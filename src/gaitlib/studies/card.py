@@ -434,6 +434,7 @@ def _ch4_friction_causes() -> dict:
     f = fidelity.FRICTION_FLOOR
     ref = sg.reference_slip(replace(ci.spec_c(), contact_params="ch4"))
     local = bool(ci.friction_starts_findings(runs))
+    legs = _ch4_leg_clauses()
     out = {}
     for k in ("b", "c"):
         r0, r1 = t.loc[ci.APPROACHES[k]], t.loc[ci.friction_label(k, f)]
@@ -451,30 +452,33 @@ def _ch4_friction_causes() -> dict:
         if sk in t.index and t.loc[sk, "status"] in validity.CONVERGED_STATUSES and t.loc[sk, "gates"] == "valid":
             out[k] += (f"; sinking ≤ {1e3 * ci.SINK_LIMIT:g} mm as well, {t.loc[sk, 'mean GRF RMSE (N)']:.1f} N"
                        + (" (from a (b) multistart that stops in a local optimum: an upper bound)" if local else ""))
-        if k == "b":
-            out[k] += _ch4_leg_clause()
-        out[k] += f" [{where}]"
+        out[k] += legs.get(k, "") + f" [{where}]"
     return out
 
 
-def _ch4_leg_clause() -> str:
-    """"; on legs × s …": (b) identified on longer legs (:func:`gaitlib.studies.contact_id.
-    leg_identification`) beside the book's (b) — the reference's slip, the identified feet's
-    slip, the ball's μ_d and the mean GRF RMSE; "" when not stored."""
+def _ch4_leg_clauses() -> dict:
+    """"b"/"c" → "; identified on thigh and shank × s …": the approach identified on longer
+    legs (:func:`gaitlib.studies.contact_id.leg_identification`) — the reference's slip there,
+    the identified feet's slip and sink, the ball's μ_d and the mean GRF RMSE; empty when not
+    stored."""
     try:
         with cache.only("the card reads stored solutions only"):
             runs = ci.leg_identification()
     except cache.NotCached:
-        return ""
+        return {}
     t = ci.friction_table(runs)
     s = sg.LEG_SCALE
-    r1 = t.loc[ci.leg_label("b", s)]
-    if r1["status"] not in validity.CONVERGED_STATUSES or r1["gates"] != "valid":
-        return f"; on legs ×{s:g}: not compared ({r1['status']}, {r1['gates']})"
     ref = sg.reference_slip(replace(ci.spec_c(), contact_params="ch4", leg_scale=s))
-    return (f"; identified on thigh and shank ×{s:g} (where the reference slides {ref['slip']:.2f} m/s) the feet "
-            f"slide {r1[sg.SLIP_COLUMN]:.2f} m/s, ball μ_d {r1['ball mu_d']:.3f}, mean GRF RMSE "
-            f"{r1['mean GRF RMSE (N)']:.1f} N")
+    out = {}
+    for k in ("b", "c"):
+        r1 = t.loc[ci.leg_label(k, s)]
+        if r1["status"] not in validity.CONVERGED_STATUSES or r1["gates"] != "valid":
+            out[k] = f"; identified on thigh and shank ×{s:g}: not compared ({r1['status']}, {r1['gates']})"
+            continue
+        out[k] = (f"; identified on thigh and shank ×{s:g} (where the reference slides {ref['slip']:.2f} m/s) the "
+                  f"feet slide {r1[sg.SLIP_COLUMN]:.2f} m/s and sink {r1['deepest sink (mm)']:.0f} mm, ball μ_d "
+                  f"{r1['ball mu_d']:.3f}, mean GRF RMSE {r1['mean GRF RMSE (N)']:.1f} N")
+    return out
 
 
 #: The Ch 4 page's section of the (c) ablation (the card links to it).

@@ -1068,16 +1068,20 @@ def leg_label(key: str, scale: float) -> str:
 
 def leg_identification(scale: float | None = None, *, use_cache: bool = True, root=None,
                        progress: bool = False) -> dict[str, ApproachResult]:
-    """(b) as the book identifies it (the multistart :data:`B_STARTS`, each through the
-    continuation), and again on legs × ``scale`` (default :data:`~gaitlib.studies.gait.
-    LEG_SCALE`; :attr:`~gaitlib.problems.gait.GaitSpec.leg_scale`: the thigh and shank longer,
-    the data's speed and cycle time following): the reference's loaded feet slide half as
-    fast there (:func:`gaitlib.studies.gait.leg_scale_slip`) — does the identified ball still
-    take Table 4.7's lowest friction, and do the feet still slide? Returns label → result."""
+    """(b) and (c) as the book identifies them, and again on legs × ``scale`` (default
+    :data:`~gaitlib.studies.gait.LEG_SCALE`; :attr:`~gaitlib.problems.gait.GaitSpec.leg_scale`:
+    the thigh and shank longer, the data's speed and cycle time following): the reference's
+    loaded feet slide half as fast there (:func:`gaitlib.studies.gait.leg_scale_slip`) — does
+    the identified ball still take Table 4.7's lowest friction, and do the feet still slide?
+    (b) by the same multistart (:data:`B_STARTS`, each through the continuation), (c)
+    warm-started from its (b), as the book's. Returns label → result: the book's (b), the
+    longer legs' (b), the book's (c), the longer legs' (c)."""
     scale = gait_study.LEG_SCALE if scale is None else float(scale)
     kw = {"use_cache": use_cache, "root": root, "progress": progress}
-    return {APPROACHES["b"]: optimal_control_multistart(**kw),
-            leg_label("b", scale): optimal_control_multistart(replace(spec_b(), leg_scale=scale), **kw)}
+    b = optimal_control_multistart(**kw)
+    lb = optimal_control_multistart(replace(spec_b(), leg_scale=scale), **kw)
+    return {APPROACHES["b"]: b, leg_label("b", scale): lb, APPROACHES["c"]: optimal_control_body(warm=b, **kw),
+            leg_label("c", scale): optimal_control_body(replace(spec_c(), leg_scale=scale), warm=lb, **kw)}
 
 
 def friction_identification(floor: float | None = None, max_sinks: tuple = (None, SINK_LIMIT), *,

@@ -272,8 +272,10 @@ def reference_slip(spec: gait_ocp.GaitSpec, v: float = SLIP_V) -> dict:
 #: The leg scales of :func:`leg_scale_slip` (thigh and shank × each; 1: Table 4.1).
 LEG_SCALES = (0.95, 1.0, 1.05, 1.1, 1.15, 1.2)
 #: The thigh and shank scale the Ch 4 identification and the Ch 5 ablation solve with (our
-#: choice: the scan's scale nearest where the Ch 4 (c) reference's signed mean slip with
-#: our contact set changes sign, :func:`gaitlib.studies.contact_id.leg_scale_findings`).
+#: choice, a round value read off the scan: there the Ch 4 (c) reference's signed mean slip
+#: with our contact set is within 0.01 m/s of zero — it changes sign a little above, see
+#: :func:`gaitlib.studies.contact_id.leg_scale_findings` — and its slip about half the
+#: thesis legs').
 LEG_SCALE = 1.1
 
 
