@@ -102,21 +102,22 @@ def test_leg_scale_findings_interpolate_where_the_signed_slip_changes_sign_by_ha
 
 
 def test_leg_row_findings_compare_the_reference_and_the_solution_slip_by_hand():
-    cols = {"status": "Solve_Succeeded", "gates": "valid"}
+    cols = {"status": "Solve_Succeeded", "gates": "valid", "deepest sink (mm)": 30.0}
     t = pd.DataFrame([{"run": fidelity.CH5_BASE_ROW, fidelity.SLIP_COLUMN: 0.20, "worst angle RMSE (deg)": 4.5, **cols},
                       {"run": fidelity.LEG_ROW, fidelity.SLIP_COLUMN: 0.18, "worst angle RMSE (deg)": 4.0, **cols},
                       {"run": fidelity.INTEGRAL_DEFECTS, fidelity.SLIP_COLUMN: 0.17, "worst angle RMSE (deg)": 4.6, **cols}]
                      ).set_index("run")
-    (s,) = fidelity.leg_row_findings(t, {"slip": 0.2, "mean_slip": 0.1}, {"slip": 0.1, "mean_slip": 0.0})
+    refs = {fidelity.CH5_BASE_ROW: {"slip": 0.2, "mean_slip": 0.1}, fidelity.LEG_ROW: {"slip": 0.1, "mean_slip": 0.0}}
+    (s,) = fidelity.leg_row_findings(t, refs)
     # the reference −50 %, the solution −10 %; the same-NLP spread: slip 0.03 (the move 0.02
     # is within: not what makes it slide), angle 0.1 (the move 0.5 is beyond)
     assert "-50 %" in s and "-10 %" in s and "not what makes the solution slide" in s
     assert "moves it 0.03: within that" in s and "moves it 0.1: beyond that" in s
     t.loc[fidelity.LEG_ROW, fidelity.SLIP_COLUMN] = 0.15  # moves 0.05 > 0.03: 0.05 / 0.1 of the reference's
-    (s,) = fidelity.leg_row_findings(t, {"slip": 0.2, "mean_slip": 0.1}, {"slip": 0.1, "mean_slip": 0.0})
+    (s,) = fidelity.leg_row_findings(t, refs)
     assert "moves 50% as far as its reference's" in s and "beyond that" in s
     t.loc[fidelity.LEG_ROW, "gates"] = "invalid: swing_load"
-    assert "not compared" in fidelity.leg_row_findings(t, {"slip": 0.2, "mean_slip": 0.1}, {"slip": 0.1, "mean_slip": 0.0})[0]
+    assert "not compared" in fidelity.leg_row_findings(t, refs)[0]
 
 
 def test_leg_floor_findings_name_the_joints_above_the_target_by_hand():
@@ -126,3 +127,22 @@ def test_leg_floor_findings_name_the_joints_above_the_target_by_hand():
     assert "hip r 2.50 → 2.20, knee r 2.10 → 1.60°" in s
     assert "at the thesis's legs above the 1.8° target: hip r, knee r" in s and "above the 1.8° target: hip r." in s
     assert fidelity.leg_floor_findings(t.drop(index=1.0), 1.8) == []
+
+
+def test_a_set_identified_on_longer_legs_is_read_for_its_legs_and_rescaled_for_others():
+    s = params.load_identified("ch4_legs")
+    assert s["leg_scale"] == pytest.approx(1.1) and params.load_identified("ch4_child")["leg_scale"] == 1.0
+    m1, m0 = ChildModel(leg_scale=s["leg_scale"]), ChildModel()
+    # on the legs it was identified on: as stored; on the thesis's legs: COM / 1.1, MOI / 1.21
+    np.testing.assert_array_equal(params.body_params("ch4_legs", m1), s["p_body"])
+    p0 = params.body_params("ch4_legs", m0)
+    assert p0[IDX["com_thigh"]] == pytest.approx(s["p_body"][IDX["com_thigh"]] / 1.1, rel=1e-12)
+    assert p0[IDX["moi_shank"]] == pytest.approx(s["p_body"][IDX["moi_shank"]] / 1.21, rel=1e-12)
+    assert p0[IDX["mass_thigh"]] == s["p_body"][IDX["mass_thigh"]]
+    np.testing.assert_array_equal(params.contact_params("ch4_legs"), s["p_contact"])
+    spec = gait_ocp.GaitSpec(model="MSK", cost="Eq5.33", contact_params="ch4", body_params="ch4")
+    assert spec.identified_sets() == ("ch4_child",)  # the keys of the stored "ch4" solutions
+    legs = replace(spec, leg_scale=1.1, contact_params="ch4_legs", body_params="ch4_legs")
+    assert legs.identified_sets() == ("ch4_legs",)
+    with pytest.raises(ValueError, match="ch4_legs"):
+        replace(spec, contact_params="ch4_legs")

@@ -337,6 +337,15 @@ display(Markdown("\n".join(f"- {x}" for x in ci.friction_findings(leg_tab))))
 print(ci.leg_label("b", gait.LEG_SCALE))
 display(leg_runs[ci.leg_label("b", gait.LEG_SCALE)].starts)
 
+# %% [markdown]
+# The (c) on the longer legs is stored as `data/identified/ch4_legs.json`
+# (`ci.save_identified(..., name="ch4_legs")`); Ch 5 solves its tracking problem on those
+# legs with it (its ablation's row "thigh and shank × 1.1 + Ch 4 (c) identified on them"):
+
+# %%
+_lc = leg_runs[ci.leg_label("c", gait.LEG_SCALE)]
+display(Markdown(ci.identified_note(ci.identified_vs_result(_lc, "ch4_legs"), _lc)))
+
 # %%
 fr_runs = ci.friction_identification()
 fr = ci.friction_table(fr_runs)

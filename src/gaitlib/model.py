@@ -589,13 +589,15 @@ class ChildModel:
         if not 0.5 <= self.leg_scale <= 2.0:
             raise ValueError(f"ChildModel: leg_scale {self.leg_scale!r} outside 0.5–2")
 
-    def leg_scaled(self, p_body) -> np.ndarray:
-        """A ``p_body`` (25,) given for the thesis's legs, with the thigh's and shank's COM
-        distances × :attr:`leg_scale` and their moments of inertia × its square (a copy)."""
+    def leg_scaled(self, p_body, from_scale: float = 1.0) -> np.ndarray:
+        """A ``p_body`` (25,) given for legs × ``from_scale`` (1: the thesis's), with the
+        thigh's and shank's COM distances × :attr:`leg_scale` / ``from_scale`` and their
+        moments of inertia × its square (a copy)."""
         p = np.array(p_body, dtype=float)
+        r = self.leg_scale / float(from_scale)
         for seg in _LEG_SEGMENTS:
-            p[_P[f"com_{seg}"]] *= self.leg_scale
-            p[_P[f"moi_{seg}"]] *= self.leg_scale ** 2
+            p[_P[f"com_{seg}"]] *= r
+            p[_P[f"moi_{seg}"]] *= r ** 2
         return p
 
     @cached_property

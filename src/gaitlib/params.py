@@ -72,6 +72,7 @@ def _load(path_str: str, mtime_ns: int) -> dict:
         "p_body": _vector(raw["p_body"], list(P_BODY_NAMES), "p_body", path),
         "provenance": raw["provenance"],
         "bounds": raw.get("bounds", {}),
+        "leg_scale": float(raw.get("leg_scale", 1.0)),
         "path": path,
     }
 
@@ -89,7 +90,9 @@ def load_identified(name: str = "ch4_child") -> dict:
     -------
     dict
         ``p_contact`` (39,) SI, ``p_body`` (25,) SI, ``provenance`` (dict), ``bounds``
-        (dict of name → [lo, hi]) and ``path``. Arrays are fresh copies.
+        (dict of name → [lo, hi]), ``leg_scale`` (the thigh and shank scale of the model it
+        was identified on, :attr:`gaitlib.model.ChildModel.leg_scale`; 1 when absent) and
+        ``path``. Arrays are fresh copies.
 
     Raises
     ------
@@ -107,27 +110,38 @@ def load_identified(name: str = "ch4_child") -> dict:
     return {**out, "p_contact": out["p_contact"].copy(), "p_body": out["p_body"].copy()}
 
 
+#: Named identified sets a spec may read (``GaitSpec.contact_params`` / ``body_params``
+#: value → file stem under ``data/identified/``): ``"ch4"`` — Ch 4 approach (c) on the
+#: thesis's legs; ``"ch4_legs"`` — the same on thigh and shank ×
+#: :data:`gaitlib.studies.gait.LEG_SCALE` (:func:`gaitlib.studies.contact_id.leg_identification`).
+IDENTIFIED_SETS = {"ch4": "ch4_child", "ch4_legs": "ch4_legs"}
+
+
 def contact_params(which: str = "default") -> np.ndarray:
     """The 39 contact parameters (SI, left foot): ``"default"`` — the thesis's identified
     values (Tables 4.17–4.18, :func:`gaitlib.contact.default_params`); ``"ch4"`` — ours
-    (approach (c) of Ch 4, :func:`load_identified`)."""
+    (approach (c) of Ch 4, :func:`load_identified`); ``"ch4_legs"`` — ours on longer legs
+    (:data:`IDENTIFIED_SETS`)."""
     if which == "default":
         return contact.default_params()
-    if which == "ch4":
-        return load_identified("ch4_child")["p_contact"]
-    raise ValueError(f"contact parameters must be 'default' or 'ch4', got {which!r}")
+    if which in IDENTIFIED_SETS:
+        return load_identified(IDENTIFIED_SETS[which])["p_contact"]
+    raise ValueError(f"contact parameters must be 'default' or one of {list(IDENTIFIED_SETS)}, got {which!r}")
 
 
 def body_params(which: str = "default", model=None) -> np.ndarray:
     """The 25 body/joint parameters (SI): ``"default"`` — Tables 4.1–4.3 scaled (Sec 4.1.1);
     ``"thesis"`` — the thesis's identified values (Tables 4.15–4.16); ``"ch4"`` — ours
-    (approach (c) of Ch 4, :func:`load_identified`). With ``model.leg_scale`` ≠ 1 the thigh's
-    and shank's COM distances and inertias follow (:meth:`~gaitlib.model.ChildModel.leg_scaled`)."""
+    (approach (c) of Ch 4, :func:`load_identified`); ``"ch4_legs"`` — ours on longer legs
+    (:data:`IDENTIFIED_SETS`). The thigh's and shank's COM distances and inertias follow
+    ``model.leg_scale`` from the legs the set was identified on
+    (:meth:`~gaitlib.model.ChildModel.leg_scaled`)."""
     model = ChildModel() if model is None else model
     if which == "default":
         return model.default_p_body()
     if which == "thesis":
         return model.leg_scaled(model.p_body_identified())
-    if which == "ch4":
-        return model.leg_scaled(load_identified("ch4_child")["p_body"])
-    raise ValueError(f"body parameters must be 'default', 'thesis' or 'ch4', got {which!r}")
+    if which in IDENTIFIED_SETS:
+        s = load_identified(IDENTIFIED_SETS[which])
+        return model.leg_scaled(s["p_body"], s["leg_scale"])
+    raise ValueError(f"body parameters must be 'default', 'thesis' or one of {list(IDENTIFIED_SETS)}, got {which!r}")

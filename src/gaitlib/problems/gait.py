@@ -266,9 +266,11 @@ class GaitSpec:
     free_contact, free_body : identify the 39 contact / 25 body parameters (Ch 4).
     body_params : ``"default"`` (Tables 4.1–4.3 scaled), ``"thesis"`` (Tables 4.15–4.16) or
         ``"ch4"`` (ours, Ch 4 approach (c), ``data/identified/ch4_child.json``,
-        :func:`gaitlib.params.load_identified`). The fixed values, or the guess when free.
-    contact_params : ``"default"`` (the thesis's Tables 4.17–4.18) or ``"ch4"`` (ours, as
-        ``body_params``). The fixed values, or the guess when free; also the geometry of the
+        :func:`gaitlib.params.load_identified`), or ``"ch4_legs"`` (ours, the same on
+        thigh and shank × :data:`gaitlib.studies.gait.LEG_SCALE`, ``data/identified/
+        ch4_legs.json``; only with ``leg_scale``). The fixed values, or the guess when free.
+    contact_params : ``"default"`` (the thesis's Tables 4.17–4.18), ``"ch4"`` or
+        ``"ch4_legs"`` (ours, as ``body_params``). The fixed values, or the guess when free; also the geometry of the
         HAT-height reference.
     mtg_params : MSK/NMSK MTG fitting parameters (Eq 5.9) of the 12 generators (left leg =
         right leg): ``"default"`` — Eq 5.22, the adult Gymnast curves scaled to the child
@@ -455,12 +457,16 @@ class GaitSpec:
             raise ValueError(f"activation_params must be None or 'ch5', got {self.activation_params!r}")
         if self.activation_params is not None and self.free_activation:
             raise ValueError("activation_params fixes γ; free_activation identifies it: choose one")
-        if self.body_params not in ("default", "thesis", "ch4"):
-            raise ValueError(f"body_params must be 'default', 'thesis' or 'ch4', got {self.body_params!r}")
+        if self.body_params not in ("default", "thesis", *params_mod.IDENTIFIED_SETS):
+            raise ValueError(f"body_params must be 'default', 'thesis' or one of {list(params_mod.IDENTIFIED_SETS)}, "
+                             f"got {self.body_params!r}")
         if self.mtg_params not in MTG_PARAM_SETS:
             raise ValueError(f"mtg_params must be one of {MTG_PARAM_SETS}, got {self.mtg_params!r}")
-        if self.contact_params not in ("default", "ch4"):
-            raise ValueError(f"contact_params must be 'default' or 'ch4', got {self.contact_params!r}")
+        if self.contact_params not in ("default", *params_mod.IDENTIFIED_SETS):
+            raise ValueError(f"contact_params must be 'default' or one of {list(params_mod.IDENTIFIED_SETS)}, "
+                             f"got {self.contact_params!r}")
+        if "ch4_legs" in (self.contact_params, self.body_params) and self.leg_scale is None:
+            raise ValueError("the 'ch4_legs' set was identified on longer legs: give leg_scale too")
         if self.contact_bounds not in ("widened", "table4.7"):
             raise ValueError(f"contact_bounds must be 'widened' or 'table4.7', got {self.contact_bounds!r}")
         if self.excitation_guess not in ("mtg", "emg"):
@@ -493,11 +499,13 @@ class GaitSpec:
 
     def identified_sets(self) -> tuple[str, ...]:
         """Names of the identified parameter sets (``data/identified/<name>.json``) this spec
-        reads: ``"ch4_child"`` for ``contact_params``/``body_params`` ``"ch4"``, ``"ch5_mtg"``
-        for ``mtg_params="ch5"``. Cache keys hash exactly these (:func:`gaitlib.cache.fingerprint`)."""
+        reads: ``"ch4_child"`` for ``contact_params``/``body_params`` ``"ch4"`` (``"ch4_legs"``
+        for ``"ch4_legs"``, :data:`gaitlib.params.IDENTIFIED_SETS`), ``"ch5_mtg"`` for
+        ``mtg_params="ch5"``. Cache keys hash exactly these (:func:`gaitlib.cache.fingerprint`)."""
         sets = []
-        if "ch4" in (self.contact_params, self.body_params):
-            sets.append("ch4_child")
+        for k, name in params_mod.IDENTIFIED_SETS.items():
+            if k in (self.contact_params, self.body_params):
+                sets.append(name)
         if self.mtg_params == "ch5":
             sets.append("ch5_mtg")
         if self.activation_params == "ch5":

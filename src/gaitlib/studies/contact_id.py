@@ -799,11 +799,13 @@ def friction_ratios(results: dict[str, ApproachResult]) -> pd.DataFrame:
 # --------------------------------------------------------------------------------------
 
 
-def save_identified(res: ApproachResult, path=None) -> Path:
+def save_identified(res: ApproachResult, path=None, name: str = "ch4_child") -> Path:
     """Write (c)'s identified parameters with their provenance (:mod:`gaitlib.params` format).
 
     Refuses a result that did not converge (IPOPT status other than Solve_Succeeded).
-    ``path`` default: :func:`gaitlib.params.identified_path` (``data/identified/ch4_child.json``).
+    ``path`` default: :func:`gaitlib.params.identified_path` of ``name`` (``data/identified/
+    <name>.json``; ``"ch4_child"``, or ``"ch4_legs"`` for a (c) on longer legs, whose file
+    also records its ``leg_scale``).
     Note: data JSON files are part of the solution-cache fingerprint, so writing this file
     makes every stored solution unreachable (they are recomputed on next use).
     """
@@ -811,16 +813,19 @@ def save_identified(res: ApproachResult, path=None) -> Path:
         raise ValueError("save_identified: expects the approach (c) result")
     if not res.success:
         raise ValueError(f"save_identified: approach (c) did not converge ({res.stats['status']}); not saving")
-    path = Path(path) if path is not None else params_mod.identified_path("ch4_child")
-    m = ChildModel()
+    path = Path(path) if path is not None else params_mod.identified_path(name)
+    m = gait_ocp.spec_model(res.solution.spec)
     clo, chi = contact_mod.bounds()
     blo, bhi = m.p_body_bounds()
     st = res.stats
+    legs = (f" The model's thigh and shank are {m.leg_scale:g} x Table 4.1's (GaitSpec.leg_scale); the body "
+            "parameters are for those legs." if res.solution.spec.leg_scale is not None else "")
     out = {
-        "name": "ch4_child",
+        "name": name,
         "description": ("Contact (39, left foot) and body/joint (25) parameters identified by approach (c) of "
                         "thesis Sec 4.4 (optimal control, Eq 4.13, per-ellipsoid normal force >= 0, Table 4.7 and "
-                        "Table 4.14 bounds) on the Schwartz 2008 Free-speed data, both legs."),
+                        "Table 4.14 bounds) on the Schwartz 2008 Free-speed data, both legs." + legs),
+        **({"leg_scale": float(m.leg_scale)} if res.solution.spec.leg_scale is not None else {}),
         "p_contact": {n: float(v) for n, v in zip(contact_mod.param_names(), res.p_contact)},
         "p_body": {n: float(v) for n, v in zip(P_BODY_NAMES, res.p_body)},
         "units": {"p_contact": {n: u for n, u in zip(contact_mod.param_names(),
@@ -856,7 +861,7 @@ def identified_vs_result(res: ApproachResult, name: str = "ch4_child") -> dict:
     contact and body parameters (relative to each parameter's bound width) and the stored
     provenance."""
     stored = params_mod.load_identified(name)
-    m = ChildModel()
+    m = _model_of(res)
     clo, chi = contact_mod.bounds()
     blo, bhi = m.p_body_bounds()
     dc = np.max(np.abs(stored["p_contact"] - res.p_contact) / (chi - clo))

@@ -294,6 +294,9 @@ FRICTION_ROW = "friction at least Table 4.18's toe μ_d (no skating ball)"
 LEG_SCALE = gait_study.LEG_SCALE
 #: The Ch 5 ablation's row with the legs longer (:func:`gaitlib.studies.gait.leg_scale_slip`).
 LEG_ROW = f"thigh and shank ×{LEG_SCALE:g}"
+#: The Ch 5 ablation's row on the longer legs with the contact and body identified on them
+#: (Ch 4 (c), :func:`gaitlib.studies.contact_id.leg_identification`; ``data/identified/ch4_legs.json``).
+LEG_SET_ROW = f"{LEG_ROW} + Ch 4 (c) identified on them"
 #: The Ch 5 ablation's row of the same problem with its defects in integral form.
 INTEGRAL_DEFECTS = "defects in integral form (the same NLP)"
 
@@ -318,7 +321,9 @@ def ch5_changes(model: str = "MSK") -> dict[str, dict]:
     a loaded foot slide, :func:`foot_slip`); :data:`LEG_ROW`, the thigh and shank ×
     :data:`LEG_SCALE` (:attr:`GaitSpec.leg_scale`: at that scale the reference — the data's
     angles on the model — stops sliding its loaded feet on average,
-    :func:`gaitlib.studies.gait.leg_scale_slip`). The last row,
+    :func:`gaitlib.studies.gait.leg_scale_slip`), and :data:`LEG_SET_ROW`, that with the
+    contact and body parameters identified on those legs (Ch 4 (c)) — the one chain of two
+    changes: the model and its identified parameters made consistent. The last row,
     :data:`INTEGRAL_DEFECTS`, changes no problem: the same NLP with its collocation defects in
     integral form (:attr:`GaitSpec.defects`, an invertible linear map of the rows, so the same
     feasible set and optima), which IPOPT walks along another path — how much of the misfit
@@ -341,6 +346,7 @@ def ch5_changes(model: str = "MSK") -> dict[str, dict]:
         FRICTION_ROW: {"friction_floor": FRICTION_FLOOR},
         ci_study.LEFT_SHIFTED_ROW: {"fourier_order": gait_ocp.EXACT_FOURIER_ORDER},
         LEG_ROW: {"leg_scale": LEG_SCALE},
+        LEG_SET_ROW: {"leg_scale": LEG_SCALE, "contact_params": "ch4_legs", "body_params": "ch4_legs"},
         INTEGRAL_DEFECTS: {"defects": "integral"},
     }
 
@@ -448,7 +454,7 @@ def ch5_ablation_findings(table: pd.DataFrame, per_channel: pd.DataFrame, floor:
 
 
 def single_change_findings(table: pd.DataFrame, per_channel: pd.DataFrame,
-                           rows: tuple = (SD_NORM, ci_study.LEFT_SHIFTED_ROW, FRICTION_ROW, LEG_ROW),
+                           rows: tuple = (SD_NORM, ci_study.LEFT_SHIFTED_ROW, FRICTION_ROW, LEG_ROW, LEG_SET_ROW),
                            n_moves: int = 4) -> list[str]:
     """One sentence per ``rows`` entry of a Ch 5 ablation (:func:`ch5_ablation`; ``per_channel``:
     its :func:`channel_table` over the usable runs) beside the book's run (:data:`CH5_BASE_ROW`):
@@ -479,7 +485,8 @@ def single_change_findings(table: pd.DataFrame, per_channel: pd.DataFrame,
         n_row = int((per_channel[row] <= per_channel["target"]).sum())
         slip = (f"; the feet slide {a[SLIP_COLUMN]:.3f} → {b[SLIP_COLUMN]:.3f} m/s (force-weighted)"
                 if SLIP_COLUMN in table.columns else "")
-        out.append(f"- **{row}** (one change; {int(b['iterations'])} iterations, objective {b['objective']:.4g} vs the "
+        changes = "two changes" if row == LEG_SET_ROW else "one change"
+        out.append(f"- **{row}** ({changes}; {int(b['iterations'])} iterations, objective {b['objective']:.4g} vs the "
                    f"book's {a['objective']:.4g}): worst RMSE {worst}; the largest moves relative to their targets: "
                    f"{moves}; channels within target: {n_row} of {len(per_channel)} (the book's run: {n_base}){slip}.")
     return out
@@ -492,52 +499,63 @@ def _unusable(table: pd.DataFrame, rows) -> list[str]:
             if table.loc[k, "status"] not in validity.CONVERGED_STATUSES or table.loc[k, "gates"] != "valid"]
 
 
-def leg_row_references(model: str = "MSK") -> tuple[dict, dict]:
+def leg_row_references(model: str = "MSK") -> dict[str, dict]:
     """:func:`gaitlib.studies.gait.reference_slip` (no solve) of the Ch 5 problem in the book's
-    reading and of its :data:`LEG_ROW` change: the input of :func:`leg_row_findings`."""
+    reading (:data:`CH5_BASE_ROW`) and of its :data:`LEG_ROW` and :data:`LEG_SET_ROW` changes:
+    the input of :func:`leg_row_findings`."""
     spec = msk.ch5_spec(model, reading="book")
-    return (gait_study.reference_slip(spec),
-            gait_study.reference_slip(replace(spec, **ch5_changes(model)[LEG_ROW])))
+    ch = ch5_changes(model)
+    return {CH5_BASE_ROW: gait_study.reference_slip(spec),
+            **{row: gait_study.reference_slip(replace(spec, **ch[row])) for row in (LEG_ROW, LEG_SET_ROW)}}
 
 
-def leg_row_findings(table: pd.DataFrame, ref_base: dict, ref_leg: dict) -> list[str]:
-    """The :data:`LEG_ROW` of a Ch 5 ablation table (:func:`ch5_ablation`) beside the book's
-    run (:data:`CH5_BASE_ROW`) and the same NLP along another path (:data:`INTEGRAL_DEFECTS`,
-    the spread a run shows without any change of problem): whether the solution's feet stop
-    sliding once its reference's do (``ref_base``, ``ref_leg``: :func:`gaitlib.studies.gait.
-    reference_slip` of the two specs) — not, when the solution's slip moves no more than the
-    same NLP moves it along another path; else how far it moves relative to the reference's
-    change. Empty when a row is missing; a row that did not
-    converge or fails a gate is said so and nothing is concluded from it."""
-    if LEG_ROW not in table.index or CH5_BASE_ROW not in table.index:
+def leg_row_findings(table: pd.DataFrame, refs: dict[str, dict]) -> list[str]:
+    """The :data:`LEG_ROW` and :data:`LEG_SET_ROW` of a Ch 5 ablation table
+    (:func:`ch5_ablation`) beside the book's run (:data:`CH5_BASE_ROW`) and the same NLP along
+    another path (:data:`INTEGRAL_DEFECTS`, the spread a run shows without any change of
+    problem): whether the solution's feet stop sliding once its reference's do (``refs``: row
+    → :func:`gaitlib.studies.gait.reference_slip` of its spec, :func:`leg_row_references`) —
+    not, when the solution's slip moves no more than the same NLP moves it along another path;
+    else how far it moves relative to the reference's change. One sentence per row present; a
+    row that did not converge or fails a gate is said so and nothing is concluded from it."""
+    if CH5_BASE_ROW not in table.index or CH5_BASE_ROW not in refs:
         return []
-    a, b = table.loc[CH5_BASE_ROW], table.loc[LEG_ROW]
-    bad = _unusable(table, (CH5_BASE_ROW, LEG_ROW))
-    if bad:
-        return [f"- Longer legs: not compared — {'; '.join(bad)}."]
+    a, ref_base = table.loc[CH5_BASE_ROW], refs[CH5_BASE_ROW]
     c = table.loc[INTEGRAL_DEFECTS] if INTEGRAL_DEFECTS in table.index else None
     c_ok = c is not None and not _unusable(table, (INTEGRAL_DEFECTS,))
     spread = {k: abs(float(c[k]) - float(a[k])) for k in (SLIP_COLUMN, "worst angle RMSE (deg)")} if c_ok else {}
-    d_ref = float(ref_leg["slip"]) - float(ref_base["slip"])
-    d_sol = float(b[SLIP_COLUMN]) - float(a[SLIP_COLUMN])
-    d_ang = float(b["worst angle RMSE (deg)"]) - float(a["worst angle RMSE (deg)"])
 
     def beyond(d, k):
         if k not in spread:
             return ""
         return (f" (the same NLP along another path moves it {spread[k]:.3g}: "
                 f"{'beyond' if abs(d) > spread[k] else 'within'} that)")
-    if SLIP_COLUMN in spread and abs(d_sol) <= spread[SLIP_COLUMN]:
-        verdict = "so the reference's own slip is not what makes the solution slide"
-    else:
-        verdict = (f"the solution's slip moves {d_sol / d_ref:.0%} as far as its reference's" if d_ref else
-                   "the reference's slip did not change")
-    return [f"- **Longer legs** (thigh and shank ×{LEG_SCALE:g}): the reference's loaded feet slide "
-            f"{ref_base['slip']:.3f} → {ref_leg['slip']:.3f} m/s ({100 * d_ref / ref_base['slip']:+.0f} %; signed mean "
-            f"{ref_base['mean_slip']:+.3f} → {ref_leg['mean_slip']:+.3f} m/s), the solution's {a[SLIP_COLUMN]:.3f} → "
-            f"{b[SLIP_COLUMN]:.3f} m/s ({100 * d_sol / a[SLIP_COLUMN]:+.0f} %){beyond(d_sol, SLIP_COLUMN)} — {verdict}; "
-            f"the worst angle RMSE {a['worst angle RMSE (deg)']:.2f} → {b['worst angle RMSE (deg)']:.2f}°"
-            f"{beyond(d_ang, 'worst angle RMSE (deg)')}."]
+    out = []
+    for row in (LEG_ROW, LEG_SET_ROW):
+        if row not in table.index or row not in refs:
+            continue
+        bad = _unusable(table, (CH5_BASE_ROW, row))
+        if bad:
+            out.append(f"- {row}: not compared — {'; '.join(bad)}.")
+            continue
+        b, ref_leg = table.loc[row], refs[row]
+        d_ref = float(ref_leg["slip"]) - float(ref_base["slip"])
+        d_sol = float(b[SLIP_COLUMN]) - float(a[SLIP_COLUMN])
+        d_ang = float(b["worst angle RMSE (deg)"]) - float(a["worst angle RMSE (deg)"])
+        if SLIP_COLUMN in spread and abs(d_sol) <= spread[SLIP_COLUMN]:
+            verdict = "so the reference's own slip is not what makes the solution slide"
+        else:
+            verdict = (f"the solution's slip moves {d_sol / d_ref:.0%} as far as its reference's" if d_ref else
+                       "the reference's slip did not change")
+        out.append(f"- **{row}**: the reference's loaded feet slide "
+                   f"{ref_base['slip']:.3f} → {ref_leg['slip']:.3f} m/s ({100 * d_ref / ref_base['slip']:+.0f} %; signed "
+                   f"mean {ref_base['mean_slip']:+.3f} → {ref_leg['mean_slip']:+.3f} m/s), the solution's "
+                   f"{a[SLIP_COLUMN]:.3f} → {b[SLIP_COLUMN]:.3f} m/s ({100 * d_sol / a[SLIP_COLUMN]:+.0f} %)"
+                   f"{beyond(d_sol, SLIP_COLUMN)} — {verdict}; the worst angle RMSE "
+                   f"{a['worst angle RMSE (deg)']:.2f} → {b['worst angle RMSE (deg)']:.2f}°"
+                   f"{beyond(d_ang, 'worst angle RMSE (deg)')}; the deepest sink {a['deepest sink (mm)']:.1f} → "
+                   f"{b['deepest sink (mm)']:.1f} mm.")
+    return out
 
 
 def path_findings(table: pd.DataFrame) -> list[str]:
