@@ -759,10 +759,13 @@ def _ch5_ablation_causes(model: str = "MSK") -> dict:
     every = fidelity.all_targets(table)
     every = (f"; every angle, torque and GRF target at once: met by {', '.join(every)}" if every else
              "; every angle, torque and GRF target at once: met by no run")
+    legs = fidelity.LEG_SET_ROW if fidelity.LEG_SET_ROW in table.columns else None
     for (kind, part, side, unit), r in table.iterrows():
+        leg = (f"; at the book's weights on legs ×{fidelity.LEG_SCALE:g} with Ch 4 (c) identified on them "
+               f"{r[legs]:.1f} {unit} (book's run {r[fidelity.CH5_BASE_ROW]:.1f})" if legs else "")
         out[(kind, part, side)] = (f"Ch 5 ablation (book's reading, {len(ok) - 1} usable changes): lowest "
                                    f"{r[r['best change']]:.1f} {unit} ({r['best change']}), target {r['target']:.1f} "
-                                   f"{unit} met by: {r['met by']}{every} [{where}]")
+                                   f"{unit} met by: {r['met by']}{every}{leg} [{where}]")
     return out
 
 
