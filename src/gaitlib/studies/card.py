@@ -418,16 +418,24 @@ def _ch4() -> list[Row]:
 CH4_FRICTION_HEADING = "Do the identified feet stand still? (b) and (c) with a friction lower bound"
 
 
+def _stored(study):
+    """``study()`` from stored solutions only (:func:`gaitlib.cache.only`), or None when one
+    it needs is not stored."""
+    try:
+        with cache.only("the card reads stored solutions only"):
+            return study()
+    except cache.NotCached:
+        return None
+
+
 def _ch4_friction_causes() -> dict:
     """"b"/"c" → what identifying with every μ ≥ the friction floor measured
     (:func:`gaitlib.studies.contact_id.friction_identification`, the floor alone): the book's
     foot slip and mean GRF RMSE beside the bounded run's, and how deep each sinks; with how
     fast the tracking reference's own feet slide (:func:`gaitlib.studies.gait.reference_slip`).
     Empty when not stored; "not compared" when either run is not converged or not valid."""
-    try:
-        with cache.only("the card reads stored solutions only"):
-            runs = ci.friction_identification()
-    except cache.NotCached:
+    runs = _stored(ci.friction_identification)
+    if runs is None:
         return {}
     t = ci.friction_table(runs)
     where = _anchor("ch04_contact", CH4_FRICTION_HEADING)
@@ -461,10 +469,8 @@ def _ch4_leg_clauses() -> dict:
     legs (:func:`gaitlib.studies.contact_id.leg_identification`) — the reference's slip there,
     the identified feet's slip and sink, the ball's μ_d and the mean GRF RMSE; empty when not
     stored."""
-    try:
-        with cache.only("the card reads stored solutions only"):
-            runs = ci.leg_identification()
-    except cache.NotCached:
+    runs = _stored(ci.leg_identification)
+    if runs is None:
         return {}
     t = ci.friction_table(runs)
     s = sg.LEG_SCALE
