@@ -15,6 +15,7 @@ from gaitlib import data as data_mod
 from gaitlib import params
 from gaitlib.model import P_BODY_NAMES, ChildModel
 from gaitlib.problems import gait as gait_ocp
+from gaitlib.studies import card
 from gaitlib.studies import contact_id as ci
 from gaitlib.studies import fidelity
 from gaitlib.studies import gait as gait_study
@@ -146,3 +147,16 @@ def test_a_set_identified_on_longer_legs_is_read_for_its_legs_and_rescaled_for_o
     assert legs.identified_sets() == ("ch4_legs",)
     with pytest.raises(ValueError, match="ch4_legs"):
         replace(spec, contact_params="ch4_legs")
+
+
+def test_the_card_sentence_on_longer_legs_concludes_only_when_every_run_stands_and_improves(monkeypatch):
+    cols = {"status": "Solve_Succeeded", "gates": "valid"}
+    t = pd.DataFrame([{"run": fidelity.CH5_BASE_ROW, fidelity.SLIP_COLUMN: 0.2, "worst angle RMSE (deg)": 4.5, **cols},
+                      {"run": fidelity.LEG_SET_ROW, fidelity.SLIP_COLUMN: 0.07, "worst angle RMSE (deg)": 2.0, **cols}]
+                     ).set_index("run")
+    monkeypatch.setattr(card, "_stored", lambda study: (t, {}))
+    (s,) = card.legs_slip_lines()
+    assert "MSK 0.200 → 0.070 m/s (worst angle 4.50 → 2.00°)" in s and "stop sliding" in s
+    t.loc[fidelity.LEG_SET_ROW, fidelity.SLIP_COLUMN] = 0.15  # still sliding: no conclusion
+    (s,) = card.legs_slip_lines()
+    assert "stop sliding" not in s and s.endswith(".")

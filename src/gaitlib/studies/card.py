@@ -1432,6 +1432,36 @@ def slip_table(card: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(out)
 
 
+def legs_slip_lines() -> list[str]:
+    """One sentence: the Ch 5 ablation's run on longer legs with the contact and body
+    identified on them (:data:`gaitlib.studies.fidelity.LEG_SET_ROW`) beside the book's
+    Ch 5 run, per model — the force-weighted foot slip and the worst angle RMSE; empty when
+    not stored, a run not usable is said so."""
+    parts, both = [], []
+    for model in ("MSK", "NMSK"):
+        got = _stored(lambda m=model: fidelity.ch5_ablation(m))
+        if got is None:
+            continue
+        t = got[0]
+        if fidelity.LEG_SET_ROW not in t.index or fidelity.CH5_BASE_ROW not in t.index:
+            continue
+        a, b = t.loc[fidelity.CH5_BASE_ROW], t.loc[fidelity.LEG_SET_ROW]
+        if b["status"] not in validity.CONVERGED_STATUSES or b["gates"] != "valid":
+            parts.append(f"{model} not compared ({b['status']}, {b['gates']})")
+            continue
+        parts.append(f"{model} {a[fidelity.SLIP_COLUMN]:.3f} → {b[fidelity.SLIP_COLUMN]:.3f} m/s (worst angle "
+                     f"{a['worst angle RMSE (deg)']:.2f} → {b['worst angle RMSE (deg)']:.2f}°)")
+        both.append(b[fidelity.SLIP_COLUMN] <= fidelity.SLIP_V < a[fidelity.SLIP_COLUMN]
+                    and b["worst angle RMSE (deg)"] < a["worst angle RMSE (deg)"])
+    if not parts:
+        return []
+    return [f"On thigh and shank ×{fidelity.LEG_SCALE:g} with Ch 4's (c) identified on them (a probe, Ch 4 and the "
+            f"Ch 5 ablation) the book-weights Ch 5 solutions' feet slide: {'; '.join(parts)}"
+            + (f" — in every run the feet stop sliding (below v_tr = {fidelity.SLIP_V:g} m/s) and the worst angle falls "
+               "together, once the model's legs fit the data's stride and its contact is identified on them."
+               if both and all(both) else ".")]
+
+
 def slip_lines(table: pd.DataFrame) -> list[str]:
     """Sentences on :func:`slip_table`: how many of the card's gait solutions (and rows) slide
     faster than v_tr on average, the range, and how many rows would change verdict if foot
