@@ -433,14 +433,17 @@ def optimal_control_multistart(spec: gait_ocp.GaitSpec | None = None, starts=B_S
 
 
 def starts_table(runs: dict[str, ApproachResult]) -> pd.DataFrame:
-    """One row per start of (b): status, converged, valid (:func:`gaitlib.validity.check`),
-    iterations (all stages), objective, the Eq 4.5 part, the force-weighted foot slip (m/s,
+    """One row per start of (b): status, converged, valid (:func:`gaitlib.validity.check`) —
+    of the final stage — and how many of the continuation's stages converged, iterations (all stages), objective, the Eq 4.5 part, the force-weighted foot slip (m/s,
     :func:`gaitlib.studies.gait.foot_slip`), the deepest sink (mm,
     :func:`gaitlib.studies.gait.foot_sink`), each ellipsoid's k_v (N/m³)."""
     rows = {}
     for name, r in runs.items():
         g = validity.check(r.solution)
+        stg = r.stages if isinstance(r.stages, pd.DataFrame) and len(r.stages) else None
         row = {"status": r.stats["status"], "converged": bool(r.success), "valid": bool(g.passed), "gates": g.label(),
+               "stages converged": (f"{int(stg['status'].isin(validity.CONVERGED_STATUSES).sum())} of {len(stg)}"
+                                    if stg is not None else ""),
                "iterations": r.stats["iterations"], "objective": r.stats["objective"], "Eq 4.5 part": r.stats["eq4_5"],
                gait_study.SLIP_COLUMN: gait_study.foot_slip(r.solution)["slip"],
                "deepest sink (mm)": 1e3 * gait_study.foot_sink(r.q, r.p_contact, _model_of(r))}
