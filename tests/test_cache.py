@@ -191,3 +191,19 @@ def test_cache_verify_command_lists_and_removes_bad_entries(tmp_path, capsys):
     assert "corrupt: " + str(tmp_path / "gait" / "bad") in capsys.readouterr().out
     assert cli.main(["cache", "verify", "--root", str(tmp_path), "--remove"]) == 0
     assert sorted(p.name for p in (tmp_path / "gait").iterdir()) == ["good"]
+
+
+def test_context_curves_are_not_part_of_any_key(data_copy):
+    """data/context/ holds curves no solve reads (data.CONTEXT_FILES): adding or editing one
+    leaves every key as it was; the same file at the top of data/ changes them."""
+    spec = {"kind": "test", "x": 2}
+    keys = (cache.key(spec, F, identified=()), cache.key(spec, F))
+    ctx = data_copy / data_mod.CONTEXT
+    ctx.mkdir(exist_ok=True)
+    (ctx / "new_context.csv").write_text("source,speed_class\n")
+    for name in data_mod.CONTEXT_FILES:
+        f = data_copy / name
+        f.write_bytes(f.read_bytes() + b"\n")
+    assert (cache.key(spec, F, identified=()), cache.key(spec, F)) == keys
+    (data_copy / "new_context.csv").write_text("source,speed_class\n")
+    assert cache.key(spec, F, identified=()) != keys[0]

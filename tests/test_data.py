@@ -32,7 +32,7 @@ def schwartz_book(archives):
 def test_regenerated_csvs_equal_committed(tmp_path, archives):
     """Rebuilding data/ from the pinned archives gives byte-identical CSVs."""
     paths = data.build(tmp_path)
-    for name in data.OUTPUT_FILES:
+    for name in {**data.OUTPUT_FILES, **data.CONTEXT_FILES}:
         assert (tmp_path / name).read_bytes() == (DATA / name).read_bytes(), name
     assert (tmp_path / "NOTICE.md").read_text() == (DATA / "NOTICE.md").read_text()
     assert set(paths) >= set(data.OUTPUT_FILES)

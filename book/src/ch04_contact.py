@@ -324,6 +324,18 @@ for k, t in leg_slip.items():
 display(Markdown("\n".join(f"- {x}" for x in ci.leg_scale_findings(leg_slip))))
 
 # %% [markdown]
+# Is the missing length a 3-D motion the 2-D model lacks? The pelvis turns about the vertical
+# in walking (Schwartz 2008's pelvic rotation, kept in `data/context/`, which no solve reads),
+# so a 3-D step is longer than the legs' sagittal sweep by what the stance hip moves back
+# relative to the pelvis's centre. The same reference (ours, thesis's legs) with each hip
+# moving by ±(w/2)·sin θ(t) for hip joint centres w apart — the rotation added, no solve:
+
+# %%
+pelvis_tab, pelvis_w0 = gait.pelvic_rotation_slip(replace(ci.spec_c(), contact_params="ch4"))
+display(pelvis_tab)
+display(Markdown(ci.pelvic_rotation_findings(pelvis_tab, pelvis_w0, data.context_curve("pelvis_rotation", "Free"))))
+
+# %% [markdown]
 # Does the identification still put the ball at Table 4.7's lowest friction when the
 # reference's feet slide less? (b) and (c) identified again on the legs × 1.1, everything
 # else as the book's — (b) by the same multistart and continuation, (c) warm-started from

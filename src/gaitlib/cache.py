@@ -134,6 +134,8 @@ def _data_digest(identified: tuple | None) -> str:
                 continue
             if rel.parts[0] == IDENTIFIED and identified is not None:
                 continue  # only the named sets, below
+            if rel.parts[0] == data.CONTEXT:
+                continue  # curves no solve reads (data.CONTEXT_FILES)
             files.append((f"data/{rel.as_posix()}", f))
     for name, f in files:
         h.update(name.encode())

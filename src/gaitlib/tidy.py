@@ -24,6 +24,7 @@ TIDY_COLUMNS = ("source", "speed_class", "quantity", "side", "percent_cycle", "m
 QUANTITY_UNITS = {
     "trunk_anterior_tilt": "deg",
     "pelvis_anterior_tilt": "deg",
+    "pelvis_rotation": "deg",
     "hip_flexion": "deg",
     "knee_flexion": "deg",
     "ankle_dorsiflexion": "deg",

@@ -569,6 +569,10 @@ def _fourier_derivatives(y: np.ndarray, T: float, order: int = 12, n_der: int = 
     return lambda tt: np.vstack([basis(tt, d) @ coef for d in range(n_der + 1)])
 
 
+#: The periodic Fourier fit with analytic time derivatives the references use (public name).
+fourier_derivatives = _fourier_derivatives
+
+
 @dataclass(frozen=True, eq=False)
 class Reference:
     """Data (and derived references) on the model's channels, SI, on a time grid."""

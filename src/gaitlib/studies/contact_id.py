@@ -1260,6 +1260,28 @@ def leg_scale_findings(tables: dict[str, pd.DataFrame]) -> list[str]:
     return out
 
 
+def pelvic_rotation_findings(table: pd.DataFrame, w_zero: float, rotation: pd.DataFrame,
+                             body_height: float = cv.BODY_HEIGHT) -> str:
+    """The sentence on :func:`gaitlib.studies.gait.pelvic_rotation_slip`'s ``(table, w_zero)``
+    (rows: hip-joint-centre separations, m; 0 included): how much of the reference's signed mean
+    slip and of its force-weighted slip the data's pelvic rotation (``rotation``:
+    :func:`gaitlib.data.context_curve` of ``pelvis_rotation``, deg) removes at each width, and
+    the separation it would take to remove the signed mean (× ``body_height``)."""
+    sm, sl = table["signed mean slip (m/s)"], table["reference slip (m/s)"]
+    w = [x for x in table.index if x > 0]
+    pts = ", ".join(f"{x:.2f} m: {sm[x]:+.3f} ({100 * (sm[x] / sm[0.0] - 1):+.0f} %), force-weighted {sl[x]:.3f}" for x in w)
+    th = rotation["mean"]
+    verdict = (f"It would take the hip centres {w_zero:.2f} m apart ({w_zero / body_height:.2f} × the body height) to "
+               "remove the signed mean: the missing pelvic rotation is not what makes the data's stride too long "
+               "for the model's legs." if w_zero > 0.5 * body_height else
+               f"It would take the hip centres {w_zero:.2f} m apart ({w_zero / body_height:.2f} × the body height) to remove "
+               "the signed mean.")
+    return (f"The data's pelvis turns about the vertical between {th.min():+.1f}° and {th.max():+.1f}° (the ipsilateral "
+            "side forward at its foot's contact), which the 2-D model cannot; it moves the stance hip back relative to "
+            f"the pelvis as the body moves on. With it added to the reference's hips (no solve; `gait.pelvic_rotation_slip`), "
+            f"the signed mean slip goes from {sm[0.0]:+.3f} m/s (no rotation) to {pts}. {verdict}")
+
+
 def findings(results: dict[str, ApproachResult], widened: ApproachResult, fit: pd.DataFrame,
              consistency: pd.DataFrame, by_phase: pd.DataFrame) -> list[str]:
     """The chapter's findings, one sentence group per item, every number from the results:

@@ -227,7 +227,23 @@ def foot_sink(q: pd.DataFrame, p_contact, model: ChildModel | None = None) -> fl
     return float(max(0.0, max(-kinematics.ellipsoid_bottoms(m, row, p_contact).min() for row in Q)))
 
 
-def reference_slip(spec: gait_ocp.GaitSpec, v: float = SLIP_V) -> dict:
+def pelvic_hip_velocity(gd: data_mod.GaitData, hip_width: float, speed_class: str = "Free",
+                        source: str = "schwartz2008") -> dict[str, np.ndarray]:
+    """The forward velocity (m/s) each hip gets from the pelvis's rotation about the vertical,
+    which the 2-D model lacks, at the instants ``gd.time``: with the hip joint centres
+    ``hip_width`` (m) apart and the data's pelvic rotation θ(t) (:func:`gaitlib.data.context_curve`,
+    positive = the ipsilateral (right) side forward), the right hip sits (w/2)·sin θ ahead of the
+    pelvis's centre and the left one as far behind, so their velocities are ±(w/2)·cos θ·θ̇
+    (a rigid pelvis). θ on the cycle fraction ``gd.time / gd.cycle_time`` (Fourier fit of order
+    12, the reference's own); ``speed_class``: whose rotation (Ch 7's time-scaled data: the tracked class's)."""
+    c = data_mod.context_curve("pelvis_rotation", speed_class, source)
+    T = float(gd.cycle_time)
+    th = gait_ocp.fourier_derivatives(c["mean"].to_numpy(float) * cv.DEG, T, order=12, n_der=1)(np.asarray(gd.time, float))
+    v = 0.5 * float(hip_width) * np.cos(th[0]) * th[1]
+    return {"r": v, "l": -v}
+
+
+def reference_slip(spec: gait_ocp.GaitSpec, v: float = SLIP_V, hip_width: float = 0.0) -> dict:
     """How fast the loaded feet of a spec's tracking reference itself slide: the data the
     spec tracks as its Q term tracks them (:func:`gaitlib.problems.gait.reference`: the data's
     joint angles, the HAT upright, moving at the walking speed, at the height where the
@@ -242,7 +258,11 @@ def reference_slip(spec: gait_ocp.GaitSpec, v: float = SLIP_V) -> dict:
     and the walking speed (``speed``), m/s; ``by_ellipsoid``: the force-weighted slip of each
     ellipsoid kind (toe, ball, heel; both feet), m/s; ``mean_slip``: the force-weighted mean
     of the signed slip (m/s, > 0: the loaded feet move forward — the HAT outruns the legs'
-    sweep, the data's stride is longer than the angles carry the model's legs)."""
+    sweep, the data's stride is longer than the angles carry the model's legs). ``hip_width``
+    (m, ≥ 0): each ellipsoid also moves with its hip's forward velocity from the data's pelvic
+    rotation (:func:`pelvic_hip_velocity`, a 3-D motion the 2-D model lacks; 0: none)."""
+    if not float(hip_width) >= 0.0:
+        raise ValueError(f"hip_width must be a distance ≥ 0 m, got {hip_width!r}")
     m = gait_ocp.spec_model(spec)
     pc = gait_ocp.contact_params_of(spec)
     _, gd = gait_ocp.spec_gait_data(spec)
@@ -251,6 +271,9 @@ def reference_slip(spec: gait_ocp.GaitSpec, v: float = SLIP_V) -> dict:
     q = np.array([der[c][0] for c in cv.COORDS]).T
     qd = np.array([der[c][1] for c in cv.COORDS]).T
     vs = gait_ocp.slip_velocities(m, q, qd, pc)
+    if float(hip_width) > 0.0:
+        hv = pelvic_hip_velocity(gd, hip_width, getattr(spec, "track_class", "") or spec.speed_class, spec.source)
+        vs = vs + np.array([hv[lab.rsplit("_", 1)[1]] for lab in ELLIPSOID_LABELS])
     f_ct = m.function("contact")
     fn = np.clip(np.array([np.asarray(f_ct(q=row, qd=np.zeros(len(cv.COORDS)), p_contact=pc)["fn"]).ravel()
                            for row in q]).T, 0.0, None)
@@ -302,6 +325,33 @@ def leg_scale_slip(spec: gait_ocp.GaitSpec, scales=LEG_SCALES) -> pd.DataFrame:
                      "anchored slip (m/s)": r["anchored_slip"], "signed mean slip (m/s)": r["mean_slip"],
                      f"load sliding > {SLIP_V} m/s (%)": 100 * r["sliding"], "note": ""})
     return pd.DataFrame(rows).set_index("leg scale")
+
+
+#: Hip-joint-centre separations of :func:`pelvic_rotation_slip`, m (0: the 2-D model).
+HIP_WIDTHS = (0.0, 0.10, 0.15, 0.20, 0.30)
+
+
+def pelvic_rotation_slip(spec: gait_ocp.GaitSpec, widths=HIP_WIDTHS) -> tuple[pd.DataFrame, float]:
+    """Whether the pelvis's rotation about the vertical — a 3-D motion the 2-D model lacks,
+    which moves the stance hip back relative to the pelvis's centre while the body moves on —
+    is what the data's stride has beyond the model's legs' sweep: :func:`reference_slip` of
+    ``spec`` with its hips moving with the data's pelvic rotation (:func:`pelvic_hip_velocity`)
+    at each hip-joint-centre separation of ``widths`` (m). No solve. Returns ``(table,
+    w_zero)``: one row per width (force-weighted, signed mean and anchored slip, m/s; share of
+    the load sliding faster than ``SLIP_V``, %), and the separation (m) at which the signed mean
+    slip would vanish — exact, because each slip velocity is linear in the width and the loads
+    are not (``inf`` if the rotation does not move it)."""
+    rows = {}
+    for w in widths:
+        r = reference_slip(spec, hip_width=float(w))
+        rows[float(w)] = {"reference slip (m/s)": r["slip"], "signed mean slip (m/s)": r["mean_slip"],
+                          "anchored slip (m/s)": r["anchored_slip"], f"load sliding > {SLIP_V} m/s (%)": 100 * r["sliding"]}
+    t = pd.DataFrame.from_dict(rows, orient="index")
+    t.index.name = "hip centres apart (m)"
+    m0 = reference_slip(spec)["mean_slip"]
+    m1 = reference_slip(spec, hip_width=1.0)["mean_slip"]
+    w_zero = float(-m0 / (m1 - m0)) if m1 != m0 else float("inf")
+    return t, w_zero
 
 
 def static_support(p_contact, speed_class: str = "Free", model: ChildModel | None = None) -> str | None:
