@@ -73,3 +73,30 @@ def test_pelvic_rotation_sentence_reads_its_table():
     assert "1.00 m apart (0.67 × the body height)" in s and "is not what makes" in s
     s2 = ci.pelvic_rotation_findings(tab, 0.2, rot, body_height=1.5)
     assert "is not what makes" not in s2 and "0.20 m apart (0.13 × the body height)" in s2
+
+
+def test_stride_sweep_is_exact_the_data_converted_with_its_length_stop_sliding(monkeypatch):
+    """Converting the dimensionless speed and cadence with ``conversion_length`` instead of
+    the hip-to-ground length (legs, angles and loads unchanged) gives a reference whose
+    signed mean slip is zero — the relation mean slip = (stride − sweep)/T is exact."""
+    from gaitlib import conventions as cv
+    spec = replace(ci.spec_c(), contact_params="ch4")
+    d = gait_study.stride_sweep(spec)
+    # stride = v*/f*·L (Schwartz 2008 Free, data/schwartz2008_speed.csv): f* counts steps, two per cycle
+    f_cycle = 0.5647953287 / 2
+    assert d["stride"] == pytest.approx(0.4293883612 / f_cycle * d["leg_length"], rel=1e-9)
+    assert d["sweep"] == pytest.approx(d["stride"] - d["mean_slip"] * d["cycle_time"], rel=1e-12)
+    monkeypatch.setattr(cv, "leg_length", lambda body_height=cv.BODY_HEIGHT, leg_scale=1.0: d["conversion_length"])
+    monkeypatch.setattr(data_mod, "_LOADED", {})
+    r = gait_study.reference_slip(spec)
+    assert abs(r["mean_slip"]) < 1e-9
+    assert r["speed"] * data_mod.load_gait_data("Free").cycle_time == pytest.approx(d["sweep"], rel=1e-9)
+
+
+def test_stride_sweep_sentence():
+    d = {"stride": 1.2, "sweep": 1.08, "ratio": 0.9, "leg_length": 0.77, "conversion_length": 0.693}
+    s = ci.stride_sweep_findings({"ours": d})
+    assert "1.200 m (v*/f*·L with L = 0.770 m" in s and "ours contact set: 1.080 m (90 %)" in s
+    assert "0.693 m" in s and "does not explain" in s
+    s2 = ci.stride_sweep_findings({"ours": {**d, "conversion_length": 0.75}})
+    assert "does not explain" not in s2

@@ -336,6 +336,16 @@ display(pelvis_tab)
 display(Markdown(ci.pelvic_rotation_findings(pelvis_tab, pelvis_w0, data.context_curve("pelvis_rotation", "Free"))))
 
 # %% [markdown]
+# Or is it the length the book converts the data's dimensionless speed and cadence with?
+# The reference's stride is v*/f*·L; the distance the data's angles carry the loaded feet
+# does not depend on L, so the mean slip gives the L at which the two agree, per contact set:
+
+# %%
+display(Markdown(ci.stride_sweep_findings({k: gait.stride_sweep(replace(ci.spec_c(), contact_params="ch4")
+                                                                if k.startswith("ours") else ci.spec_c())
+                                           for k in ref_slip})))
+
+# %% [markdown]
 # Does the identification still put the ball at Table 4.7's lowest friction when the
 # reference's feet slide less? (b) and (c) identified again on the legs × 1.1, everything
 # else as the book's — (b) by the same multistart and continuation, (c) warm-started from

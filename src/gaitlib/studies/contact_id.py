@@ -1260,6 +1260,26 @@ def leg_scale_findings(tables: dict[str, pd.DataFrame]) -> list[str]:
     return out
 
 
+def stride_sweep_findings(sweeps: dict[str, dict]) -> str:
+    """The sentence on :func:`gaitlib.studies.gait.stride_sweep` of each contact set (label →
+    its dict, the thesis's legs): what share of the data's stride the data's angles carry the
+    model's loaded feet, and the leg length the dimensionless data would have to be converted
+    with for the two to agree, beside the model's hip-to-ground and hip-to-ankle lengths."""
+    d0 = next(iter(sweeps.values()))
+    hip_ankle = (0.245 + 0.246) * cv.BODY_HEIGHT
+    parts = "; ".join(f"{k} contact set: {d['sweep']:.3f} m ({100 * d['ratio']:.0f} %), agreeing at a conversion length of "
+                      f"{d['conversion_length']:.3f} m" for k, d in sweeps.items())
+    longest = max(d["conversion_length"] for d in sweeps.values())
+    return (f"Per cycle the data's stride is {d0['stride']:.3f} m (v*/f*·L with L = {d0['leg_length']:.3f} m, the model's "
+            f"hip-to-ground length). The data's angles carry the model's loaded feet (force-weighted; exact: the mean "
+            f"slip is (stride − sweep)/T; `gait.stride_sweep`): {parts}. "
+            + (f"Every one is shorter than the model's hip-to-ankle length ({hip_ankle:.3f} m), the shortest of the "
+               "usual leg-length definitions (hip, trochanter or ASIS to the ankle or the floor): the normalising "
+               "length does not explain the difference."
+               if longest < hip_ankle else
+               f"The model's hip-to-ankle length is {hip_ankle:.3f} m."))
+
+
 def pelvic_rotation_findings(table: pd.DataFrame, w_zero: float, rotation: pd.DataFrame,
                              body_height: float = cv.BODY_HEIGHT) -> str:
     """The sentence on :func:`gaitlib.studies.gait.pelvic_rotation_slip`'s ``(table, w_zero)``

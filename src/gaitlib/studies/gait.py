@@ -354,6 +354,26 @@ def pelvic_rotation_slip(spec: gait_ocp.GaitSpec, widths=HIP_WIDTHS) -> tuple[pd
     return t, w_zero
 
 
+def stride_sweep(spec: gait_ocp.GaitSpec) -> dict:
+    """How much of the data's stride the data's angles carry the model's legs, from
+    :func:`reference_slip` (no solve). Every slip velocity of the reference is (D + c(τ))/T on
+    the normalised cycle τ: D the stride the data's dimensionless speed and cadence give
+    (v*/f*·L, m), T the cycle time (s), c fixed by the angles, the legs and the feet. So the
+    force-weighted mean slip m gives the legs' force-weighted sweep per cycle exactly,
+    ``sweep = D − m·T`` (m), and the conversion length at which the data's stride equals it,
+    ``L · sweep / D`` (m: the leg length Schwartz's normalisation would have to have used for
+    this model's legs). Returns ``stride``, ``sweep``, ``ratio`` (sweep / stride), ``cycle_time``,
+    ``mean_slip``, ``leg_length`` (the book's conversion length, hip to ground) and
+    ``conversion_length``."""
+    r = reference_slip(spec)
+    _, gd = gait_ocp.spec_gait_data(spec)
+    T, D = float(gd.cycle_time), float(gd.speed) * float(gd.cycle_time)
+    sweep = D - r["mean_slip"] * T
+    L = cv.leg_length(cv.BODY_HEIGHT, 1.0 if getattr(spec, "leg_scale", None) is None else float(spec.leg_scale))
+    return {"stride": D, "sweep": sweep, "ratio": sweep / D, "cycle_time": T, "mean_slip": r["mean_slip"],
+            "leg_length": L, "conversion_length": L * sweep / D}
+
+
 def static_support(p_contact, speed_class: str = "Free", model: ChildModel | None = None) -> str | None:
     """Whether a contact set (39,) carries the data's vertical load at rest in the data's
     poses, as the tracking reference's HAT height needs (:func:`gaitlib.kinematics.
