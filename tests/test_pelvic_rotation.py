@@ -100,3 +100,15 @@ def test_stride_sweep_sentence():
     assert "0.693 m" in s and "does not explain" in s
     s2 = ci.stride_sweep_findings({"ours": {**d, "conversion_length": 0.75}})
     assert "does not explain" not in s2
+
+
+def test_card_stride_sentence_reads_the_two_measurements():
+    from gaitlib.studies import card
+    (s,) = card.stride_lines()
+    spec = replace(ci.spec_c(), contact_params="ch4")
+    d = gait_study.stride_sweep(spec)
+    _, w0 = gait_study.pelvic_rotation_slip(spec, widths=(0.0,))
+    assert f"{100 * d['ratio']:.0f} % of the stride" in s and f"{w0:.2f} m apart" in s
+    assert f"{d['conversion_length']:.3f} m" in s
+    # the verdict only when both are out of reach (half the body height apart; shorter than hip to ankle)
+    assert ("neither explains it" in s) == (w0 > 0.5 * 1.47 and d["conversion_length"] < 0.491 * 1.47)

@@ -71,7 +71,7 @@ print("Ch 3 jumps (the thesis's bounds, kept on purpose): " + "; ".join(
 
 # %%
 slips = card.slip_table(c)
-display(Markdown(" ".join(card.slip_lines(slips) + card.legs_slip_lines())))
+display(Markdown(" ".join(card.slip_lines(slips) + card.legs_slip_lines() + card.stride_lines())))
 slips.drop(columns=["rows counted as reproduced"])
 
 # %% [markdown]

@@ -1462,6 +1462,23 @@ def legs_slip_lines() -> list[str]:
                if both and all(both) else ".")]
 
 
+def stride_lines() -> list[str]:
+    """One sentence, no solve (Ch 4): how much of the data's stride the data's angles carry
+    the model's loaded feet with our Ch 4 contact set (:func:`gaitlib.studies.gait.stride_sweep`),
+    and the two 3-D/normalisation readings measured against it — the pelvic rotation the 2-D
+    model lacks (the hip width it would need, :func:`gaitlib.studies.gait.pelvic_rotation_slip`)
+    and the leg length the data would have to be converted with."""
+    spec = replace(ci.spec_c(), contact_params="ch4")
+    d = sg.stride_sweep(spec)
+    _, w0 = sg.pelvic_rotation_slip(spec, widths=(0.0,))
+    hip_ankle = (0.245 + 0.246) * cv.BODY_HEIGHT
+    return [f"Why the data's stride is too long for the model's legs (Ch 4, no solve): the data's angles carry its loaded "
+            f"feet {100 * d['ratio']:.0f} % of the stride; the pelvis's rotation, which the 2-D model lacks, would close "
+            f"the rest only with the hip centres {w0:.2f} m apart, and the dimensionless data only if converted with a "
+            f"leg length of {d['conversion_length']:.3f} m (the model's hip to ankle: {hip_ankle:.3f} m)"
+            + (" — neither explains it." if w0 > 0.5 * cv.BODY_HEIGHT and d["conversion_length"] < hip_ankle else ".")]
+
+
 def slip_lines(table: pd.DataFrame) -> list[str]:
     """Sentences on :func:`slip_table`: how many of the card's gait solutions (and rows) slide
     faster than v_tr on average, the range, and how many rows would change verdict if foot
