@@ -2,6 +2,7 @@
 
     .venv/bin/python benchmarks/bench_build_reuse.py            # Ch 4 (b) at 20 × 5, ≈ 1 h 20 min
     .venv/bin/python benchmarks/bench_build_reuse.py --quick    # 6 × 3, one start, ≈ 7 min
+    .venv/bin/python benchmarks/bench_build_reuse.py --start "thesis (c)"   # 20 × 5, one start (four solves)
 
 Contact identification (b) of Ch 4 (``gaitlib.studies.contact_id.optimal_control_multistart``:
 three starts, each through three continuation stages and the final problem — twelve solves)
@@ -76,11 +77,14 @@ def ci_starts() -> tuple:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="6 × 3 mesh (a check of the script, not the result)")
+    ap.add_argument("--start", action="append", default=None,
+                    help="a start of the multistart (repeatable; default all, or 'thesis (c)' with --quick)")
     ap.add_argument("--stem", default=None)
     args = ap.parse_args(argv)
     n, d = (6, 3) if args.quick else (20, 5)
-    starts = ("thesis (c)",) if args.quick else ci_starts()
-    stem = args.stem or ("build_reuse_quick" if args.quick else "build_reuse")
+    starts = tuple(args.start) if args.start else ("thesis (c)",) if args.quick else ci_starts()
+    one = "" if args.start is None else f"_{len(starts)}start{'s' if len(starts) > 1 else ''}"
+    stem = args.stem or ("build_reuse_quick" if args.quick else "build_reuse") + one
     load = list(os.getloadavg())
     runs = [run(n, d, reuse, starts) for reuse in (False, True)]
     off, on = runs
@@ -89,7 +93,8 @@ def main(argv=None) -> int:
     doc = {"measured": datetime.now(timezone.utc).isoformat(timespec="seconds"), "machine": machine_info(),
            "load_average_start": load,
            "mesh": [n, d], "starts": list(starts), "runs": runs, "identical_solves": f"{sum(same)} of {len(same)}",
-           "command": "python benchmarks/bench_build_reuse.py" + (" --quick" if args.quick else "")}
+           "command": "python benchmarks/bench_build_reuse.py" + (" --quick" if args.quick else "")
+                      + "".join(f' --start "{x}"' for x in (args.start or ()))}
     cols = ["reuse", "solves", "builds", "e2e_s", "build_s", "solve_s", "iterations"]
     table = [{"reuse": "on" if r["reuse"] else "off", "solves": len(r["rows"]),
               "builds": sum(not row["reused"] for row in r["rows"]),

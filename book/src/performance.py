@@ -115,7 +115,7 @@ if build is not None:
 # (b) of Chapter 4 in two fresh processes, without and with reuse:
 
 # %%
-for stem in ("build_reuse", "build_reuse_6x3"):
+for stem in ("build_reuse", "build_reuse_1start", "build_reuse_6x3"):
     reuse = perf.load_optional(stem)
     if reuse is not None:
         print(perf.measured_on(reuse))
