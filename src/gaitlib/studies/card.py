@@ -1378,8 +1378,8 @@ def _skating_cause(cot: pd.DataFrame, res) -> str:
     text = (f"the loaded feet slide at {slip[col].min():.2f}–{slip[col].max():.2f} m/s (force-weighted; the friction "
             f"law sticks below {fidelity.SLIP_V:g} m/s)")
     try:
-        res_f0 = fidelity.consistent_speed_study(friction_floor=fidelity.FRICTION_FLOOR, progress=False)
-        res_f = res_f0.with_reruns(res_f0.rerun_failed(max_iter=3000))
+        _, _, res_f = fidelity.stored_consistent_study("the runs with the friction floor",
+                                                       friction_floor=fidelity.FRICTION_FLOOR)
     except cache.NotCached:
         return text + " — the same problem with friction not stored"
     cot_f = pr.cot_table(res_f)

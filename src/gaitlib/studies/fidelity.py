@@ -25,6 +25,7 @@ import casadi as ca
 import numpy as np
 import pandas as pd
 
+from .. import cache
 from .. import contact as contact_mod
 from .. import conventions as cv
 from .. import data as data_mod
@@ -297,6 +298,8 @@ LEG_ROW = f"thigh and shank ×{LEG_SCALE:g}"
 #: The Ch 5 ablation's row on the longer legs with the contact and body identified on them
 #: (Ch 4 (c), :func:`gaitlib.studies.contact_id.leg_identification`; ``data/identified/ch4_legs.json``).
 LEG_SET_ROW = f"{LEG_ROW} + Ch 4 (c) identified on them"
+#: The :class:`GaitSpec` fields of :data:`LEG_SET_ROW`.
+LEG_SET_CHANGE = {"leg_scale": LEG_SCALE, "contact_params": "ch4_legs", "body_params": "ch4_legs"}
 #: The Ch 5 ablation's row of the same problem with its defects in integral form.
 INTEGRAL_DEFECTS = "defects in integral form (the same NLP)"
 
@@ -346,7 +349,7 @@ def ch5_changes(model: str = "MSK") -> dict[str, dict]:
         FRICTION_ROW: {"friction_floor": FRICTION_FLOOR},
         ci_study.LEFT_SHIFTED_ROW: {"fourier_order": gait_ocp.EXACT_FOURIER_ORDER},
         LEG_ROW: {"leg_scale": LEG_SCALE},
-        LEG_SET_ROW: {"leg_scale": LEG_SCALE, "contact_params": "ch4_legs", "body_params": "ch4_legs"},
+        LEG_SET_ROW: LEG_SET_CHANGE,
         INTEGRAL_DEFECTS: {"defects": "integral"},
     }
 
@@ -854,17 +857,42 @@ def ball_friction(which: str = "default") -> tuple[float, float]:
 FRICTION_FLOOR = gait_study.FRICTION_FLOOR
 
 
-def consistent_speed_study(friction_floor: float | None = None, **kw):
+def consistent_speed_study(friction_floor: float | None = None, legs: bool = False, **kw):
     """Thesis Ch 7's NMSK DT problem at **every** speed class, *Free* included (same cost,
     activation parameters and parameter sets at each speed; Free data scaled in time), with
     the swing foot unloaded (:func:`swing_bound`), warm-started from the swing-unloaded
     Ch 5 NMSK solution (:func:`gaitlib.studies.predictive.speed_study`). ``friction_floor``:
     every ellipsoid's friction coefficients at least this (:attr:`GaitSpec.friction_floor`,
-    e.g. :data:`FRICTION_FLOOR`), the Ch 5 start solved with the same floor."""
+    e.g. :data:`FRICTION_FLOOR`), the Ch 5 start solved with the same floor. ``legs``: the
+    probe of :data:`LEG_SET_ROW` at every speed — thigh and shank × :data:`LEG_SCALE` with the
+    contact and body set identified on them (``ch4_legs``), the Ch 5 start solved on them too."""
     params = {**pr.default_params(), "swing_load_max": swing_bound()}
     if friction_floor is not None:
         params["friction_floor"] = float(friction_floor)
+    if legs:
+        params.update(LEG_SET_CHANGE)
     return pr.speed_study(models=("NMSK",), classes=cv.SPEED_CLASSES, params=params, **kw)
+
+
+def stored_consistent_study(what: str, **kw):
+    """:func:`consistent_speed_study` (``kw``: its options) read from the store only, with the
+    runs that stopped at the 1000-iteration limit rerun with 3000 from the same start (the
+    chapter's rule). Returns ``(study, reruns, used)``: the study as solved, its reruns
+    (:meth:`StudyResult.rerun_failed`) and the study with the converged, valid reruns standing
+    in. Raises :class:`gaitlib.cache.NotCached` naming ``what`` when a run is not stored."""
+    with cache.only(f"{what} are read from the store (fidelity.consistent_speed_study"
+                    f"({', '.join(f'{k}={v!r}' for k, v in kw.items())}) solves them)"):
+        res0 = consistent_speed_study(progress=False, **kw)
+        inv = res0.rerun_failed(max_iter=3000)
+    return res0, inv, res0.with_reruns(inv)
+
+
+def curve_tables(res) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
+    """The tables of a consistent study's curve: ``(cot, terms, slip)`` — its
+    :func:`~gaitlib.studies.predictive.cot_table`, :func:`cot_terms` and :func:`slip_table`
+    (rows by class)."""
+    cot = pr.cot_table(res)
+    return cot, cot_terms(cot, res.solutions), slip_table({s.spec.speed_class: s for s in res.solutions.values()})
 
 
 def cot_terms(cot: pd.DataFrame, solutions: dict) -> pd.DataFrame:

@@ -509,7 +509,9 @@ def speed_study(models=("MSK", "NMSK"), classes=CH7_CLASSES, *, n_intervals: int
     bases = {m: baseline(m, n_intervals=n_intervals, degree=degree, root=root, source=source, reading=reading,
                          **base_params)
              for m in models}
-    gaits = {c: data_mod.load_gait_data(c, source) for c in classes}
+    # the guess's cycle time and stride: on longer legs the data's speed and cadence give other ones
+    legs = {} if params.get("leg_scale") is None else {"leg_scale": float(params["leg_scale"])}
+    gaits = {c: data_mod.load_gait_data(c, source, **legs) for c in classes}
     specs, guesses = {}, {}
     for m in models:
         sp = ch7_specs(m, bases[m], classes, n_intervals=n_intervals, degree=degree, source=source, reading=reading,
