@@ -160,3 +160,31 @@ def test_the_card_sentence_on_longer_legs_concludes_only_when_every_run_stands_a
     t.loc[fidelity.LEG_SET_ROW, fidelity.SLIP_COLUMN] = 0.15  # still sliding: no conclusion
     (s,) = card.legs_slip_lines()
     assert "stop sliding" not in s and s.endswith(".")
+
+
+def test_legs_curve_sentences_read_their_tables():
+    col = "slip, force-weighted (m/s)"
+    cot_u = pd.DataFrame({"mark": ["", "", ""]}, index=["Slow", "Free", "Fast"])
+    slip_u = pd.DataFrame({col: [0.5, 0.7, 1.2]}, index=cot_u.index)
+    cot_l = pd.DataFrame({"mark": ["", "NOT CONVERGED: x", ""]}, index=cot_u.index)
+    slip_l = pd.DataFrame({col: [0.3, 0.6, 0.05]}, index=cot_u.index)
+    a, b = fidelity.legs_curve_findings(slip_u, cot_u, slip_l, cot_l)
+    assert "2 of 3 runs are converged, valid gaits (Slow, Fast); left out (marked): Free (NOT CONVERGED: x)" in a
+    assert "Slow 0.50 → 0.30 m/s, Fast 1.20 → 0.05 m/s" in b and "in 1 of 2" in b
+    slip_l[col] = 0.05
+    _, b = fidelity.legs_curve_findings(slip_u, cot_u, slip_l, cot_l)
+    assert "below v_tr = 0.1 m/s in every one" in b
+
+
+def test_card_clauses_on_the_stored_legs_curve():
+    """The card's clauses on Ch 7's consistent curve on longer legs read the stored study."""
+    g = card._legs_curve()
+    assert g is not None, "the legs curve is in the store (solutions/)"
+    s = card._legs_clause("cot")
+    assert f"{len(g['ok'])} of {len(g['cot'])} runs converged and valid" in s
+    for c in g["ok"]:
+        assert f"{c} {g['cot'].loc[c, 'COT (J/kg/m)']:.2f}" in s
+    assert f"minimum at {g['at']}" in s and card.CH7_LEGS_HEADING.split(" (")[0].lower().replace(" ", "-") in s
+    assert f"closer in {g['closer']} of {g['n']} cells" in card._legs_clause("cells")
+    # the Free run tracks its own data: its cells are not counted
+    assert g["n"] == 3 * len([c for c in g["ok"] if c != "Free"])

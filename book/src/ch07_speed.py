@@ -310,7 +310,7 @@ if res_l is not None:
     display(pd.concat({"book's legs": slip_u, f"legs ×{fidelity.LEG_SCALE:g} + set": slip_l}, axis=1), cot_l, terms_l)
     pull_l = pr.input_pull(res_l, gaits).drop(index="NMSK Free", level="run", errors="ignore")
     display(pull_l)
-    display(Markdown("\n\n".join(fidelity.cot_curve_findings(
+    display(Markdown("\n\n".join(fidelity.legs_curve_findings(slip_u, cot_u, slip_l, cot_l) + fidelity.cot_curve_findings(
         cot_l, terms_l, name=f"The curve on legs ×{fidelity.LEG_SCALE:g} with the contact identified on them")
         + [f"**Against the class data**, on legs ×{fidelity.LEG_SCALE:g} with the contact identified on them: "
            + x.lstrip("- ") for x in pr.pin_findings(pull_l)])))

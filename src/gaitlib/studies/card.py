@@ -1339,6 +1339,9 @@ def _ch7_pin(bases: dict, runs: dict, c5: dict | None = None, c5_notes: dict | N
                                       + "".join(_rerun_note(c5_notes or {}, k) for k in sorted(c5_notes or {}))
                                       + f": closer in {k5} of {n5} "
                                       f"cells [{_anchor('ch07_speed', 'With our Ch 5 activation parameters')}]") if x)
+    legs = _legs_clause("cells")
+    if legs:
+        cause = "; ".join(x for x in (cause if cause != "unknown" else "", legs) if x)
     valid = _joint({k: gate(s, k) for k, s in nm.items() if s is not None and not marks_mod.failure_label(s)})
     return Row(7, item, "closer", f"{closer} of {n} unmarked cells", "", cause, "Ch 7 NMSK, 4 runs",
                valid or "valid", holds=closer > n / 2)
@@ -1365,9 +1368,56 @@ def _ch7_consistent() -> list[Row]:
     where = _anchor("ch07_speed", "One consistent problem on valid gaits")
     cause = f"{cause} [{where}]" if cause else ""
     skate = _skating_cause(cot, res)
-    cause = "; ".join(x for x in (cause, skate) if x) or "unknown"
+    cause = "; ".join(x for x in (cause, skate, _legs_clause("cot")) if x) or "unknown"
     return [Row(7, item, "U, minimum at natural speed", ours, "", cause,
                 "Ch 7 NMSK DT, swing unloaded", _joint(valid), holds=at == "Free")]
+
+
+#: The Ch 7 page's section of the consistent curve on longer legs (the card links to it).
+CH7_LEGS_HEADING = "On longer legs with the contact identified on them (a probe)"
+
+
+def _legs_curve() -> dict | None:
+    """The consistent curve on legs × :data:`gaitlib.studies.fidelity.LEG_SCALE` with the
+    contact identified on them (Ch 7, :data:`CH7_LEGS_HEADING`), from the store: ``ok`` (the
+    classes of converged, valid runs), ``cot``, ``terms``, ``slip``, ``at`` (the class of the
+    lowest COT among ``ok``, or None), ``closer``/``n`` (:func:`gaitlib.studies.predictive.
+    closer_cells` of its non-Free runs) and ``used`` (the 3000-iteration reruns standing in);
+    None when not stored."""
+    try:
+        _, _, res = fidelity.stored_consistent_study("the runs on longer legs", legs=True)
+    except cache.NotCached:
+        return None
+    cot, terms, slip = fidelity.curve_tables(res)
+    ok = [c for c in cot.index if not cot.loc[c, "mark"]]
+    gaits = {c: data_mod.load_gait_data(c) for c in cv.SPEED_CLASSES}
+    pull = pr.input_pull(res, gaits).drop(index="NMSK Free", level="run", errors="ignore")
+    closer, n = pr.closer_cells(pull)
+    at = cot.loc[ok, "COT (J/kg/m)"].astype(float).idxmin() if ok else None
+    return {"ok": ok, "cot": cot, "terms": terms, "slip": slip, "at": at, "closer": closer, "n": n,
+            "used": tuple(res.rerun_used)}
+
+
+def _legs_clause(what: str) -> str:
+    """The card's clause on the consistent curve on longer legs (:func:`_legs_curve`):
+    ``what="cot"`` its COT points and minimum, ``"cells"`` its cells closer to the class data;
+    empty when not stored."""
+    g = _legs_curve()
+    if g is None:
+        return ""
+    where = _anchor("ch07_speed", CH7_LEGS_HEADING)
+    head = f"on legs ×{fidelity.LEG_SCALE:g} with the contact identified on them (a probe"
+    if not g["ok"]:
+        return f"{head}) no run is a converged, valid gait [{where}]"
+    used = (f", {', '.join(g['used'])} through {'its 3000-iteration rerun' if len(g['used']) == 1 else 'their 3000-iteration reruns'}"
+            if g["used"] else "")
+    col = "slip, force-weighted (m/s)"
+    if what == "cells":
+        return f"{head}; {len(g['ok'])} of {len(g['cot'])} runs converged and valid{used}): closer in {g['closer']} of {g['n']} cells [{where}]"
+    cot = g["cot"]
+    return (f"{head}; {len(g['ok'])} of {len(cot)} runs converged and valid{used}, feet sliding "
+            f"{g['slip'].loc[g['ok'], col].min():.2f}–{g['slip'].loc[g['ok'], col].max():.2f} m/s): "
+            + ", ".join(f"{c} {cot.loc[c, 'COT (J/kg/m)']:.2f}" for c in g["ok"]) + f", minimum at {g['at']} [{where}]")
 
 
 def _skating_cause(cot: pd.DataFrame, res) -> str:

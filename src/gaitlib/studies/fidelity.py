@@ -895,6 +895,29 @@ def curve_tables(res) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
     return cot, cot_terms(cot, res.solutions), slip_table({s.spec.speed_class: s for s in res.solutions.values()})
 
 
+def legs_curve_findings(slip_u: pd.DataFrame, cot_u: pd.DataFrame, slip_l: pd.DataFrame,
+                        cot_l: pd.DataFrame) -> list[str]:
+    """The consistent curve on legs × :data:`LEG_SCALE` with the contact identified on them
+    (``cot_l``, ``slip_l``: :func:`curve_tables` of ``consistent_speed_study(legs=True)``)
+    beside the book's legs (``cot_u``, ``slip_u``): how many runs are converged, valid gaits,
+    and, where both runs of a class are, how fast their loaded feet slide."""
+    col = "slip, force-weighted (m/s)"
+    ok_l = [c for c in cot_l.index if not cot_l.loc[c, "mark"]]
+    both = [c for c in ok_l if c in cot_u.index and not cot_u.loc[c, "mark"]]
+    bad = [f"{c} ({cot_l.loc[c, 'mark']})" for c in cot_l.index if cot_l.loc[c, "mark"]]
+    out = [f"**On legs ×{LEG_SCALE:g} with the contact identified on them** {len(ok_l)} of {len(cot_l)} runs are "
+           f"converged, valid gaits" + (f" ({', '.join(ok_l)})" if ok_l else "")
+           + (f"; left out (marked): {'; '.join(bad)}" if bad else "") + "."]
+    if both:
+        faster = [c for c in both if slip_l.loc[c, col] > SLIP_V]
+        out.append("Where both runs of a class are valid, the loaded feet slide (force-weighted, the book's legs → "
+                   "the probe): " + ", ".join(f"{c} {slip_u.loc[c, col]:.2f} → {slip_l.loc[c, col]:.2f} m/s" for c in both)
+                   + (f" — faster than v_tr = {SLIP_V:g} m/s in {len(faster)} of {len(both)}: the two changes that stop "
+                      "the Ch 5 tracking solutions' feet (Ch 5's ablation) do not stop these." if faster else
+                      f" — below v_tr = {SLIP_V:g} m/s in every one."))
+    return out
+
+
 def cot_terms(cot: pd.DataFrame, solutions: dict) -> pd.DataFrame:
     """COT by term of Eq 5.38 (:func:`gaitlib.studies.msk.cot_breakdown`, the NLP's reading)
     of every unmarked (converged, valid) point of a :func:`gaitlib.studies.predictive.cot_table`,
