@@ -316,6 +316,24 @@ if res_l is not None:
            + x.lstrip("- ") for x in pr.pin_findings(pull_l)])))
 
 # %% [markdown]
+# The same probe with every ellipsoid's friction at least `fidelity.FRICTION_FLOOR` too (the
+# change of "The feet skate" above; **our change**, labelled): longer legs, the contact
+# identified on them, and no skating ball.
+
+# %%
+res_lf = stored_consistent("the runs on longer legs with the friction floor", legs=True,
+                           friction_floor=fidelity.FRICTION_FLOOR)
+if res_lf is not None:
+    cot_lf, terms_lf, slip_lf = fidelity.curve_tables(res_lf)
+    fig = pr.cot_figure(cot_lf, label=f"ours: legs ×{fidelity.LEG_SCALE:g} + set + friction ≥ {fidelity.FRICTION_FLOOR:g}")
+    display(slip_lf, cot_lf, terms_lf)
+    pull_lf = pr.input_pull(res_lf, gaits).drop(index="NMSK Free", level="run", errors="ignore")
+    name_lf = f"legs ×{fidelity.LEG_SCALE:g}, the contact identified on them and friction ≥ {fidelity.FRICTION_FLOOR:g}"
+    display(Markdown("\n\n".join(fidelity.cot_curve_findings(cot_lf, terms_lf, name=f"The curve on {name_lf}")
+                                  + [f"**Against the class data**, on {name_lf}: " + x.lstrip("- ")
+                                     for x in pr.pin_findings(pull_lf)])))
+
+# %% [markdown]
 # ## The predicted NMSK gaits against each class's data (thesis Figs 7.6–7.9)
 
 # %%
