@@ -943,8 +943,12 @@ def cot_figure(cot: pd.DataFrame, ch5_row: str | None = None,
         ax.plot(bad["speed (m/s)"], bad["COT (J/kg/m)"], "x", color=marks.MARK_COLOR, ms=9, mew=2,
                 label=f"{marks.DAGGER} ours, marked (not converged or invalid)")
         for name, r in bad.iterrows():
-            ax.annotate(f"{marks.DAGGER} {r['mark']}", (r["speed (m/s)"], r["COT (J/kg/m)"]), fontsize=6,
-                        color=marks.MARK_COLOR, textcoords="offset points", xytext=(-4, -12), ha="right")
+            # the kind of each mark (its first words; the table beside has the whole mark), kept out of the
+            # layout: a long mark pushed left of the axes collapses a constrained layout
+            kinds = " + ".join(dict.fromkeys(m.split(":")[0].strip() for m in r["mark"].split(";")))
+            ax.annotate(f"{marks.DAGGER} {kinds}", (r["speed (m/s)"], r["COT (J/kg/m)"]), fontsize=6,
+                        color=marks.MARK_COLOR, textcoords="offset points", xytext=(-4, -12),
+                        ha="right").set_in_layout(False)
     if ch5_row and ch5_row in cot.index:
         r5 = cot.loc[ch5_row]
         ax.plot([r5["speed (m/s)"]], [r5["COT (J/kg/m)"]], "D", mfc="none", color="C2", ms=7,
