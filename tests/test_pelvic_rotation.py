@@ -94,7 +94,7 @@ def test_stride_sweep_is_exact_the_data_converted_with_its_length_stop_sliding(m
 
 
 def test_stride_sweep_sentence():
-    d = {"stride": 1.2, "sweep": 1.08, "ratio": 0.9, "leg_length": 0.77, "conversion_length": 0.693}
+    d = {"stride": 1.2, "sweep": 1.08, "ratio": 0.9, "leg_length": 0.77, "conversion_length": 0.693, "hip_to_ankle": 0.7218}
     s = ci.stride_sweep_findings({"ours": d})
     assert "1.200 m (v*/f*·L with L = 0.770 m" in s and "ours contact set: 1.080 m (90 %)" in s
     assert "0.693 m" in s and "does not explain" in s

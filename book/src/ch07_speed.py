@@ -34,7 +34,7 @@
 # %%
 import pandas as pd
 
-from gaitlib import cache, data, plots
+from gaitlib import cache, data, marks, plots
 from gaitlib.studies import fidelity, gait, predictive as pr
 from IPython.display import Markdown, display
 
@@ -307,7 +307,9 @@ res_l = stored_consistent("the runs on longer legs", legs=True)
 if res_l is not None:
     cot_l, terms_l, slip_l = fidelity.curve_tables(res_l)
     fig = pr.cot_figure(cot_l, label=f"ours: one problem, legs ×{fidelity.LEG_SCALE:g} + Ch 4 (c) on them (converged, valid)")
-    display(pd.concat({"book's legs": slip_u, f"legs ×{fidelity.LEG_SCALE:g} + set": slip_l}, axis=1), cot_l, terms_l)
+    display(marks.mark_table(pd.concat({"book's legs": slip_u, f"legs ×{fidelity.LEG_SCALE:g} + set": slip_l}, axis=1),
+                             {c: m for c, m in cot_l["mark"].items() if m}, column=f"mark (legs ×{fidelity.LEG_SCALE:g})"),
+            cot_l, terms_l)
     pull_l = pr.input_pull(res_l, gaits).drop(index="NMSK Free", level="run", errors="ignore")
     display(pull_l)
     display(Markdown("\n\n".join(fidelity.legs_curve_findings(slip_u, cot_u, slip_l, cot_l) + fidelity.cot_curve_findings(
@@ -326,7 +328,7 @@ res_lf = stored_consistent("the runs on longer legs with the friction floor", le
 if res_lf is not None:
     cot_lf, terms_lf, slip_lf = fidelity.curve_tables(res_lf)
     fig = pr.cot_figure(cot_lf, label=f"ours: legs ×{fidelity.LEG_SCALE:g} + set + friction ≥ {fidelity.FRICTION_FLOOR:g}")
-    display(slip_lf, cot_lf, terms_lf)
+    display(marks.mark_table(slip_lf, {c: m for c, m in cot_lf["mark"].items() if m}), cot_lf, terms_lf)
     pull_lf = pr.input_pull(res_lf, gaits).drop(index="NMSK Free", level="run", errors="ignore")
     name_lf = f"legs ×{fidelity.LEG_SCALE:g}, the contact identified on them and friction ≥ {fidelity.FRICTION_FLOOR:g}"
     display(Markdown("\n\n".join(fidelity.cot_curve_findings(cot_lf, terms_lf, name=f"The curve on {name_lf}")

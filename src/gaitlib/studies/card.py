@@ -1521,12 +1521,12 @@ def stride_lines() -> list[str]:
     spec = replace(ci.spec_c(), contact_params="ch4")
     d = sg.stride_sweep(spec)
     _, w0 = sg.pelvic_rotation_slip(spec, widths=(0.0,))
-    hip_ankle = (0.245 + 0.246) * cv.BODY_HEIGHT
+    hip_ankle = d["hip_to_ankle"]
     return [f"Why the data's stride is too long for the model's legs (Ch 4, no solve): the data's angles carry its loaded "
             f"feet {100 * d['ratio']:.0f} % of the stride; the pelvis's rotation, which the 2-D model lacks, would close "
             f"the rest only with the hip centres {w0:.2f} m apart, and the dimensionless data only if converted with a "
             f"leg length of {d['conversion_length']:.3f} m (the model's hip to ankle: {hip_ankle:.3f} m)"
-            + (" — neither explains it." if w0 > 0.5 * cv.BODY_HEIGHT and d["conversion_length"] < hip_ankle else ".")]
+            + (" — neither explains it." if w0 > sg.HIP_WIDTH_OUT_OF_REACH_BH * cv.BODY_HEIGHT and d["conversion_length"] < hip_ankle else ".")]
 
 
 def slip_lines(table: pd.DataFrame) -> list[str]:

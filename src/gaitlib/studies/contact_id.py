@@ -1266,7 +1266,7 @@ def stride_sweep_findings(sweeps: dict[str, dict]) -> str:
     model's loaded feet, and the leg length the dimensionless data would have to be converted
     with for the two to agree, beside the model's hip-to-ground and hip-to-ankle lengths."""
     d0 = next(iter(sweeps.values()))
-    hip_ankle = (0.245 + 0.246) * cv.BODY_HEIGHT
+    hip_ankle = d0["hip_to_ankle"]
     parts = "; ".join(f"{k} contact set: {d['sweep']:.3f} m ({100 * d['ratio']:.0f} %), agreeing at a conversion length of "
                       f"{d['conversion_length']:.3f} m" for k, d in sweeps.items())
     longest = max(d["conversion_length"] for d in sweeps.values())
@@ -1293,7 +1293,7 @@ def pelvic_rotation_findings(table: pd.DataFrame, w_zero: float, rotation: pd.Da
     th = rotation["mean"]
     verdict = (f"It would take the hip centres {w_zero:.2f} m apart ({w_zero / body_height:.2f} × the body height) to "
                "remove the signed mean: the missing pelvic rotation is not what makes the data's stride too long "
-               "for the model's legs." if w_zero > 0.5 * body_height else
+               "for the model's legs." if w_zero > gait_study.HIP_WIDTH_OUT_OF_REACH_BH * body_height else
                f"It would take the hip centres {w_zero:.2f} m apart ({w_zero / body_height:.2f} × the body height) to remove "
                "the signed mean.")
     return (f"The data's pelvis turns about the vertical between {th.min():+.1f}° and {th.max():+.1f}° (the ipsilateral "

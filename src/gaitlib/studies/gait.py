@@ -327,6 +327,9 @@ def leg_scale_slip(spec: gait_ocp.GaitSpec, scales=LEG_SCALES) -> pd.DataFrame:
     return pd.DataFrame(rows).set_index("leg scale")
 
 
+#: A hip-joint-centre separation beyond this × the body height is out of any body's reach
+#: (the verdict of the pelvic-rotation sentences; the pelvis is far narrower than half the height).
+HIP_WIDTH_OUT_OF_REACH_BH = 0.5
 #: Hip-joint-centre separations of :func:`pelvic_rotation_slip`, m (0: the 2-D model).
 HIP_WIDTHS = (0.0, 0.10, 0.15, 0.20, 0.30)
 
@@ -363,15 +366,16 @@ def stride_sweep(spec: gait_ocp.GaitSpec) -> dict:
     ``sweep = D − m·T`` (m), and the conversion length at which the data's stride equals it,
     ``L · sweep / D`` (m: the leg length Schwartz's normalisation would have to have used for
     this model's legs). Returns ``stride``, ``sweep``, ``ratio`` (sweep / stride), ``cycle_time``,
-    ``mean_slip``, ``leg_length`` (the book's conversion length, hip to ground) and
-    ``conversion_length``."""
+    ``mean_slip``, ``leg_length`` (the book's conversion length, hip to ground),
+    ``conversion_length`` and ``hip_to_ankle`` (the model's thigh + shank, m)."""
     r = reference_slip(spec)
     _, gd = gait_ocp.spec_gait_data(spec)
     T, D = float(gd.cycle_time), float(gd.speed) * float(gd.cycle_time)
     sweep = D - r["mean_slip"] * T
     L = cv.leg_length(cv.BODY_HEIGHT, 1.0 if getattr(spec, "leg_scale", None) is None else float(spec.leg_scale))
+    m = gait_ocp.spec_model(spec)
     return {"stride": D, "sweep": sweep, "ratio": sweep / D, "cycle_time": T, "mean_slip": r["mean_slip"],
-            "leg_length": L, "conversion_length": L * sweep / D}
+            "leg_length": L, "conversion_length": L * sweep / D, "hip_to_ankle": m.lengths["thigh"] + m.lengths["shank"]}
 
 
 def static_support(p_contact, speed_class: str = "Free", model: ChildModel | None = None) -> str | None:
