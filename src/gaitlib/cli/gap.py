@@ -49,11 +49,20 @@ def cmd_gap(args) -> int:
     from . import common as cli
     from ..gap import diagnose
     from ..gap import io as gio
+    from ..gap import reference
 
     effects = effect_names(args.effects)
     # the data gates (gaitlib.plausibility) run here, before any problem is built
     ds = gio.read_data(args.data, like=args.like, speed_class=args.speed_class, fill_from=args.fill_from,
                        allow_no_sd=args.allow_no_sd, n_subjects=args.n_subjects)
+    ref = None
+    if args.reference is not None:
+        ref = gio.read_data(args.reference, like=args.like, speed_class=ds.gait.speed_class, fill_from=args.fill_from,
+                            allow_no_sd=args.allow_no_sd, n_subjects=args.reference_n_subjects)
+        try:
+            reference.check_same_grid(ds, ref)
+        except ValueError as e:
+            raise cli.CLIError(str(e)) from None
     base = _base(args, ds.gait.speed_class)
     _spec(base)
     root = cli.check_cache(args.cache, not args.no_cache)
@@ -63,11 +72,11 @@ def cmd_gap(args) -> int:
                     what="the diagnosis's files (diagnosis.json, located.csv, ranking.csv, shrink_*.csv, "
                          "figures)") as o:
         print(f"gaitlib gap: {ds.label} ({ds.base}, {ds.gait.speed_class}, n = {ds.n} from {ds.n_source}); "
-              f"baseline {args.model} {args.cost} {args.intervals} x {args.degree}, objective {args.objective}",
-              flush=True)
+              f"baseline {args.model} {args.cost} {args.intervals} x {args.degree}, objective {args.objective}"
+              + (f"; the change relative to {ref.label} (n = {ref.n})" if ref is not None else ""), flush=True)
         d = diagnose.diagnose(ds, base=base, effects=effects, objective=args.objective, resamples=args.resamples,
                        seed=args.seed, root=root, use_cache=not args.no_cache, serial=args.serial,
-                       n_workers=args.workers, scheduler=args.scheduler, progress=True)
+                       n_workers=args.workers, scheduler=args.scheduler, progress=True, reference=ref)
         d.save(o.tmp, figures=not args.no_figures)
     cols = ["rank", "effect", "n_params", "start", "nests_baseline", "status", "pct_closed", "dAIC", "dBIC",
             "residual_ratio"]
@@ -140,22 +149,24 @@ def cmd_gap_validate(args) -> int:
     from . import common as cli
     from ..gap import validate as V
 
-    sets = V.ALL_SETS if args.set == "all" else tuple(dict.fromkeys(x.strip() for x in args.set.split(",")))
-    bad = [x for x in sets if x not in V.ALL_SETS]
+    known = tuple(x for x in V.ALL_SETS if not (args.relative and x == "model-variant"))
+    sets = known if args.set == "all" else tuple(dict.fromkeys(x.strip() for x in args.set.split(",")))
+    bad = [x for x in sets if x not in known]
     if bad or not sets:
-        raise cli.CLIError(f"--set: unknown set(s) {', '.join(bad) or '(none)'}; known: all, {', '.join(V.ALL_SETS)}")
+        raise cli.CLIError(f"--set: unknown set(s) {', '.join(bad) or '(none)'}; known"
+                           f"{' with --relative' if args.relative else ''}: all, {', '.join(known)}")
     base = _base(args, args.speed)
     _spec(base)
     root = cli.check_cache(args.cache, not args.no_cache)
     out = Path(args.out)
     table = V.draws(sets, args.per_band)
-    print(f"gaitlib gap-validate: {len(table)} manipulated data sets + the unedited one ({', '.join(sets)}; "
+    print(f"gaitlib gap-validate: {len(table)} manipulated data sets + {'a reference' if args.relative else 'the unedited one'} ({', '.join(sets)}; "
           f"method {V.METHOD.hash()}); baseline {args.model} {args.cost} {args.intervals} x {args.degree}", flush=True)
     with cli.Output(out, overwrite=args.overwrite, files=VALIDATE_FILES, last=("validation.json",),
                     what="the validation's files (validation.json, cases.csv, scores.csv, confusion.csv)") as o:
         v = V.run(sets, per_band=args.per_band, speed_class=args.speed, base=base, root=root,
                   use_cache=not args.no_cache, serial=args.serial, n_workers=args.workers, scheduler=args.scheduler,
-                  progress=True)
+                  progress=True, relative=args.relative)
         v.save(o.tmp)
     print(v.scores().to_string(index=False, float_format=lambda x: f"{x:.0f}"))
     print(f"wrote {out / 'validation.json'}")
@@ -187,6 +198,11 @@ def add_parsers(sub) -> None:
                                                      "this data set (e.g. schwartz2008); excluded from the gap")
     g.add_argument("--speed-class", default=None, help="the speed class to diagnose if the CSV has several "
                                                        "(VerySlow|Slow|Free|Fast|VeryFast)")
+    g.add_argument("--reference", default=None,
+                   help="a reference tidy CSV of the same speed class: diagnose the change from it (the baseline's "
+                        "fit of the reference + (data - reference)) instead of the whole gap")
+    g.add_argument("--reference-n-subjects", type=int_at_least(1), default=None,
+                   help="subjects behind the reference's means (as --n-subjects)")
     g.add_argument("--allow-no-sd", action="store_true", help="accept curves whose SD is 0 everywhere: tracked, "
                                                               "but left out of the located gap")
     g.add_argument("--effects", default=None, help=f"comma-separated candidates (default all applicable: "
@@ -220,6 +236,9 @@ def add_parsers(sub) -> None:
     v.add_argument("--out", required=True, help="output directory")
     v.add_argument("--set", default="all", help="all (default) or a comma-separated list of: independent, "
                                                 "out-of-library, model-variant, null")
+    v.add_argument("--relative", action="store_true",
+                   help="diagnose each manipulated data set relative to the unedited data (gaitlib gap --reference), "
+                        "both resampled within their sampling error")
     v.add_argument("--per-band", type=int_at_least(1), default=1, help="draws per manipulation and magnitude band")
     v.add_argument("--speed", default="Free", help="speed class of the real data (default Free)")
     v.add_argument("--serial", action="store_true", help="solve in this process without dask")

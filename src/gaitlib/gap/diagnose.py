@@ -71,6 +71,7 @@ from .. import effects as effects_mod
 from .. import sweep as sweep_mod
 from . import io as gio
 from . import locate
+from . import reference as gref
 from .method import BIC_THRESHOLD, DEFAULT_BASE, EXPLAINED_PCT, METHOD, PROFILE_GRID, RUNNER_UP_MARGIN
 from .noise import smooth_noise
 from .nullstart import null_start_many
@@ -82,7 +83,7 @@ __all__ = ["BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "Fit", "Diagnosis", 
            "candidates", "base_spec", "as_dataset", "baseline_fits", "pick_best", "BASELINE_STARTS",
            "COARSE_MESH", "GRF_SD_FACTOR", "RETRY_MARGIN", "grf_weighted", "candidate_fits", "needs_retry",
            "alternates_of", "lowest_objective", "BaselineFailed", "nesting", "ABOVE_LOCATED", "FIT_STARTS",
-           "with_effects", "contenders_of"]
+           "with_effects", "contenders_of", "relative_fits"]
 
 
 def base_spec(base=None) -> gait_ocp.GaitSpec:
@@ -227,6 +228,7 @@ class Diagnosis:
     skipped: dict
     settings: dict
     solution_located: locate.Located | None = None  # the gap of a given (e.g. thesis) solution
+    reference_fit: object | None = None  # the baseline's fit of the reference data (``reference=``)
 
     def to_dict(self) -> dict:
         def rec(df):
@@ -578,7 +580,8 @@ def needs_retry(n: str, sol, base_sol) -> bool:
 
 
 def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit", root=None, use_cache=True,
-                   alternates: dict | None = None, null_start: bool = True, **sweep_kw) -> dict:
+                   alternates: dict | None = None, null_start: bool = True, warms: dict | None = None,
+                   **sweep_kw) -> dict:
     """Fits of every candidate on every data set: key → {effect: Fit}.
 
     Each candidate is warm-started from ``bases[key]`` (the baseline fit). ``alternates``
@@ -594,7 +597,9 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
     names where it started (:data:`FIT_STARTS`; ``stats["retry_start"]`` too, ``"best"``
     for the first solve, when more than one was tried). A nested candidate whose kept fit
     still :func:`needs_retry` is a failed local search: ``Fit.search = "failed search"``
-    (:func:`assemble` does not rank it)."""
+    (:func:`assemble` does not rank it). ``warms`` (key → {effect: solution}): the first
+    solve of an NLP-identified effect starts from that solution instead of the baseline fit
+    (a change relative to a reference continues each candidate's fit of the reference)."""
     groups = {}
     for n in names:
         e = effects_mod.EFFECTS[n]
@@ -602,7 +607,8 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
             continue
         if e.identify == "nlp":
             spec = with_effects(spec0, ((n, None),))
-            groups[n] = (spec, [(f"{k}|{n}", ds.gait, bases[k]) for k, ds in datasets.items() if bases[k] is not None])
+            groups[n] = (spec, [(f"{k}|{n}", ds.gait, ((warms or {}).get(k) or {}).get(n) or bases[k])
+                                for k, ds in datasets.items() if bases[k] is not None])
         else:
             for m in PROFILE_GRID[n]:
                 spec = with_effects(spec0, ((n, m),))
@@ -730,7 +736,7 @@ def _comparison_fit(name: str, base_sol, ds) -> Fit:
 
 def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None, solution=None, like=None,
              fill_from=None, n_subjects: int | None = None, resamples: int = 200, seed: int = 0, root=None,
-             use_cache: bool = True, **sweep_kw) -> Diagnosis:
+             use_cache: bool = True, reference=None, **sweep_kw) -> Diagnosis:
     """Diagnose the sim-to-real gap of a baseline model on a data set.
 
     Parameters
@@ -750,6 +756,14 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
         does not know unless it has an ``n_subjects`` column).
     resamples, seed : data resampling for the % closed intervals.
     root, use_cache : the solutions cache.
+    reference : a reference data set (CSV, DataSet or GaitData; same speed class and time
+        grid): diagnose the *change* from it instead of the whole gap
+        (:mod:`gaitlib.gap.reference`) — the baseline and every candidate are fitted to the
+        reference as in an absolute diagnosis (every start of :data:`BASELINE_STARTS`, the
+        retries); the data are fitted as their continuation (the baseline from the
+        reference's fit only, each candidate from its own fit of the reference), and each
+        located gap has that model's own residual on the reference subtracted. ``settings["reference"]`` names the reference and
+        its fit; :attr:`Diagnosis.reference_fit` is that fit.
     **sweep_kw : ``scheduler``, ``n_workers``, ``serial``, ``progress`` of :func:`gaitlib.sweep.sweep`.
 
     Raises :class:`BaselineFailed` (with every start's IPOPT status) when no start of the
@@ -757,21 +771,93 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
     """
     ds = as_dataset(data, like, fill_from, n_subjects)
     spec0 = base_spec(base)
-    names, skipped = candidates(spec0, ds.gait, effects)
+    ref_info, ref_fit, ref = None, None, None
+    if reference is not None:
+        ref = as_dataset(reference, like, fill_from)
+        gref.check_same_grid(ds, ref)  # before any solve
     kw = dict(sweep_kw)
     with sweep_mod.local_cluster(kw.pop("n_workers", None), scheduler=kw.pop("scheduler", None),
                                  serial=kw.get("serial", False)) as scheduler:  # one cluster for every sweep
-        b = baseline_fits(spec0, {"data": ds}, warm, objective=objective, root=root, use_cache=use_cache,
-                          detail=True, scheduler=scheduler, **kw)
-        base_sol = b["data"]["best"]
-        if base_sol is None:
-            raise BaselineFailed({st: s.stats["status"] for st, s in b["data"].items()
-                                  if st != "best" and s is not None})
-        fits = candidate_fits(spec0, {"data": ds}, {"data": base_sol}, names, objective=objective, root=root,
-                              use_cache=use_cache, alternates=alternates_of(b), scheduler=scheduler, **kw)["data"]
-    settings = {"objective": objective, "candidates": names, "warm": warm is not None}
-    return assemble(ds, spec0, base_sol, fits, objective=objective, resamples=resamples, seed=seed, skipped=skipped,
-                    settings=settings, solution=solution)
+        if ref is not None:
+            rb = baseline_fits(spec0, {"reference": ref}, warm, objective=objective, root=root, use_cache=use_cache,
+                               detail=True, scheduler=scheduler, **kw)
+            ref_fit = rb["reference"]["best"]
+            if ref_fit is None:
+                raise BaselineFailed({f"reference {st}": s.stats["status"] for st, s in rb["reference"].items()
+                                      if st != "best" and s is not None})
+            ref_info = {"label": ref.label, "n_subjects": ref.n, "signature": ref.signature,
+                        "fit": _stats(ref_fit), "rss_reference": locate.locate(ref_fit, ref).rss,
+                        "data_label": ds.label, "data_n_subjects": ds.n}
+        names, skipped = candidates(spec0, ds.gait, effects)
+        if ref is None:
+            b = baseline_fits(spec0, {"data": ds}, warm, objective=objective, root=root, use_cache=use_cache,
+                              detail=True, scheduler=scheduler, **kw)
+            base_sol = b["data"]["best"]
+            if base_sol is None:
+                raise BaselineFailed({st: s.stats["status"] for st, s in b["data"].items()
+                                      if st != "best" and s is not None})
+            all_fits = candidate_fits(spec0, {"data": ds}, {"data": base_sol}, names, objective=objective, root=root,
+                                      use_cache=use_cache, alternates=alternates_of(b), scheduler=scheduler, **kw)
+        else:
+            names = [n for n in names if n in candidates(spec0, ref.gait, names)[0]]
+            # the reference: every candidate fitted as in an absolute diagnosis (every start) …
+            ref_fits = candidate_fits(spec0, {"reference": ref}, {"reference": ref_fit}, names, objective=objective,
+                                      root=root, use_cache=use_cache, alternates=alternates_of(rb),
+                                      scheduler=scheduler, **kw)["reference"]
+            # … and the data as its continuation: the baseline from the reference's fit only,
+            # each candidate from its own fit of the reference (the same basin, so the fits
+            # differ by the change, not by the local optimum a multistart lands in)
+            b = baseline_fits(spec0, {"data": ds}, ref_fit, objective=objective, root=root, use_cache=use_cache,
+                              detail=True, starts=("warm",), scheduler=scheduler, **kw)
+            base_sol = b["data"]["best"]
+            if base_sol is None:
+                raise BaselineFailed({st: s.stats["status"] for st, s in b["data"].items()
+                                      if st != "best" and s is not None})
+            warms = {"data": {n: f.solution for n, f in ref_fits.items() if f.solution is not None}}
+            all_fits = candidate_fits(spec0, {"data": ds}, {"data": base_sol}, names, objective=objective, root=root,
+                                      use_cache=use_cache, warms=warms, scheduler=scheduler, **kw)
+            all_fits["reference"] = ref_fits
+    fits = all_fits["data"]
+    if ref is not None:
+        ds = gref.relative_data(ds, ref, ref_fit)  # the same data and fits; the gap located relative to R
+        fits = relative_fits(fits, all_fits["reference"], ds, ref, base_sol)
+    settings = {"objective": objective, "candidates": names, "warm": warm is not None, "reference": ref_info}
+    d = assemble(ds, spec0, base_sol, fits, objective=objective, resamples=resamples, seed=seed, skipped=skipped,
+                 settings=settings, solution=solution)
+    d.reference_fit = ref_fit
+    return d
+
+
+def relative_fits(fits: dict, ref_fits: dict, ds: gio.DataSet, ref: gio.DataSet, base_sol) -> dict:
+    """The candidates' fits of the data located relative to the reference, each against its
+    *own* fit of the reference (:mod:`gaitlib.gap.reference`): candidate k's located gap is
+    [F_k(N) − N_k] − [F_k(R) − R_k] (N_k, R_k: the data as k reads them at its parameters on
+    each), so an effect that explains part of the reference's own gap is not credited with it,
+    and an effect whose parameter change is the whole change between R and N closes the gap.
+    A candidate without a fit of the reference is not located (``located=None``, not ranked).
+    Comparison-only effects are searched again on the relative data (on ``base_sol``)."""
+    import dataclasses
+
+    out = {}
+    for n, f in fits.items():
+        fr = ref_fits.get(n)
+        f = dataclasses.replace(f)
+        if fr is None or fr.solution is None:
+            f.located, f.ok = None, False
+            f.status = f"{f.status}; no fit of the reference"
+            out[n] = f
+            continue
+        bg = gref.background(ref, fr.solution, fr.thetas)
+        dk = dataclasses.replace(ds, background=bg)
+        if not effects_mod.EFFECTS[n].resolve:
+            out[n] = _comparison_fit(n, base_sol, dk)
+            continue
+        f.located = locate.locate(f.solution, dk, thetas=f.thetas) if f.solution is not None else None
+        if not fr.ok:
+            f.ok = False
+            f.status = f"{f.status}; reference fit {fr.status}"
+        out[n] = f
+    return out
 
 
 # ``gaitlib.gap.diagnose(...)`` calls :func:`diagnose` even after this submodule was imported

@@ -95,6 +95,10 @@ class DataSet:
     path : the CSV, if read from one.
     n_source : where ``n`` came from: ``"option"``, ``"column"`` or ``"known source <name>"``
         (module docstring).
+    background : None, or (a change relative to a reference, :mod:`gaitlib.gap.reference`)
+        the reference fit's residual S_R − R per channel on the data's time grid (model units,
+        tracked representation), which :func:`gaitlib.gap.locate.locate` adds to these data
+        (after any data-model effect) before standardising; the fits never see it.
     """
 
     gait: object
@@ -105,6 +109,7 @@ class DataSet:
     path: str | None = None
     notes: tuple = field(default_factory=tuple)
     n_source: str = ""
+    background: object | None = None  # DataFrame: a reference fit's residual (gaitlib.gap.reference)
 
     @property
     def signature(self) -> str:

@@ -50,6 +50,7 @@ over the included channels (estimated once, on the baseline's residual).
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -64,7 +65,7 @@ from .io import DataSet, filled_channels
 from ..validity import RESIDUAL_FORCE_FRACTION, RESIDUAL_MOMENT_FRACTION
 
 __all__ = ["PHASES", "PHASE_NAMES", "N_GRID", "phase_edges", "phase_of", "sim_channels", "Located", "locate",
-           "resels", "ALPHA", "SD_FLOOR", "residual_thresholds", "residual_table",
+           "resels", "periodic", "ALPHA", "SD_FLOOR", "residual_thresholds", "residual_table",
            "COM_HEIGHT_FRACTION"]
 
 PHASES = ("LR", "MSt/TSt", "PSw", "ISw", "MSw", "TSw")
@@ -133,7 +134,8 @@ def sim_channels(sol: "gait_ocp.GaitSolution", source: str = "schwartz2008") -> 
     return df
 
 
-def _periodic(tau_src, y, tau):
+def periodic(tau_src, y, tau):
+    """``y`` (one period on ``tau_src`` ⊂ [0, 1)) read at ``tau`` by periodic linear interpolation."""
     ts = np.concatenate([tau_src - 1.0, tau_src, tau_src + 1.0])
     return np.interp(np.mod(tau, 1.0), ts, np.tile(y, 3))
 
@@ -223,19 +225,22 @@ class Located:
                                              else [str(c) for c in self.residuals.loc[self.residuals["over"], "channel"]])}
 
 
-def locate(sim, ds, thetas: dict | None = None, exclude=()) -> Located:
+def locate(sim, ds, thetas: dict | None = None, exclude=(), background=None) -> Located:
     """Locate the gap of a solution (a GaitSolution or its :func:`sim_channels` frame)
     against a data set (:class:`gaitlib.gap.io.DataSet` or GaitData).
 
     ``thetas``: effect → parameter values of the solution's effects, for the data-model
     effects (left-leg shift, EMG timing) that change how the data are read
     (:func:`gaitlib.effects.adjust_data`). ``exclude``: model channels not to count
-    (default: those a DataSet filled from another data set).
+    (default: those a DataSet filled from another data set). ``background`` (default: a
+    DataSet's own): per channel, a curve on the data's time grid added to the data (after
+    the data-model effects) — a reference fit's residual (:mod:`gaitlib.gap.reference`).
     """
     n = 1
     if isinstance(ds, DataSet):
         exclude = set(exclude) | filled_channels(ds)
         n, gait = ds.n, ds.gait
+        background = ds.background if background is None else background
     else:
         gait = ds
     if not isinstance(sim, pd.DataFrame):
@@ -243,6 +248,11 @@ def locate(sim, ds, thetas: dict | None = None, exclude=()) -> Located:
     if thetas:
         gait = effects_mod.adjust_data(gait, thetas)
     view = gait_ocp.tracking_data(gait)
+    if background is not None:
+        mean = view.mean.copy()
+        for c in background.columns:
+            mean[c] = mean[c].to_numpy() + background[c].to_numpy()
+        view = dataclasses.replace(view, mean=mean)
     tau = np.arange(N_GRID) / N_GRID
     t_data = np.asarray(view.time, float) / float(view.cycle_time)
     inc, exc = _channels(view, set(sim.columns), exclude)
@@ -254,7 +264,7 @@ def locate(sim, ds, thetas: dict | None = None, exclude=()) -> Located:
         sd = np.interp(tau, t_data, view.sd[col].to_numpy())
         floor = SD_FLOOR * float(np.sqrt(np.mean(sd**2)))
         sde = np.maximum(sd, floor)
-        s = _periodic(tau_src, sim[col].to_numpy(), tau)
+        s = periodic(tau_src, sim[col].to_numpy(), tau)
         z = (s - m) / sde
         se = sde / np.sqrt(max(n, 1))
         Z = (np.abs(s - m) - sde) / se

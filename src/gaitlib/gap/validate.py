@@ -57,13 +57,16 @@ from .method import BIC_THRESHOLD, METHOD, RUNNER_UP_MARGIN, Method
 from .noise import smooth_noise
 
 __all__ = ["Injection", "INJECTIONS", "SETS", "BANDS", "PLATE_THRESHOLD_BW", "VARIANTS", "VARIANT_SEEDS", "ALL_SETS",
-           "NULL_DRAWS", "draws", "inject", "resample", "run", "Validation", "null_spread", "visibility"]
+           "NULL_DRAWS", "REFERENCE_DRAW", "draws", "inject", "resample", "run", "Validation", "null_spread", "visibility"]
 
 #: Vertical force (body weights) above which a foot counts as on the plate in the AP-bias
 #: manipulation: 10 N for the Schwartz 2008 mean child (41.4 kg), a typical plate threshold.
 PLATE_THRESHOLD_BW = 0.025
 #: Band names, in order.
 BANDS = ("small", "middle", "large")
+#: Name of the reference's draw in the relative validation (its resampling seed comes from
+#: the method's hash and this name).
+REFERENCE_DRAW = "reference"
 
 
 def _rows(df, quantities):
@@ -263,7 +266,10 @@ class Validation:
     manipulated data minus that of its fit of the unedited data, absolute and as % of the
     latter: at most what the right effect can close, so how visible the injection is
     against the real data's own gap; ``rss_added_unrefit``: the same at the unedited data's
-    fit, not re-fitted — what the manipulation adds before the baseline adapts to it),
+    fit, not re-fitted — what the manipulation adds before the baseline adapts to it; in a
+    relative validation, ``settings["relative"]``, the baseline's RSS on the relative data —
+    all of it is the change — as % of the reference's own gap, and the RSS at the
+    reference's fit),
     ``unedited`` (the diagnosis of the unedited data), ``settings`` (method, its hash,
     mesh)."""
 
@@ -337,15 +343,27 @@ def _summary(d: diagnose.Diagnosis, expected: str | None = None) -> dict:
 
 def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_class: str = "Free",
         base: dict | None = None, work_dir=None, resamples: int = 0, progress: bool = False,
-        **diag_kw) -> Validation:
+        relative: bool = False, **diag_kw) -> Validation:
     """Diagnose every draw of :func:`draws` (and the unedited data) with
     :func:`gaitlib.gap.diagnose` — baseline ``base`` (default: the method's), all
     applicable library effects as candidates. The manipulated CSVs are written to
     ``work_dir`` (a temporary folder if None) and read back through
-    :func:`gaitlib.gap.io.read_data`, as ``gaitlib gap --data`` reads a user's file."""
+    :func:`gaitlib.gap.io.read_data`, as ``gaitlib gap --data`` reads a user's file.
+
+    ``relative``: diagnose the *change* from a reference instead (``gaitlib gap --data CSV
+    --reference REF``, :mod:`gaitlib.gap.reference`) — the reference is the unedited data
+    resampled within SD/√n (seed from the method's hash, :data:`REFERENCE_DRAW`), every
+    manipulated data set is resampled too (its own seed), so the change carries the sampling
+    error of two independent groups; a ``null`` draw's right answer is then "unexplained"
+    (nothing changed). The same draws (magnitudes, signs) as the absolute validation. No
+    ``model-variant`` set (a variant's twin has no reference of its own)."""
     import tempfile
 
+    if relative and "model-variant" in sets:
+        raise ValueError("run(relative=True): the model-variant set has no reference data set; "
+                         "run it without relative")
     method = METHOD  # the diagnosis runs with it: the draws are its own
+    h = method.hash()
     base = dict(method.base if base is None else base, speed_class=speed_class)
     table = draws(sets, per_band, method)
     frame = real_frame(speed_class)
@@ -355,12 +373,25 @@ def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_clas
         wd.mkdir(parents=True, exist_ok=True)
         p0 = wd / "unedited.csv"
         frame.to_csv(p0, index=False)
-        d0 = diagnose.diagnose(gio.read_data(p0), base=base, resamples=resamples, **diag_kw)
-        unedited = _summary(d0)
+        n0 = gio.read_data(p0).n
+        ref_ds, d0 = None, None
+        if relative:
+            pr = wd / "reference.csv"
+            ref_seed = _seed(h, REFERENCE_DRAW, 0) % 2**31
+            resample(frame, ref_seed, n0).to_csv(pr, index=False)
+            ref_ds = gio.read_data(pr)
+            unedited = {"named": "unexplained", "reference": "the unedited data resampled within SD/sqrt(n)",
+                        "reference_seed": ref_seed}
+        else:
+            d0 = diagnose.diagnose(gio.read_data(p0), base=base, resamples=resamples, **diag_kw)
+            unedited = _summary(d0)
         for _, c in table.iterrows():
             p = wd / f"{c['case']}.csv"
             if c["set"] == "null":
-                resample(frame, int(c["magnitude"]), gio.read_data(p0).n).to_csv(p, index=False)
+                resample(frame, int(c["magnitude"]), n0).to_csv(p, index=False)
+            elif relative:  # a second group: the manipulated data with their own sampling error
+                resample(inject(frame, c["injection"], c["magnitude"]), _seed(h, c["case"], 1) % 2**31,
+                         n0).to_csv(p, index=False)
             elif c["set"] == "model-variant":
                 fields = dict(base, **VARIANTS[c["injection"]][0])
                 fields.pop("derivatives", None)  # the generating solve on the default path
@@ -369,18 +400,32 @@ def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_clas
             else:
                 inject(frame, c["injection"], c["magnitude"]).to_csv(p, index=False)
             ds = gio.read_data(p)
-            # the gap the manipulation adds at the unedited data's baseline fit (no re-fit)
-            unrefit = locate.locate(d0.baseline, ds).rss - d0.located.rss
-            try:
-                d = diagnose.diagnose(ds, base=base, resamples=resamples, **diag_kw)
-                s = _summary(d, c["expected"])
-                added = s["rss_baseline"] - d0.located.rss
-            except diagnose.BaselineFailed as exc:
-                s = {"named": "baseline failed", "verdict": "baseline failed", "error": str(exc)}
-                added = np.nan
-            row = {**c.to_dict(), "rss_added": added, "added_pct": 100.0 * added / d0.located.rss,
+            if relative:
+                try:
+                    d = diagnose.diagnose(ds, base=base, resamples=resamples, reference=ref_ds, **diag_kw)
+                    s = _summary(d, c["expected"])
+                    # on relative data the whole baseline RSS is the change (+ sampling error),
+                    # as % of the reference's own gap; unrefit: at the reference's fit
+                    added, gap0 = s["rss_baseline"], d.settings["reference"]["rss_reference"]
+                    unrefit = locate.locate(d.reference_fit, d.data).rss
+                except diagnose.BaselineFailed as exc:
+                    s = {"named": "baseline failed", "verdict": "baseline failed", "error": str(exc)}
+                    added, gap0, unrefit = np.nan, np.nan, np.nan
+                unedited.setdefault("rss_reference", gap0)
+            else:
+                # the gap the manipulation adds at the unedited data's baseline fit (no re-fit)
+                unrefit = locate.locate(d0.baseline, ds).rss - d0.located.rss
+                gap0 = d0.located.rss
+                try:
+                    d = diagnose.diagnose(ds, base=base, resamples=resamples, **diag_kw)
+                    s = _summary(d, c["expected"])
+                    added = s["rss_baseline"] - d0.located.rss
+                except diagnose.BaselineFailed as exc:
+                    s = {"named": "baseline failed", "verdict": "baseline failed", "error": str(exc)}
+                    added = np.nan
+            row = {**c.to_dict(), "rss_added": added, "added_pct": 100.0 * added / gap0,
                    "rss_added_unrefit": unrefit, **s}
-            if c["set"] == "null":  # the right answer: the unedited data's own verdict
+            if c["set"] == "null":  # the right answer: the unedited data's own verdict (relative: nothing changed)
                 row["expected"] = unedited["named"]
             row["correct"] = row["named"] in str(row["expected"]).split("|")
             rows.append(row)
@@ -388,7 +433,7 @@ def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_clas
                 print(f"{c['case']}: {c['magnitude']:+g} {c['unit']} -> {row['named']} ({row['verdict']}), "
                       f"expected {c['expected']}", flush=True)
     settings = {"method": method.to_dict(), "method_hash": method.hash(), "base": base, "per_band": per_band,
-                "sets": list(sets), "speed_class": speed_class}
+                "sets": list(sets), "speed_class": speed_class, "relative": bool(relative)}
     return Validation(pd.DataFrame(rows), unedited, settings)
 
 

@@ -1,0 +1,110 @@
+"""Diagnose a change against a reference data set, not a whole gap.
+
+The gap diagnosis (:mod:`gaitlib.gap.diagnose`) asks which unmodelled effect explains the
+model's misfit to *one* data set. On real data that misfit is large and mostly the model's
+own (Schwartz 2008 *Free*: baseline RSS ≈ 650 on n_eff ≈ 270), so a laboratory effect of
+middle size adds a few per cent to it and cannot stand out (Chapter 8's validation). A
+laboratory usually has a second question that does not carry the model's own gap: *what
+changed between two data sets* — this laboratory's children and the normative set, one
+marker protocol and another, before and after a plate recalibration.
+
+Relative data
+-------------
+With R the reference data, N the new data, S_R the baseline model's fit of R and F(·) any
+model's fit of N, the *located* gap is taken against
+
+    N' = N + (S_R − R)
+
+channel by channel on the data's time grid, as the gait problem tracks them (the hip as
+the thigh in the laboratory, :func:`gaitlib.problems.gait.tracking_data`; model units), with
+N's SD — i.e. each residual F − N has the reference fit's own residual S_R − R subtracted.
+Every fit is still a fit of N (the same NLP, data and cache entries as the absolute
+diagnosis); only the located gap, so the RSS, ΔBIC and ranking, is relative. So when
+nothing changed (N = R) the baseline's relative gap is zero; when N is R with an effect
+the library represents exactly (a marker offset c), the effect's fit reads N − c = R and
+gives S_R back, a relative gap of zero again; the model's own misfit to R, which swamps
+a middle-sized laboratory effect in the absolute diagnosis, cancels. A data-model effect
+(offset, plate bias, left-leg shift) adjusts N before the background is added, as it
+would the data alone. The sampling error of a difference of two independent group means
+of n_N and n_R subjects is SD·√(1/n_N + 1/n_R), so N' has
+``n = round(1 / (1/n_N + 1/n_R))`` subjects.
+
+Assumptions, stated: the model's own misfit S_R − R does not change with the effect (first
+order: an effect that changes the gait changes the misfit too); both data sets have the same
+time grid, cycle time and speed (a change of cadence is not a curve offset: refused with a
+one-line error). Channels the reference fit does not simulate (EMG for SK) get no background.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pandas as pd
+
+from .. import effects as effects_mod
+from ..problems import gait as gait_ocp
+from . import io as gio
+from . import locate
+
+__all__ = ["relative_data", "relative_n", "check_same_grid", "offset_channels", "background"]
+
+
+def relative_n(n_new: int, n_ref: int) -> int:
+    """Subjects of a difference of two independent group means (its SE is SD/√n)."""
+    if n_new < 1 or n_ref < 1:
+        raise ValueError(f"relative_n: subjects must be >= 1, got {n_new} and {n_ref}")
+    return max(1, int(round(1.0 / (1.0 / n_new + 1.0 / n_ref))))
+
+
+def check_same_grid(ds: gio.DataSet, ref: gio.DataSet) -> None:
+    """ValueError (one line, naming both data sets) unless ``ds`` and ``ref`` share the time
+    grid, cycle time and speed."""
+    g, g0 = ds.gait, ref.gait
+    what = None
+    if abs(float(g.cycle_time) - float(g0.cycle_time)) > 1e-9:
+        what = f"cycle time {g.cycle_time:.4f} s vs {g0.cycle_time:.4f} s"
+    elif abs(float(g.speed) - float(g0.speed)) > 1e-9:
+        what = f"speed {g.speed:.4f} m/s vs {g0.speed:.4f} m/s"
+    elif len(g.time) != len(g0.time) or not np.allclose(g.time, g0.time, atol=1e-9):
+        what = f"time grids of {len(g.time)} and {len(g0.time)} points differ"
+    if what:
+        raise ValueError(f"reference: {ds.label} and {ref.label} differ in {what}; a change relative to a reference "
+                         "needs the same speed class and time grid")
+
+
+def offset_channels(gait, sim) -> list:
+    """The channels N' replaces: those the fit tracks or locates (angles, net torques, GRFs,
+    EMG) that both the data and the reference fit have."""
+    cols = [j for j in gait_ocp.LEG_JOINTS] + [f"tau_{j}" for j in gait_ocp.LEG_JOINTS] + list(gait_ocp.GRF_CHANNELS)
+    cols += sorted(c for c in sim.columns if c.startswith("emg_"))
+    return [c for c in cols if c in gait.mean.columns and c in sim.columns]
+
+
+def background(ref: gio.DataSet, ref_fit, thetas: dict | None = None):
+    """S_R − R (module docstring) on the reference's time grid, one column per
+    :func:`offset_channels` (model units, the tracked representation); ``thetas``: the
+    fit's effect parameters, for the data-model effects that change how R is read
+    (:func:`gaitlib.effects.adjust_data`)."""
+    sim = ref_fit if hasattr(ref_fit, "columns") else locate.sim_channels(ref_fit, ref.gait.source)
+    g0 = effects_mod.adjust_data(ref.gait, thetas) if thetas else ref.gait
+    view0 = gait_ocp.tracking_data(g0)
+    t = np.asarray(view0.time, float) / float(view0.cycle_time)
+    tau_src = sim.index.to_numpy(float)
+    cols = offset_channels(ref.gait, sim)
+    return pd.DataFrame({c: locate.periodic(tau_src, sim[c].to_numpy(), t) - view0.mean[c].to_numpy() for c in cols},
+                        index=view0.mean.index)
+
+
+def relative_data(ds: gio.DataSet, ref: gio.DataSet, ref_fit) -> gio.DataSet:
+    """``ds`` (N) located relative to ``ref`` (R): the same data and fits, with the background
+    S_R − R (:func:`background`; ``ref_fit``, the baseline's fit of R: a GaitSolution or its
+    :func:`gaitlib.gap.locate.sim_channels` frame) that :func:`gaitlib.gap.locate.locate` adds
+    to the data it locates against."""
+    check_same_grid(ds, ref)
+    bg = background(ref, ref_fit)
+    note = (f"located relative to {ref.label}: {bg.shape[1]} channels carry the reference fit's residual "
+            f"(N' = N + S_R - R, gaitlib.gap.reference)")
+    return dataclasses.replace(ds, background=bg, label=f"{ds.label} − {ref.label}", n=relative_n(ds.n, ref.n),
+                               notes=tuple(ds.notes) + (note,),
+                               n_source=f"1/(1/{ds.n} + 1/{ref.n}) (difference of two group means)")

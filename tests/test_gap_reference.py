@@ -1,0 +1,121 @@
+"""A change relative to a reference data set (gaitlib.gap.reference): N' = S_R + (N − R),
+checked by hand on a synthetic reference fit, and the refusals before any solve."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from gaitlib import conventions as cv
+from gaitlib.gap import diagnose as D
+from gaitlib.gap import io as gio
+from gaitlib.gap import locate as L
+from gaitlib.gap import reference as R
+from gaitlib.gap import validate as V
+from gaitlib.problems import gait as gait_ocp
+
+
+@pytest.fixture(scope="module")
+def frame():
+    return V.real_frame("Free")
+
+
+def _ds(tmp_path, df, name):
+    p = tmp_path / f"{name}.csv"
+    df.to_csv(p, index=False)
+    return gio.read_data(p)
+
+
+@pytest.fixture(scope="module")
+def ref(frame, tmp_path_factory):
+    return _ds(tmp_path_factory.mktemp("r"), frame, "reference")
+
+
+def _fake_fit(columns, n=40):
+    """A reference 'fit' as a sim_channels frame: smooth periodic curves on τ = k/n, one per
+    channel (distinct amplitudes and phases), plus a pelvic tilt and a residual column."""
+    tau = np.arange(n) / n
+    out = {c: (1.0 + 0.1 * i) * np.sin(2 * np.pi * (tau + 0.07 * i)) for i, c in enumerate(columns)}
+    out["pelvis_tilt"] = np.full(n, 0.2)
+    out["res_R_x"] = np.zeros(n)
+    return pd.DataFrame(out, index=pd.Index(tau, name="tau"))
+
+
+CHANNELS = list(gait_ocp.LEG_JOINTS) + [f"tau_{j}" for j in gait_ocp.LEG_JOINTS] + list(gait_ocp.GRF_CHANNELS)
+
+
+def _at(sim, c, t):
+    ts = sim.index.to_numpy(float)
+    return np.interp(t, np.concatenate([ts - 1, ts, ts + 1]), np.tile(sim[c].to_numpy(), 3))
+
+
+def test_the_reference_fit_has_no_gap_relative_to_its_own_data(ref):
+    """N = R: the located gap of S_R against N' = R + (S_R − R) is zero on every channel the
+    fit simulates; the fits' data (N) are untouched."""
+    sim = _fake_fit(CHANNELS)
+    rel = R.relative_data(ref, ref, sim)
+    assert rel.gait is ref.gait and rel.background is not None
+    loc = L.locate(sim, rel)
+    assert set(loc.channels["name"]) >= {"hip_r", "knee_l", "ankle_r", "grf_y_l"}
+    assert np.allclose(loc.points["z"], 0.0, atol=1e-9)
+    assert L.locate(sim, ref).rss > 1.0  # without the background: the fake fit's misfit
+    assert R.offset_channels(ref.gait, sim) == CHANNELS
+
+
+def test_background_is_the_fits_residual_by_hand(ref):
+    """S_R − R on the data grid: the hip as the thigh in the laboratory (data hip + pelvic
+    tilt), the rest as the data."""
+    sim = _fake_fit(CHANNELS)
+    bg = R.background(ref, sim)
+    t = np.asarray(ref.gait.time, float) / float(ref.gait.cycle_time)
+    m = ref.gait.mean
+    assert np.allclose(bg["hip_r"], _at(sim, "hip_r", t) - (m["hip_r"] + m["pelvis_tilt"]), atol=1e-12)
+    assert np.allclose(bg["tau_knee_l"], _at(sim, "tau_knee_l", t) - m["tau_knee_l"], atol=1e-12)
+    assert list(bg.index) == list(m.index)
+
+
+def test_a_marker_offset_shows_alone_and_its_effect_closes_it(tmp_path, frame, ref):
+    """A knee offset of +3° on the data's knee (both legs, through the reader): at the
+    reference's fit the relative gap is −c/SD* on the knee and zero elsewhere, and the knee
+    offset effect at c closes it exactly."""
+    sim = _fake_fit(CHANNELS)
+    new = _ds(tmp_path, V.inject(frame, "knee_offset", 3.0), "knee")
+    rel = R.relative_data(new, ref, sim)
+    c = cv.DATA_SIGN["knee"] * math.radians(3.0)
+    pts = L.locate(sim, rel).points
+    knee = pts["channel"].isin(["angle:knee_r", "angle:knee_l"])
+    assert np.allclose(pts.loc[knee, "z"], -c / pts.loc[knee, "sd_eff"], atol=1e-9)
+    assert np.allclose(pts.loc[~knee, "z"], 0.0, atol=1e-9)
+    assert np.allclose(L.locate(sim, rel, thetas={"knee_offset": {"c": c}}).points["z"], 0.0, atol=1e-9)
+
+
+def test_subjects_of_a_difference_of_two_means():
+    # 1/(1/83 + 1/83) = 41.5 → 42 (round half to even); 1/(1/10 + 1/40) = 8
+    assert R.relative_n(83, 83) == 42
+    assert R.relative_n(10, 40) == 8
+    assert R.relative_n(1, 1) == 1
+    with pytest.raises(ValueError, match="subjects"):
+        R.relative_n(0, 5)
+
+
+def test_relative_data_are_labelled_with_both_and_their_subjects(ref):
+    rel = R.relative_data(ref, ref, _fake_fit(CHANNELS))
+    assert rel.n == R.relative_n(ref.n, ref.n)
+    assert ref.label in rel.label and "difference of two group means" in rel.n_source
+    assert any(n.startswith("located relative to") for n in rel.notes)
+
+
+def test_another_speed_class_is_refused_before_any_solve(ref, monkeypatch):
+    slow = gio.load_real("Slow")
+    with pytest.raises(ValueError, match="cycle time"):
+        R.check_same_grid(slow, ref)
+
+    def no_solve(*a, **k):
+        raise AssertionError("a solve was started")
+
+    monkeypatch.setattr(D, "baseline_fits", no_solve)
+    with pytest.raises(ValueError, match="same speed class"):
+        D.diagnose(slow, base=dict(speed_class="Slow", n_intervals=4, degree=2), reference=ref, serial=True)
