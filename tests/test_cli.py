@@ -395,3 +395,37 @@ def test_run_gait_defects_reach_the_spec_and_keep_the_default_key(flag, want, ca
     assert spec.defects == want
     if want is None:  # the default form is the unset option: the stored solutions' keys
         assert "defects" not in spec.to_dict()
+
+
+def test_gap_reference_of_another_speed_class_is_refused_before_any_solve(capsys, monkeypatch, tmp_path):
+    """``gaitlib gap --reference``: a reference without the data's speed class is one line
+    naming the reference and the class, exit 2, nothing solved or written (another time grid:
+    :func:`gaitlib.gap.reference.check_same_grid`, tests/test_gap_reference.py); a matching
+    one reaches the diagnosis."""
+    from gaitlib.gap import validate as V
+
+    frame = V.real_frame("Free")
+    free, slow = tmp_path / "free.csv", tmp_path / "slow.csv"
+    frame.to_csv(free, index=False)
+    V.real_frame("Slow").to_csv(slow, index=False)
+    seen = []
+    monkeypatch.setattr(D, "diagnose", lambda ds, **k: seen.append(k["reference"]) or _fake_diagnosis({}))
+    out = tmp_path / "out"
+    rc, _, err = _run(["gap", "--data", str(free), "--reference", str(slow), "--out", str(out),
+                       "--cache", str(tmp_path / "c")], capsys)
+    line = _one_line(err, "gap")
+    assert rc == 2 and "slow.csv" in line and "'Free'" in line
+    assert not seen and not out.exists()
+    rc, _, _ = _run(["gap", "--data", str(free), "--reference", str(free), "--out", str(out),
+                     "--cache", str(tmp_path / "c")], capsys)
+    assert rc == 0 and len(seen) == 1 and seen[0].label == "free.csv"
+
+
+def test_gap_validate_relative_has_no_model_variant_set(capsys, monkeypatch, tmp_path):
+    from gaitlib.gap import validate as V
+
+    monkeypatch.setattr(V, "run", lambda *a, **k: pytest.fail("solved despite a bad option"))
+    rc, _, err = _run(["gap-validate", "--relative", "--set", "model-variant", "--out", str(tmp_path / "v"),
+                       "--cache", str(tmp_path / "c")], capsys)
+    assert rc == 2 and "unknown set(s) model-variant" in _one_line(err, "gap-validate") and "--relative" in err
+

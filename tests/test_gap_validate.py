@@ -360,3 +360,38 @@ def test_experiment_lines_are_computed_from_their_results(tmp_path, monkeypatch)
     assert G.stored_experiment("absent.json", "s.py") is None
     with pytest.raises(RuntimeError, match="rerun benchmarks/s.py"):
         G.stored_experiment("x.json", "s.py")
+
+
+def test_relative_lines_count_both_runs_on_the_same_cases():
+    """The relative validation's sentences and side-by-side table count the two made-up runs
+    by hand: the same case names pair the absolute and relative diagnoses."""
+    import pandas as pd
+    from gaitlib.studies import gap as G
+
+    def rows(named):
+        cases = ["knee_offset_middle_0", "plate_gain_large_0", "hip_offset_small_0", "knee_rom_large_0", "null_0",
+                 "null_1"]
+        sets = ["independent", "independent", "independent", "out-of-library", "null", "null"]
+        bands = ["middle", "large", "small", "large", "—", "—"]
+        exp = ["knee_offset", "grf_scale", "hip_offset", "unexplained", "unexplained", "unexplained"]
+        return pd.DataFrame({"set": sets, "injection": [c.rsplit("_", 2)[0] for c in cases], "band": bands,
+                             "magnitude": [-2.5, 0.12, 1.0, 0.2, 7.0, 8.0], "unit": ["deg", "1", "deg", "1", "seed", "seed"],
+                             "case": cases, "expected": exp, "named": named, "verdict": "partial",
+                             "correct": [n == e for n, e in zip(named, exp)], "rank1": named, "rank1_dBIC": -20.0,
+                             "rank1_pct": 30.0, "rank2": None, "rank2_dBIC": float("nan"), "rank2_pct": float("nan"),
+                             "added_pct": [3.0, 5.0, 1.0, 2.0, 0.5, 0.4]})
+
+    absolute = V.Validation(rows(["unexplained", "grf_scale", "unexplained", "left_shift", "x", "y"]), {}, {})
+    rel = V.Validation(rows(["knee_offset", "body_mass", "hip_offset", "unexplained", "unexplained", "friction"]),
+                       {"named": "unexplained"}, {"relative": True})
+    ind, small, ool, nul = G.relative_lines(rel, absolute)
+    assert "middle and large magnitudes 1 of 2 named right (50 %" in ind and "same manipulations: 1 of 2." in ind
+    assert "plate_gain large (+0.12 1) named body_mass" in ind
+    assert small.startswith("Small magnitudes: 1 of 1 named right (0 unexplained)")
+    assert "1 of 1 read \"unexplained\" (100 %" in ool
+    assert "1 of 2 read \"unexplained\" — named: friction (partial)." in nul
+    t = G.relative_cases(rel, absolute)
+    assert list(t["named (absolute)"][:2]) == ["unexplained", "grf_scale"]
+    assert list(t["named (relative)"][:2]) == ["knee_offset", "body_mass"]
+    with pytest.raises(ValueError, match="not a relative one"):
+        G.relative_lines(absolute, rel)

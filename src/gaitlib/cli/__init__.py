@@ -15,12 +15,14 @@ Commands
 ``card --out DIR``   the replication report card: ``card.csv``, one row per thesis headline
                      number with ours, the verdict and the solution's validity (gaitlib.studies.card)
 ``gap --data CSV --out DIR``   sim-to-real gap diagnosis of a tidy data CSV: located gap,
-                     ranking of candidate effects, shrink; ``diagnosis.json`` + figures (gaitlib.gap)
+                     ranking of candidate effects, shrink; ``diagnosis.json`` + figures (gaitlib.gap);
+                     ``--reference REF``: the change from a reference data set (gaitlib.gap.reference)
 ``gap-twin --effect NAME --magnitude X --seed N --out CSV``   a twin data set with a known
                      injected effect, in the tidy format
 ``gap-validate --out DIR``   the gap diagnosis on real data manipulated by known amounts
                      (in-library and out-of-library; gaitlib.gap.validate): ``validation.json``,
-                     ``cases.csv``, ``scores.csv``, ``confusion.csv``
+                     ``cases.csv``, ``scores.csv``, ``confusion.csv``; ``--relative``: each set
+                     diagnosed relative to the unedited data
 ``cache verify [--remove] [--root DIR]``   check every cached solution against its checksums;
                      ``--remove`` deletes the corrupt or incomplete ones (they are re-solved on use)
 

@@ -56,7 +56,8 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "left_leg_flips", "co_contraction_text", "findings",
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
            "VALIDATION_RUNS", "stored_validation", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
-           "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines"]
+           "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines",
+           "relative_cases", "relative_lines"]
 
 #: Baseline of the twin study: SK, data tracking (Eq 4.11), 10 × 3 LGR — the coarse mesh (the full 20 × 5 mesh costs ≈ 10× per solve and the twin study
 #: needs ≈ 170 solves per seed).
@@ -363,6 +364,8 @@ VALIDATION_RUNS = {
     "variants": "gaitlib gap-validate --set model-variant --derivatives nodes --out "
                 "benchmarks/results/gap_validation/variants",
     "null": "gaitlib gap-validate --set null --derivatives nodes --out benchmarks/results/gap_validation/null",
+    "relative": "gaitlib gap-validate --relative --set independent,out-of-library,null --derivatives nodes --out "
+                "benchmarks/results/gap_validation/relative",
 }
 
 
@@ -474,6 +477,68 @@ def validation_lines(v: gval.Validation, target: float = 90.0) -> list[str]:
     out.append(f"The unedited data, diagnosed the same way: {u['named']} ({u['verdict']}); ranked first "
                f"{u.get('rank1')} at ΔBIC {u.get('rank1_dBIC', float('nan')):.1f}, second {u.get('rank2')} at "
                f"{u.get('rank2_dBIC', float('nan')):.1f}. Every injection sits on top of this gap of the real data.")
+    return out
+
+
+def relative_cases(rel: gval.Validation, absolute: gval.Validation) -> pd.DataFrame:
+    """The relative validation's cases beside the absolute one's on the same draws (the
+    draws follow the method's hash, so a case name is the same manipulation at the same
+    magnitude): manipulation, band, magnitude, expected, named (absolute), named and verdict
+    (relative), right (relative), the relative run's first two ranked with ΔBIC and % closed,
+    and the change's RSS as % of the reference's own gap (``added_pct``)."""
+    r = validation_cases(rel).assign(case=rel.rows["case"].to_numpy(), added_pct=rel.rows["added_pct"].to_numpy())
+    a = absolute.rows.set_index("case")["named"]
+    r.insert(5, "named (absolute)", r["case"].map(a).fillna("—"))
+    return r.drop(columns=["case"]).rename(columns={"named": "named (relative)", "verdict": "verdict (relative)",
+                                                    "right": "right (relative)",
+                                                    "added_pct": "change RSS (% of the reference's gap)"})
+
+
+def relative_lines(rel: gval.Validation, absolute: gval.Validation, target: float = 90.0) -> list[str]:
+    """The relative validation in words beside the absolute one, every number from the two
+    runs: top-1 on independent injections at middle and large magnitudes, small ones, the
+    out-of-library "unexplained" rate, and the null draws (nothing changed: the right answer
+    is "unexplained")."""
+    if not rel.settings.get("relative"):
+        raise ValueError("relative_lines: the first validation is not a relative one (gap-validate --relative)")
+    r, a = rel.rows, absolute.rows.set_index("case")
+
+    def sel(x, band=None, s="independent"):
+        m = x["set"] == s
+        return x[m & x["band"].isin(band)] if band else x[m]
+
+    out = []
+    ind = sel(r, ["middle", "large"])
+    if len(ind):
+        wrong = ind[~ind["correct"].astype(bool)]
+        same = a.reindex(ind["case"])
+        a_right = int(same["correct"].fillna(False).astype(bool).sum())
+        out.append(f"**Relative to the unedited data: independent injections at middle and large magnitudes "
+                   f"{int(ind['correct'].sum())} of {len(ind)} named right ({100.0 * ind['correct'].mean():.0f} %; "
+                   f"target ≥ {target:g} %)** — the absolute diagnosis of the same manipulations: {a_right} of "
+                   f"{int(same['correct'].notna().sum())}."
+                   + (" Misnamed: " + "; ".join(f"{x} {b} ({m:+.3g} {u}) named {n}" for x, b, m, u, n in
+                                              zip(wrong["injection"], wrong["band"], wrong["magnitude"], wrong["unit"],
+                                                  wrong["named"])) + "." if len(wrong) else ""))
+    small = sel(r, ["small"])
+    if len(small):
+        out.append(f"Small magnitudes: {int(small['correct'].sum())} of {len(small)} named right "
+                   f"({int((small['named'] == 'unexplained').sum())} unexplained).")
+    ool = sel(r, s="out-of-library")
+    if len(ool):
+        named = ool[ool["named"] != "unexplained"]
+        out.append(f"**Out-of-library manipulations: {int((ool['named'] == 'unexplained').sum())} of {len(ool)} read "
+                   f"\"unexplained\" ({100.0 * (ool['named'] == 'unexplained').mean():.0f} %; target ≥ {target:g} %)**"
+                   + ("; a library effect was named for " + "; ".join(
+                       f"{x} {b} ({n}, {vd})" for x, b, n, vd in zip(named["injection"], named["band"], named["named"],
+                                                                      named["verdict"])) + "." if len(named) else "."))
+    nul = sel(r, s="null")
+    if len(nul):
+        fp = nul[nul["named"] != "unexplained"]
+        out.append(f"Nothing changed (the unedited data resampled against the resampled reference): "
+                   f"{len(nul) - len(fp)} of {len(nul)} read \"unexplained\""
+                   + (" — named: " + ", ".join(f"{n} ({vd})" for n, vd in zip(fp["named"], fp["verdict"])) + "."
+                      if len(fp) else "."))
     return out
 
 
