@@ -379,7 +379,7 @@ def test_relative_lines_count_both_runs_on_the_same_cases():
                              "case": cases, "expected": exp, "named": named, "verdict": "partial",
                              "correct": [n == e for n, e in zip(named, exp)], "rank1": named, "rank1_dBIC": -20.0,
                              "rank1_pct": 30.0, "rank2": None, "rank2_dBIC": float("nan"), "rank2_pct": float("nan"),
-                             "added_pct": [3.0, 5.0, 1.0, 2.0, 0.5, 0.4]})
+                             "added_pct": [3.0, 5.0, 1.0, 2.0, 0.5, 0.4], "n_eff": [250.0, 260, 255, 240, 230, 270]})
 
     absolute = V.Validation(rows(["unexplained", "grf_scale", "unexplained", "left_shift", "x", "y"]), {}, {})
     rel = V.Validation(rows(["knee_offset", "body_mass", "hip_offset", "unexplained", "unexplained", "friction"]),
@@ -390,6 +390,7 @@ def test_relative_lines_count_both_runs_on_the_same_cases():
     assert small.startswith("Small magnitudes: 1 of 1 named right (0 unexplained)")
     assert "1 of 1 read \"unexplained\" (100 %" in ool
     assert "1 of 2 read \"unexplained\" — named: friction (partial)." in nul
+    assert "reached ΔBIC -20 to -20 (unexplained, closing 30 %" in nul and "residual, 230–270)" in nul
     t = G.relative_cases(rel, absolute)
     assert list(t["named (absolute)"][:2]) == ["unexplained", "grf_scale"]
     assert list(t["named (relative)"][:2]) == ["knee_offset", "body_mass"]
