@@ -396,3 +396,20 @@ def test_relative_lines_count_both_runs_on_the_same_cases():
     assert list(t["named (relative)"][:2]) == ["knee_offset", "body_mass"]
     with pytest.raises(ValueError, match="not a relative one"):
         G.relative_lines(absolute, rel)
+
+
+@pytest.mark.parametrize("name,m", [("hip_offset", 2.5), ("knee_offset", -3.0), ("ankle_offset", 4.0),
+                                    ("plate_gain", -0.05), ("plate_ap_bias", 0.02)])
+def test_effect_magnitude_undoes_its_manipulation(tmp_path, frame, base_gait, name, m):
+    """The change a relative diagnosis should identify: the effect at effect_magnitude(...)
+    gives the unedited data back (both legs, through the reader)."""
+    g = _read(tmp_path, V.inject(frame, name, m), "x")
+    p, v = V.effect_magnitude(name, m, base_gait)
+    back = effects_mod.adjust_data(g, {V.INJECTIONS[name].expected: {p: v}})
+    assert np.allclose(back.mean.to_numpy(float), base_gait.mean.to_numpy(float), atol=1e-9)
+
+
+def test_effect_magnitude_of_a_load_scale_is_the_mass_change():
+    assert V.effect_magnitude("load_scale", 0.11, None) == ("k", 0.11)
+    with pytest.raises(ValueError, match="not an independent manipulation"):
+        V.effect_magnitude("knee_rom", 0.1, None)

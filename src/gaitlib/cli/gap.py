@@ -79,7 +79,7 @@ def cmd_gap(args) -> int:
                        n_workers=args.workers, scheduler=args.scheduler, progress=True, reference=ref)
         d.save(o.tmp, figures=not args.no_figures)
     cols = ["rank", "effect", "n_params", "start", "nests_baseline", "status", "pct_closed", "dAIC", "dBIC",
-            "residual_ratio"]
+            "residual_ratio"] + (["parameter_change"] if ref is not None else [])
     print(d.ranking[cols].to_string(index=False, float_format=lambda v: f"{v:.2f}"))
     print(json.dumps({"top_effect": d.top_effect, "verdict": d.verdict, "rss_baseline": d.located.rss,
                       "n_eff": d.located.n_eff, "baseline_status": d.baseline.stats["status"]}, indent=1))

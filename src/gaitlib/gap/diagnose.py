@@ -139,6 +139,7 @@ class Fit:
     profile: list = field(default_factory=list)  # [(magnitude, rss, status)]
     start: str = "baseline"  # where the kept fit started (:data:`FIT_STARTS`)
     search: str = "ok"  # "ok" or "failed search" (:func:`candidate_fits`)
+    reference_thetas: dict = field(default_factory=dict)  # its fit of a reference (:func:`relative_fits`)
 
 
 def _status(sol) -> tuple[str, bool]:
@@ -290,7 +291,8 @@ class Diagnosis:
         out.mkdir(parents=True, exist_ok=True)
         (out / "diagnosis.json").write_text(json.dumps(self.to_dict(), indent=1, default=_json_default))
         self.located.table.to_csv(out / "located.csv", index=False, float_format="%.6g")
-        self.ranking.drop(columns=["parameters"]).to_csv(out / "ranking.csv", index=False, float_format="%.6g")
+        dicts = [c for c in ("parameters", "parameters_reference", "parameter_change") if c in self.ranking.columns]
+        self.ranking.drop(columns=dicts).to_csv(out / "ranking.csv", index=False, float_format="%.6g")
         for k, v in self.shrink.items():
             v.to_csv(out / f"shrink_{k}.csv", index=False, float_format="%.6g")
         if figures:
@@ -355,8 +357,12 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
     for name, f in fits.items():
         e = effects_mod.EFFECTS[name]
         nests, _ = nesting(name)
+        th_r = f.reference_thetas.get(name, {})
+        th = f.thetas.get(name, {})
         row = {"effect": name, "title": e.title, "n_params": f.n_params, "identify": f.identify,
-               "parameters": f.thetas.get(name, {}), "status": f.status, "ok": f.ok, "start": f.start,
+               "parameters": th, "parameters_reference": th_r,
+               "parameter_change": {k: float(v) - float(th_r[k]) for k, v in th.items() if k in th_r},
+               "status": f.status, "ok": f.ok, "start": f.start,
                "nests_baseline": nests, "search": f.search, "rss_before": loc0.rss, "rss_after": np.nan,
                "pct_closed": np.nan, "dAIC": np.nan, "dBIC": np.nan, "residual_ratio": np.nan}
         if f.located is not None and f.located.residuals is not None:
@@ -835,6 +841,8 @@ def relative_fits(fits: dict, ref_fits: dict, ds: gio.DataSet, ref: gio.DataSet,
     each), so an effect that explains part of the reference's own gap is not credited with it,
     and an effect whose parameter change is the whole change between R and N closes the gap.
     A candidate without a fit of the reference is not located (``located=None``, not ranked).
+    ``Fit.reference_thetas``: the candidate's parameters on the reference, so the ranking's
+    ``parameter_change`` is the change the candidate identifies between R and N.
     Comparison-only effects are searched again on the relative data (on ``base_sol``)."""
     import dataclasses
 
@@ -850,8 +858,9 @@ def relative_fits(fits: dict, ref_fits: dict, ds: gio.DataSet, ref: gio.DataSet,
         bg = gref.background(ref, fr.solution, fr.thetas)
         dk = dataclasses.replace(ds, background=bg)
         if not effects_mod.EFFECTS[n].resolve:
-            out[n] = _comparison_fit(n, base_sol, dk)
+            out[n] = dataclasses.replace(_comparison_fit(n, base_sol, dk), reference_thetas=fr.thetas)
             continue
+        f.reference_thetas = fr.thetas
         f.located = locate.locate(f.solution, dk, thetas=f.thetas) if f.solution is not None else None
         if not fr.ok:
             f.ok = False

@@ -48,6 +48,7 @@ from typing import Callable
 import numpy as np
 import pandas as pd
 
+from .. import conventions as cv
 from .. import data as data_mod
 from . import diagnose
 from . import io as gio
@@ -57,7 +58,7 @@ from .method import BIC_THRESHOLD, METHOD, RUNNER_UP_MARGIN, Method
 from .noise import smooth_noise
 
 __all__ = ["Injection", "INJECTIONS", "SETS", "BANDS", "PLATE_THRESHOLD_BW", "VARIANTS", "VARIANT_SEEDS", "ALL_SETS",
-           "NULL_DRAWS", "REFERENCE_DRAW", "draws", "inject", "resample", "run", "Validation", "null_spread", "visibility"]
+           "NULL_DRAWS", "REFERENCE_DRAW", "draws", "effect_magnitude", "inject", "resample", "run", "Validation", "null_spread", "visibility"]
 
 #: Vertical force (body weights) above which a foot counts as on the plate in the AP-bias
 #: manipulation: 10 N for the Schwartz 2008 mean child (41.4 kg), a typical plate threshold.
@@ -252,6 +253,24 @@ def resample(frame: pd.DataFrame, seed: int, n: int) -> pd.DataFrame:
     return df
 
 
+def effect_magnitude(name: str, magnitude: float, gait) -> tuple[str, float]:
+    """(parameter, value) of the library effect that undoes independent manipulation
+    ``name`` at ``magnitude`` (its unit), in the effect's units and signs on ``gait`` (the
+    unedited data; tests/test_gap_validate.py checks each against the effect): an angle
+    offset c° → c = DATA_SIGN · c·π/180 rad; a gain → s (plate) or k (load scale, body mass)
+    = m; an AP bias b BW → b · body mass · g · DATA_SIGN (N)."""
+    m = float(magnitude)
+    if name in ("hip_offset", "knee_offset", "ankle_offset"):
+        return "c", cv.DATA_SIGN[name.split("_")[0]] * np.radians(m)
+    if name == "plate_gain":
+        return "s", m
+    if name == "load_scale":
+        return "k", m
+    if name == "plate_ap_bias":
+        return "b", m * float(gait.body_mass) * cv.G * cv.DATA_SIGN.get("grf_x", 1.0)
+    raise ValueError(f"effect_magnitude: {name!r} is not an independent manipulation ({', '.join(SETS['independent'])})")
+
+
 def inject(frame: pd.DataFrame, name: str, magnitude: float) -> pd.DataFrame:
     """``frame`` with manipulation ``name`` at ``magnitude`` (its unit: :attr:`Injection.unit`)."""
     if name not in INJECTIONS:
@@ -338,6 +357,8 @@ def _summary(d: diagnose.Diagnosis, expected: str | None = None) -> dict:
         out.update(expected_effect=str(e.name), expected_rank=(None if pd.isna(e["rank"]) else int(e["rank"])),
                    expected_dBIC=float(e["dBIC"]), expected_pct=float(e["pct_closed"]),
                    expected_parameters=dict(e["parameters"] or {}))
+        if "parameter_change" in e.index and e["parameter_change"]:
+            out["expected_change"] = dict(e["parameter_change"])
     return out
 
 
