@@ -384,7 +384,13 @@ def test_relative_lines_count_both_runs_on_the_same_cases():
     absolute = V.Validation(rows(["unexplained", "grf_scale", "unexplained", "left_shift", "x", "y"]), {}, {})
     rel = V.Validation(rows(["knee_offset", "body_mass", "hip_offset", "unexplained", "unexplained", "friction"]),
                        {"named": "unexplained"}, {"relative": True})
-    ind, small, ool, nul = G.relative_lines(rel, absolute)
+    ind, small, ool, nul = G.relative_lines(rel, absolute)  # no expected_change: no magnitude sentence
+    c_knee = V.effect_magnitude("knee_offset", -2.5, gio.load_real().gait)[1]
+    rel.rows["expected_change"] = [{"c": 1.1 * c_knee}, {"s": 0.9 * 0.12}, {"c": 0.0}, None, None, None]
+    mag = G.relative_lines(rel, absolute)[2]
+    assert mag.endswith("identified / injected 0.90 to 1.10 (median 1.00) over the 2 middle and large injections.")
+    m = G.relative_magnitudes(rel)
+    assert list(m["parameter"]) == ["c", "s", "c"] and m["ratio"].round(6).tolist() == [1.1, 0.9, 0.0]
     assert "middle and large magnitudes 1 of 2 named right (50 %" in ind and "same manipulations: 1 of 2." in ind
     assert "plate_gain large (+0.12 1) named body_mass" in ind
     assert small.startswith("Small magnitudes: 1 of 1 named right (0 unexplained)")

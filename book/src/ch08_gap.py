@@ -430,13 +430,17 @@ display(Markdown("\n\n".join(gap_study.validation_lines(valv)[:-1])))
 # and both data sets share speed class and time grid. Here the reference is the unedited
 # data resampled within SD/√n, every manipulated set is resampled too (two independent
 # groups), the draws are the same as above (same hash), and four *null* draws — the unedited
-# data resampled, nothing changed — must read "unexplained":
+# data resampled, nothing changed — must read "unexplained". The second table gives, for
+# every independent injection, the change the expected effect's fit identified between the
+# reference and the data (`parameter_change` of the ranking) against the change that undoes
+# the manipulation (`gaitlib.gap.validate.effect_magnitude`: rad, model signs; gains; N):
 
 # %%
 valr = gap_study.stored_validation("relative")
 print("written by:", gap_study.VALIDATION_RUNS["relative"])
 display(valr.scores())
 display(gap_study.relative_cases(valr, val))
+display(gap_study.relative_magnitudes(valr).round(4))
 display(Markdown("\n\n".join(gap_study.relative_lines(valr, val))))
 
 # %% [markdown]
