@@ -72,7 +72,7 @@ from .. import sweep as sweep_mod
 from . import io as gio
 from . import locate
 from . import reference as gref
-from .method import BIC_THRESHOLD, DEFAULT_BASE, EXPLAINED_PCT, METHOD, PROFILE_GRID, RUNNER_UP_MARGIN
+from .method import BIC_THRESHOLD, DEFAULT_BASE, EXPLAINED_PCT, METHOD, PROFILE_GRID, RELATIVE, RUNNER_UP_MARGIN
 from .noise import smooth_noise
 from .nullstart import null_start_many
 from .solve import solve_many
@@ -83,7 +83,8 @@ __all__ = ["BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "Fit", "Diagnosis", 
            "candidates", "base_spec", "as_dataset", "baseline_fits", "pick_best", "BASELINE_STARTS",
            "COARSE_MESH", "GRF_SD_FACTOR", "RETRY_MARGIN", "grf_weighted", "candidate_fits", "needs_retry",
            "alternates_of", "lowest_objective", "BaselineFailed", "nesting", "ABOVE_LOCATED", "FIT_STARTS",
-           "with_effects", "contenders_of", "relative_fits"]
+           "with_effects", "contenders_of", "relative_fits",
+           "null_calibration"]
 
 
 def base_spec(base=None) -> gait_ocp.GaitSpec:
@@ -342,7 +343,7 @@ def nesting(name: str) -> tuple[bool, str]:
 
 
 def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", resamples: int = 200, seed: int = 0,
-             top: int = 3, skipped=None, settings=None, solution=None) -> Diagnosis:
+             top: int = 3, skipped=None, settings=None, solution=None, threshold: float | None = None) -> Diagnosis:
     """Rank fitted candidates against the baseline fit and build the :class:`Diagnosis`.
 
     Ranked (``rank`` 1, 2, …, by ΔBIC): candidates with a located fit whose ``search`` is
@@ -350,7 +351,10 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
     search (:func:`candidate_fits`), or a nested candidate whose located gap ends above the
     baseline's (:data:`ABOVE_LOCATED`). So a ranked candidate that nests the baseline
     (``nests_baseline``, :func:`nesting`) closes ≥ −100 :data:`RETRY_MARGIN` % of the RSS;
-    only a non-nesting one can show a negative % closed."""
+    only a non-nesting one can show a negative % closed. ``threshold``: the ΔBIC the top
+    effect must reach (default :data:`BIC_THRESHOLD`; a relative diagnosis's null
+    calibration lowers it)."""
+    thr = BIC_THRESHOLD if threshold is None else float(threshold)
     loc0 = locate.locate(base_sol, ds)
     n_eff = loc0.n_eff
     rows = []
@@ -389,7 +393,7 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
         m = int(ranked.sum())
         rank[:m] = np.arange(1, m + 1)
         ranking.insert(0, "rank", rank)
-    elig = ranking[(ranking["ok"]) & (ranking["dBIC"] <= BIC_THRESHOLD)] if not ranking.empty else ranking
+    elig = ranking[(ranking["ok"]) & (ranking["dBIC"] <= thr)] if not ranking.empty else ranking
     contenders = contenders_of(ranking)
     if len(elig) and len(contenders) <= 1:
         top_effect = str(elig.iloc[0]["effect"])
@@ -417,7 +421,7 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
         ranking["pct_closed_hi"] = ranking["effect"].map(lambda k: intervals.get(k, [np.nan, np.nan])[1])
     sol_loc = locate.locate(solution, ds) if solution is not None else None
     st = dict(settings or {})
-    st.update({"resamples": resamples, "seed": seed, "bic_threshold": BIC_THRESHOLD,
+    st.update({"resamples": resamples, "seed": seed, "bic_threshold": BIC_THRESHOLD, "threshold_used": thr,
                "runner_up_margin": RUNNER_UP_MARGIN, "contenders": contenders if len(elig) else [],
                "method": METHOD.to_dict(), "method_hash": METHOD.hash()})
     return Diagnosis(ds, spec0, objective, base_sol, loc0, fits, ranking, top_effect, verdict, shrink, intervals,
@@ -742,7 +746,7 @@ def _comparison_fit(name: str, base_sol, ds) -> Fit:
 
 def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None, solution=None, like=None,
              fill_from=None, n_subjects: int | None = None, resamples: int = 200, seed: int = 0, root=None,
-             use_cache: bool = True, reference=None, **sweep_kw) -> Diagnosis:
+             use_cache: bool = True, reference=None, calibration: dict | None = None, **sweep_kw) -> Diagnosis:
     """Diagnose the sim-to-real gap of a baseline model on a data set.
 
     Parameters
@@ -768,7 +772,12 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
         reference as in an absolute diagnosis (every start of :data:`BASELINE_STARTS`, the
         retries); the data are fitted as their continuation (the baseline from the
         reference's fit only, each candidate from its own fit of the reference), and each
-        located gap has that model's own residual on the reference subtracted. ``settings["reference"]`` names the reference and
+        located gap has that model's own residual on the reference subtracted; the top
+        effect must also beat every candidate's ΔBIC on the reference's null draws
+        (:func:`null_calibration`, :data:`gaitlib.gap.method.RELATIVE`).
+        ``settings["reference"]["null_calibration"]`` holds them.
+    calibration : a ``null_calibration`` of an earlier diagnosis against the same reference,
+        spec, candidates and subjects (checked), used instead of redoing it. ``settings["reference"]`` names the reference and
         its fit; :attr:`Diagnosis.reference_fit` is that fit.
     **sweep_kw : ``scheduler``, ``n_workers``, ``serial``, ``progress`` of :func:`gaitlib.sweep.sweep`.
 
@@ -823,15 +832,72 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
             all_fits = candidate_fits(spec0, {"data": ds}, {"data": base_sol}, names, objective=objective, root=root,
                                       use_cache=use_cache, warms=warms, scheduler=scheduler, **kw)
             all_fits["reference"] = ref_fits
+            n_rel = gref.relative_n(ds.n, ref.n)
+            if calibration is not None:  # computed before for this reference: checked, not redone
+                want = {"relative_method_hash": RELATIVE.hash(), "reference_signature": ref.signature,
+                        "n_subjects": n_rel, "spec": spec0.to_dict(), "candidates": list(names)}
+                bad = [k for k, v in want.items() if calibration.get(k) != v]
+                if bad:
+                    raise ValueError(f"calibration= was made for another {', '.join(bad)}: not this diagnosis's")
+                calib = calibration
+            else:
+                calib = null_calibration(spec0, ref, ref_fit, ref_fits, names, n_rel, warms, objective=objective,
+                                         root=root, use_cache=use_cache, scheduler=scheduler,
+                                         **kw) if RELATIVE.null_draws > 0 else None
     fits = all_fits["data"]
+    threshold = None
     if ref is not None:
         ds = gref.relative_data(ds, ref, ref_fit)  # the same data and fits; the gap located relative to R
         fits = relative_fits(fits, all_fits["reference"], ds, ref, base_sol)
+        ref_info["relative_method"] = RELATIVE.to_dict()
+        ref_info["relative_method_hash"] = RELATIVE.hash()
+        ref_info["null_calibration"] = calib
+        if calib is not None and calib["lowest_dBIC"] is not None:
+            threshold = min(BIC_THRESHOLD, calib["lowest_dBIC"])
     settings = {"objective": objective, "candidates": names, "warm": warm is not None, "reference": ref_info}
     d = assemble(ds, spec0, base_sol, fits, objective=objective, resamples=resamples, seed=seed, skipped=skipped,
-                 settings=settings, solution=solution)
+                 settings=settings, solution=solution, threshold=threshold)
     d.reference_fit = ref_fit
     return d
+
+
+def null_calibration(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, names, n: int, warms: dict, *,
+                     objective="fit", root=None, use_cache=True, method=None, **sweep_kw) -> dict:
+    """The relative diagnosis's null calibration (:class:`gaitlib.gap.method.RelativeMethod`):
+    the reference redrawn ``method.null_draws`` times within the sampling error of a
+    difference of two group means of ``n`` subjects (:func:`gaitlib.gap.reference.null_draw`),
+    each draw fitted and located relative to the reference exactly as the data are (the
+    baseline from the reference's fit, each candidate from its own fit of the reference),
+    and every ranked candidate's ΔBIC kept. Returns ``{"draws", "seeds", "n_subjects",
+    "best" (per draw: its first-ranked effect and ΔBIC, or its failure), "dBIC" (per draw:
+    effect → ΔBIC), "lowest_dBIC" (over draws and candidates; None if no draw was ranked),
+    "baseline_failed" (draws none of whose baseline fits converged)}``."""
+    method = method or RELATIVE
+    seeds = [gref.null_seed(ref, j, method.hash()) for j in range(method.null_draws)]
+    draws = {f"null{j}": gref.null_draw(ref, n, sd) for j, sd in enumerate(seeds)}
+    kw = dict(objective=objective, root=root, use_cache=use_cache, **sweep_kw)
+    bases = baseline_fits(spec0, draws, ref_fit, starts=("warm",), **kw)
+    ok = {k: v for k, v in draws.items() if bases[k] is not None}
+    nf = candidate_fits(spec0, ok, bases, names, warms={k: warms["data"] for k in ok}, **kw) if ok else {}
+    best, per = [], []
+    for k, dk in draws.items():
+        if bases[k] is None:
+            best.append({"draw": k, "effect": "baseline failed", "dBIC": None})
+            per.append({})
+            continue
+        rel = gref.relative_data(dk, ref, ref_fit)
+        d = assemble(rel, spec0, bases[k], relative_fits(nf[k], ref_fits, rel, ref, bases[k]), objective=objective,
+                     resamples=0)
+        r = d.ranking[d.ranking["ok"].astype(bool) & np.isfinite(d.ranking["dBIC"].astype(float))]
+        per.append({str(e): float(v) for e, v in zip(r["effect"], r["dBIC"])})
+        best.append({"draw": k, "effect": str(r.iloc[0]["effect"]) if len(r) else None,
+                     "dBIC": float(r.iloc[0]["dBIC"]) if len(r) else None})
+    vals = [v for p in per for v in p.values()]
+    return {"relative_method_hash": method.hash(), "reference_signature": ref.signature, "spec": spec0.to_dict(),
+            "candidates": list(names), "draws": method.null_draws, "seeds": seeds, "n_subjects": n, "best": best,
+            "dBIC": per,
+            "lowest_dBIC": min(vals) if vals else None,
+            "baseline_failed": [b["draw"] for b in best if b["effect"] == "baseline failed"]}
 
 
 def relative_fits(fits: dict, ref_fits: dict, ds: gio.DataSet, ref: gio.DataSet, base_sol) -> dict:

@@ -14,7 +14,7 @@ import hashlib
 import json
 from dataclasses import asdict, dataclass
 
-__all__ = ["Method", "METHOD", "BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "EXPLAINED_PCT", "RUNNER_UP_MARGIN"]
+__all__ = ["Method", "METHOD", "RelativeMethod", "RELATIVE", "BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "EXPLAINED_PCT", "RUNNER_UP_MARGIN"]
 
 
 @dataclass(frozen=True)
@@ -72,3 +72,40 @@ DEFAULT_BASE = dict(METHOD.base)
 EXPLAINED_PCT = METHOD.explained_pct
 #: ΔBIC by which the named effect must beat the runner-up (0: no such test).
 RUNNER_UP_MARGIN = METHOD.runner_up_margin
+
+
+@dataclass(frozen=True)
+class RelativeMethod:
+    """How a change relative to a reference is decided (:mod:`gaitlib.gap.reference`), on
+    top of :data:`METHOD` (its threshold, margin and verdicts).
+
+    Attributes
+    ----------
+    null_draws : K. On the clean background of a relative diagnosis a free parameter absorbs
+        a share of pure sampling error that the criterion counts as very strong evidence (the
+        first relative validation, Chapter 8: draws with nothing changed reached ΔBIC −134).
+        So the reference is redrawn K times within the sampling error of a difference of two
+        group means (:func:`gaitlib.gap.reference.null_draw`, seeds from this hash and the
+        reference's signature), each draw diagnosed relative to the reference exactly as the
+        data are, and a top effect is named only if its ΔBIC is also below the lowest ΔBIC
+        that any candidate reached on any of the K draws: a max-statistic test, family-wise
+        over the candidates, at level 1/(K + 1). 0: no calibration.
+    revision : bumped when the relative diagnosis decides differently for a reason outside
+        these fields. 1: the null calibration.
+    """
+
+    null_draws: int = 9
+    revision: int = 1
+
+    def to_dict(self) -> dict:
+        return json.loads(json.dumps(asdict(self)))
+
+    def hash(self) -> str:
+        """16 hex digits of the SHA-256 of this method's fields and :data:`METHOD`'s."""
+        text = json.dumps({"method": METHOD.to_dict(), "relative": self.to_dict()}, sort_keys=True,
+                          separators=(",", ":"))
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+#: The relative method in use.
+RELATIVE = RelativeMethod()

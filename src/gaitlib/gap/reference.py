@@ -38,6 +38,7 @@ one-line error). Channels the reference fit does not simulate (EMG for SK) get n
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 
 import numpy as np
 import pandas as pd
@@ -46,8 +47,10 @@ from .. import effects as effects_mod
 from ..problems import gait as gait_ocp
 from . import io as gio
 from . import locate
+from .noise import smooth_noise
 
-__all__ = ["relative_data", "relative_n", "check_same_grid", "offset_channels", "background"]
+__all__ = ["relative_data", "relative_n", "check_same_grid", "offset_channels", "background", "null_draw",
+           "null_seed"]
 
 
 def relative_n(n_new: int, n_ref: int) -> int:
@@ -108,3 +111,30 @@ def relative_data(ds: gio.DataSet, ref: gio.DataSet, ref_fit) -> gio.DataSet:
     return dataclasses.replace(ds, background=bg, label=f"{ds.label} − {ref.label}", n=relative_n(ds.n, ref.n),
                                notes=tuple(ds.notes) + (note,),
                                n_source=f"1/(1/{ds.n} + 1/{ref.n}) (difference of two group means)")
+
+
+def null_seed(ref: gio.DataSet, draw: int, method_hash: str) -> int:
+    """The seed of null draw ``draw`` of reference ``ref`` under a relative method's hash."""
+    return int(hashlib.sha256(f"{method_hash}|{ref.signature}|null|{draw}".encode()).hexdigest()[:12], 16) % 2**31
+
+
+def null_draw(ref: gio.DataSet, n: int, seed: int) -> gio.DataSet:
+    """Another group like ``ref`` with nothing changed: every channel's mean + SD/√n · g(τ)
+    (g: :func:`gaitlib.gap.noise.smooth_noise`, one curve per channel; ``n``: the subjects
+    of the difference, :func:`relative_n`), the left leg regenerated from the right when
+    ``ref``'s is generated (as the reader does), SDs unchanged."""
+    if n < 1:
+        raise ValueError(f"null_draw: n (subjects) must be >= 1, got {n}")
+    g = ref.gait
+    generated = effects_mod.left_generated(g)
+    rng = np.random.default_rng(int(seed))
+    t = np.asarray(g.time, float) / float(g.cycle_time)
+    cols = [c for c in g.mean.columns if not (generated and c.endswith("_l"))]
+    eps = smooth_noise(rng, len(cols))(t)
+    mean = g.mean.copy()
+    for i, c in enumerate(cols):
+        mean[c] = g.mean[c].to_numpy() + g.sd[c].to_numpy() / np.sqrt(n) * eps[i]
+    g2 = dataclasses.replace(g, mean=mean, notes=tuple(g.notes) + (f"null draw (seed {seed}, n {n})",))
+    if generated:
+        g2 = effects_mod.regenerate_left(g2, float(g.left_shift))
+    return dataclasses.replace(ref, gait=g2, label=f"{ref.label} null draw {seed}", path=None)

@@ -54,7 +54,7 @@ from . import diagnose
 from . import io as gio
 from . import locate
 from . import twin
-from .method import BIC_THRESHOLD, METHOD, RUNNER_UP_MARGIN, Method
+from .method import BIC_THRESHOLD, METHOD, RELATIVE, RUNNER_UP_MARGIN, Method
 from .noise import smooth_noise
 
 __all__ = ["Injection", "INJECTIONS", "SETS", "BANDS", "PLATE_THRESHOLD_BW", "VARIANTS", "VARIANT_SEEDS", "ALL_SETS",
@@ -197,10 +197,12 @@ def _seed(method_hash: str, name: str, draw: int) -> int:
     return int(hashlib.sha256(f"{method_hash}|{name}|{draw}".encode()).hexdigest()[:12], 16)
 
 
-def draws(sets=("independent", "out-of-library"), per_band: int = 1, method: Method = METHOD) -> pd.DataFrame:
+def draws(sets=("independent", "out-of-library"), per_band: int = 1, method: Method = METHOD,
+          seed_hash: str | None = None) -> pd.DataFrame:
     """The validation's draws: one row per (manipulation, band, draw) with its magnitude and
-    expected answer; magnitudes from generators seeded by ``method.hash()``."""
-    h = method.hash()
+    expected answer; magnitudes from generators seeded by ``method.hash()`` (or
+    ``seed_hash``: the relative validation's, :data:`gaitlib.gap.method.RELATIVE`)."""
+    h = method.hash() if seed_hash is None else seed_hash
     rows = []
     for s in sets:
         if s == "null":
@@ -373,20 +375,22 @@ def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_clas
 
     ``relative``: diagnose the *change* from a reference instead (``gaitlib gap --data CSV
     --reference REF``, :mod:`gaitlib.gap.reference`) — the reference is the unedited data
-    resampled within SD/√n (seed from the method's hash, :data:`REFERENCE_DRAW`), every
-    manipulated data set is resampled too (its own seed), so the change carries the sampling
-    error of two independent groups; a ``null`` draw's right answer is then "unexplained"
-    (nothing changed). The same draws (magnitudes, signs) as the absolute validation. No
-    ``model-variant`` set (a variant's twin has no reference of its own)."""
+    resampled within SD/√n (seed from the relative method's hash,
+    :data:`gaitlib.gap.method.RELATIVE`, and :data:`REFERENCE_DRAW`), every manipulated
+    data set is resampled too (its own seed), so the change carries the sampling error of
+    two independent groups; a ``null`` draw's right answer is then "unexplained" (nothing
+    changed). Magnitudes and signs are drawn from the relative method's hash (fresh draws
+    when that method changes). The reference's null calibration is computed with the first
+    case and reused. No ``model-variant`` set (a variant's twin has no reference of its own)."""
     import tempfile
 
     if relative and "model-variant" in sets:
         raise ValueError("run(relative=True): the model-variant set has no reference data set; "
                          "run it without relative")
     method = METHOD  # the diagnosis runs with it: the draws are its own
-    h = method.hash()
+    h = RELATIVE.hash() if relative else method.hash()  # the relative method's own draws
     base = dict(method.base if base is None else base, speed_class=speed_class)
-    table = draws(sets, per_band, method)
+    table = draws(sets, per_band, method, seed_hash=h)
     frame = real_frame(speed_class)
     rows = []
     with tempfile.TemporaryDirectory() as td:
@@ -395,7 +399,7 @@ def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_clas
         p0 = wd / "unedited.csv"
         frame.to_csv(p0, index=False)
         n0 = gio.read_data(p0).n
-        ref_ds, d0 = None, None
+        ref_ds, d0, calib = None, None, None
         if relative:
             pr = wd / "reference.csv"
             ref_seed = _seed(h, REFERENCE_DRAW, 0) % 2**31
@@ -423,8 +427,11 @@ def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_clas
             ds = gio.read_data(p)
             if relative:
                 try:
-                    d = diagnose.diagnose(ds, base=base, resamples=resamples, reference=ref_ds, **diag_kw)
+                    d = diagnose.diagnose(ds, base=base, resamples=resamples, reference=ref_ds, calibration=calib,
+                                          **diag_kw)
+                    calib = d.settings["reference"]["null_calibration"]  # the same reference: once
                     s = _summary(d, c["expected"])
+                    s["threshold_used"] = d.settings.get("threshold_used")
                     # on relative data the whole baseline RSS is the change (+ sampling error),
                     # as % of the reference's own gap; unrefit: at the reference's fit
                     added, gap0 = s["rss_baseline"], d.settings["reference"]["rss_reference"]
@@ -433,6 +440,8 @@ def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_clas
                     s = {"named": "baseline failed", "verdict": "baseline failed", "error": str(exc)}
                     added, gap0, unrefit = np.nan, np.nan, np.nan
                 unedited.setdefault("rss_reference", gap0)
+                if calib is not None:
+                    unedited["null_calibration"] = calib
             else:
                 # the gap the manipulation adds at the unedited data's baseline fit (no re-fit)
                 unrefit = locate.locate(d0.baseline, ds).rss - d0.located.rss
@@ -455,6 +464,8 @@ def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_clas
                       f"expected {c['expected']}", flush=True)
     settings = {"method": method.to_dict(), "method_hash": method.hash(), "base": base, "per_band": per_band,
                 "sets": list(sets), "speed_class": speed_class, "relative": bool(relative)}
+    if relative:
+        settings.update(relative_method=RELATIVE.to_dict(), relative_method_hash=RELATIVE.hash())
     return Validation(pd.DataFrame(rows), unedited, settings)
 
 
