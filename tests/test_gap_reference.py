@@ -3,6 +3,7 @@ checked by hand on a synthetic reference fit, and the refusals before any solve.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -119,3 +120,49 @@ def test_another_speed_class_is_refused_before_any_solve(ref, monkeypatch):
     monkeypatch.setattr(D, "baseline_fits", no_solve)
     with pytest.raises(ValueError, match="same speed class"):
         D.diagnose(slow, base=dict(speed_class="Slow", n_intervals=4, degree=2), reference=ref, serial=True)
+
+
+def test_a_null_draw_is_the_reference_plus_its_sampling_error(ref):
+    """Every right-leg channel moves by SD/√n · g (|g| of unit variance: a few SDs/√n at
+    most), the left leg is regenerated from the right (the reader's generation), SDs are
+    unchanged, a seed gives the same draw and another seed another."""
+    from gaitlib import effects as E
+
+    n = 41
+    a, b, c = R.null_draw(ref, n, 5), R.null_draw(ref, n, 5), R.null_draw(ref, n, 6)
+    assert np.array_equal(a.gait.mean.to_numpy(), b.gait.mean.to_numpy())
+    assert not np.allclose(a.gait.mean.to_numpy(), c.gait.mean.to_numpy())
+    assert np.array_equal(a.gait.sd[["knee_r", "grf_y_r"]].to_numpy(), ref.gait.sd[["knee_r", "grf_y_r"]].to_numpy())
+    assert E.left_generated(ref.gait) and E.left_generated(a.gait)
+    for col in ("knee_r", "tau_ankle_r", "grf_y_r", "pelvis_tilt"):
+        z = (a.gait.mean[col] - ref.gait.mean[col]) / (ref.gait.sd[col] / np.sqrt(n))
+        assert 0.05 < float(np.std(z)) and float(np.max(np.abs(z))) < 5.0, col
+    with pytest.raises(ValueError, match="subjects"):
+        R.null_draw(ref, 0, 1)
+    assert R.null_seed(ref, 0, "h") != R.null_seed(ref, 1, "h") and R.null_seed(ref, 0, "h") == R.null_seed(ref, 0, "h")
+
+
+def test_the_relative_method_names_itself_and_the_absolute_one():
+    from gaitlib.gap import method as M
+
+    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 1
+    h = M.RELATIVE.hash()
+    assert len(h) == 16 and h != M.METHOD.hash()
+    assert M.RelativeMethod(null_draws=3).hash() != h
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        M.RELATIVE.null_draws = 1
+
+
+def test_a_calibration_of_another_reference_is_refused(ref, monkeypatch):
+    """diagnose(calibration=…) checks the calibration was made for this reference, spec,
+    candidates and subjects before using it (after the reference's fits, which are faked)."""
+    class FakeSol:
+        stats = {"status": "Solve_Succeeded", "objective": 1.0, "iterations": 1}
+
+    monkeypatch.setattr(D, "baseline_fits", lambda spec0, sets, warm, **k: {
+        key: {"best": FakeSol(), "warm": FakeSol()} for key in sets})
+    monkeypatch.setattr(D, "candidate_fits", lambda spec0, sets, bases, names, **k: {key: {} for key in sets})
+    monkeypatch.setattr(D.locate, "locate", lambda *a, **k: type("L", (), {"rss": 1.0})())
+    bad = {"relative_method_hash": "x" * 16}
+    with pytest.raises(ValueError, match="another relative_method_hash"):
+        D.diagnose(ref, reference=ref, calibration=bad, serial=True)

@@ -80,9 +80,15 @@ def cmd_gap(args) -> int:
         d.save(o.tmp, figures=not args.no_figures)
     cols = ["rank", "effect", "n_params", "start", "nests_baseline", "status", "pct_closed", "dAIC", "dBIC",
             "residual_ratio"] + (["parameter_change"] if ref is not None else [])
-    print(d.ranking[cols].to_string(index=False, float_format=lambda v: f"{v:.2f}"))
-    print(json.dumps({"top_effect": d.top_effect, "verdict": d.verdict, "rss_baseline": d.located.rss,
-                      "n_eff": d.located.n_eff, "baseline_status": d.baseline.stats["status"]}, indent=1))
+    print(d.ranking[[c for c in cols if c in d.ranking.columns]].to_string(index=False,
+                                                                         float_format=lambda v: f"{v:.2f}"))
+    summary = {"top_effect": d.top_effect, "verdict": d.verdict, "rss_baseline": d.located.rss,
+               "n_eff": d.located.n_eff, "baseline_status": d.baseline.stats["status"]}
+    calib = ((getattr(d, "settings", None) or {}).get("reference") or {}).get("null_calibration")
+    if calib is not None:  # the relative diagnosis's null calibration
+        summary.update(null_draws=calib["draws"], null_lowest_dBIC=calib["lowest_dBIC"],
+                       threshold_used=d.settings.get("threshold_used"))
+    print(json.dumps(summary, indent=1))
     print(f"wrote {out / 'diagnosis.json'}")
     failed = [(f.effect, f.status) for f in d.fits.values() if not f.ok]
     if failed:
