@@ -402,6 +402,10 @@ def test_relative_lines_count_both_runs_on_the_same_cases():
     assert list(t["named (relative)"][:2]) == ["knee_offset", "body_mass"]
     with pytest.raises(ValueError, match="not a relative one"):
         G.relative_lines(absolute, rel)
+    rel.rows["magnitude"] = rel.rows["magnitude"] * 1.5  # other draws: nothing is paired
+    assert "(other draws than the absolute validation's" in G.relative_lines(rel, absolute)[0]
+    assert "absolute diagnosis named 1 of 2 of its own" in G.relative_lines(rel, absolute)[0]
+    assert set(G.relative_cases(rel, absolute)["named (absolute)"]) == {"—"}
 
 
 @pytest.mark.parametrize("name,m", [("hip_offset", 2.5), ("knee_offset", -3.0), ("ankle_offset", 4.0),
@@ -419,3 +423,17 @@ def test_effect_magnitude_of_a_load_scale_is_the_mass_change():
     assert V.effect_magnitude("load_scale", 0.11, None) == ("k", 0.11)
     with pytest.raises(ValueError, match="not an independent manipulation"):
         V.effect_magnitude("knee_rom", 0.1, None)
+
+
+def test_calibration_lines_count_the_stored_null_draws():
+    from gaitlib.studies import gap as G
+
+    calib = {"draws": 3, "n_subjects": 41, "lowest_dBIC": -150.0, "baseline_failed": ["null2"],
+             "best": [{"draw": "null0", "effect": "ankle_offset", "dBIC": -150.0},
+                      {"draw": "null1", "effect": "ankle_offset", "dBIC": -40.0},
+                      {"draw": "null2", "effect": "baseline failed", "dBIC": None}]}
+    v = V.Validation(V.pd.DataFrame(), {"null_calibration": calib}, {"relative": True})
+    (line,) = G.calibration_lines(v)
+    assert "redrawn 3 times" in line and "(n = 41)" in line and "from -40 to -150 (ankle_offset ×2)" in line
+    assert "named only at ΔBIC ≤ -150 (the threshold alone: -10)" in line and "baseline: null2." in line
+    assert G.calibration_lines(V.Validation(V.pd.DataFrame(), {}, {}))[0].startswith("(no null calibration")

@@ -167,7 +167,8 @@ def cmd_gap_validate(args) -> int:
     out = Path(args.out)
     table = V.draws(sets, args.per_band)
     print(f"gaitlib gap-validate: {len(table)} manipulated data sets + {'a reference' if args.relative else 'the unedited one'} ({', '.join(sets)}; "
-          f"method {V.METHOD.hash()}); baseline {args.model} {args.cost} {args.intervals} x {args.degree}", flush=True)
+          f"method {V.METHOD.hash()}" + (f", relative method {V.RELATIVE.hash()}" if args.relative else "")
+          + f"); baseline {args.model} {args.cost} {args.intervals} x {args.degree}", flush=True)
     with cli.Output(out, overwrite=args.overwrite, files=VALIDATE_FILES, last=("validation.json",),
                     what="the validation's files (validation.json, cases.csv, scores.csv, confusion.csv)") as o:
         v = V.run(sets, per_band=args.per_band, speed_class=args.speed, base=base, root=root,

@@ -29,6 +29,18 @@ would the data alone. The sampling error of a difference of two independent grou
 of n_N and n_R subjects is SD·√(1/n_N + 1/n_R), so N' has
 ``n = round(1 / (1/n_N + 1/n_R))`` subjects.
 
+Null calibration
+----------------
+On this clean background a free parameter absorbs a share of pure sampling error that the
+criterion (ΔBIC with n_eff the resels of the baseline's residual) counts as very strong
+evidence: in the first relative validation (Chapter 8), draws in which nothing changed
+reached ΔBIC −134. So the reference is redrawn K times within the sampling error of the
+difference (:func:`null_draw`; K and the seeds from
+:data:`gaitlib.gap.method.RELATIVE`), each draw diagnosed relative to the reference exactly
+as the data are, and the top effect must also beat the lowest ΔBIC that any candidate
+reached on any draw (:func:`gaitlib.gap.diagnose.null_calibration`): a max-statistic test
+over the candidates at level 1/(K + 1).
+
 Assumptions, stated: the model's own misfit S_R − R does not change with the effect (first
 order: an effect that changes the gait changes the misfit too); both data sets have the same
 time grid, cycle time and speed (a change of cadence is not a curve offset: refused with a

@@ -57,7 +57,7 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
            "VALIDATION_RUNS", "stored_validation", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
            "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines",
-           "relative_cases", "relative_lines", "relative_magnitudes"]
+           "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines"]
 
 #: Baseline of the twin study: SK, data tracking (Eq 4.11), 10 × 3 LGR — the coarse mesh (the full 20 × 5 mesh costs ≈ 10× per solve and the twin study
 #: needs ≈ 170 solves per seed).
@@ -379,12 +379,16 @@ def stored_validation(name: str = "real") -> gval.Validation:
     if v.settings.get("method_hash") != now:
         raise RuntimeError(f"{folder}: a validation of method {v.settings.get('method_hash')}, the method is now "
                            f"{now}: rerun `{VALIDATION_RUNS[name]}`")
+    if v.settings.get("relative") and v.settings.get("relative_method_hash") != gap_method.RELATIVE.hash():
+        raise RuntimeError(f"{folder}: a relative validation of relative method "
+                           f"{v.settings.get('relative_method_hash')}, it is now {gap_method.RELATIVE.hash()}: rerun "
+                           f"`{VALIDATION_RUNS[name]}`")
     return v
 
 
 #: A validation made by an earlier method, kept as the "before" of a method change:
 #: folder under ``gap_validation`` → the method revision that made it.
-SUPERSEDED_VALIDATIONS = {"real_rev1": 1}
+SUPERSEDED_VALIDATIONS = {"real_rev1": 1, "relative_rev0": 0}
 
 
 def superseded_validation(name: str = "real_rev1") -> gval.Validation:
@@ -480,15 +484,23 @@ def validation_lines(v: gval.Validation, target: float = 90.0) -> list[str]:
     return out
 
 
+def _same_draws(rel: gval.Validation, absolute: gval.Validation) -> pd.Series:
+    """case → the absolute diagnosis's named effect, for the cases drawn at the same
+    magnitude in both runs (a relative method of its own draws other magnitudes)."""
+    a = absolute.rows.set_index("case")
+    m = rel.rows.set_index("case")["magnitude"]
+    same = [c for c in m.index if c in a.index and np.isclose(float(a.loc[c, "magnitude"]), float(m[c]))]
+    return a.loc[same, "named"]
+
+
 def relative_cases(rel: gval.Validation, absolute: gval.Validation) -> pd.DataFrame:
-    """The relative validation's cases beside the absolute one's on the same draws (the
-    draws follow the method's hash, so a case name is the same manipulation at the same
-    magnitude): manipulation, band, magnitude, expected, named (absolute), named and verdict
+    """The relative validation's cases beside the absolute one's where they share the draw
+    (same case at the same magnitude; else "—"): manipulation, band, magnitude, expected, named (absolute), named and verdict
     (relative), right (relative), the relative run's first two ranked with ΔBIC and % closed,
     and the change's RSS as % of the reference's own gap (``added_pct``)."""
     r = validation_cases(rel).assign(case=rel.rows["case"].to_numpy(), added_pct=rel.rows["added_pct"].to_numpy())
-    a = absolute.rows.set_index("case")["named"]
-    r.insert(5, "named (absolute)", r["case"].map(a).fillna("—"))
+    a = _same_draws(rel, absolute)
+    r.insert(5, "named (absolute)", [str(a[c]) if c in a.index else "—" for c in r["case"]])
     return r.drop(columns=["case"]).rename(columns={"named": "named (relative)", "verdict": "verdict (relative)",
                                                     "right": "right (relative)",
                                                     "added_pct": "change RSS (% of the reference's gap)"})
@@ -529,12 +541,16 @@ def relative_lines(rel: gval.Validation, absolute: gval.Validation, target: floa
     ind = sel(r, ["middle", "large"])
     if len(ind):
         wrong = ind[~ind["correct"].astype(bool)]
-        same = a.reindex(ind["case"])
-        a_right = int(same["correct"].fillna(False).astype(bool).sum())
+        paired = _same_draws(rel, absolute).index.intersection(ind["case"])
+        a_right = int(a.loc[paired, "correct"].astype(bool).sum())
         out.append(f"**Relative to the unedited data: independent injections at middle and large magnitudes "
                    f"{int(ind['correct'].sum())} of {len(ind)} named right ({100.0 * ind['correct'].mean():.0f} %; "
-                   f"target ≥ {target:g} %)** — the absolute diagnosis of the same manipulations: {a_right} of "
-                   f"{int(same['correct'].notna().sum())}."
+                   f"target ≥ {target:g} %)**"
+                   + (f" — the absolute diagnosis of the same manipulations: {a_right} of {len(paired)}."
+                      if len(paired) == len(ind) else
+                      f" (other draws than the absolute validation's: the relative method draws from its own hash; "
+                      f"the absolute diagnosis named {int(sel(a.reset_index(), ['middle', 'large'])['correct'].sum())} "
+                      f"of {len(sel(a.reset_index(), ['middle', 'large']))} of its own).")
                    + (" Misnamed: " + "; ".join(f"{x} {b} ({m:+.3g} {u}) named {n}" for x, b, m, u, n in
                                               zip(wrong["injection"], wrong["band"], wrong["magnitude"], wrong["unit"],
                                                   wrong["named"])) + "." if len(wrong) else ""))
@@ -570,8 +586,30 @@ def relative_lines(rel: gval.Validation, absolute: gval.Validation, target: floa
                    f"sampling error only), far beyond the threshold ({diagnose.BIC_THRESHOLD:g}): on this clean "
                    f"background a free parameter absorbs a share of the noise that the criterion's effective "
                    f"sample size (the resels of the baseline's residual, {nul['n_eff'].min():.0f}–"
-                   f"{nul['n_eff'].max():.0f}) counts as very strong evidence; what keeps these draws unexplained is "
-                   f"the runner-up margin ({diagnose.RUNNER_UP_MARGIN:g}): several candidates absorb noise alike.")
+                   f"{nul['n_eff'].max():.0f}) counts as very strong evidence"
+                   + (f"; the null calibration's threshold ({float(nul['threshold_used'].iloc[0]):.0f}) "
+                      + (f"did not hold {len(fp)} of them." if len(fp) else "held them.")
+                      if "threshold_used" in nul.columns and nul["threshold_used"].notna().all() else
+                      f"; what keeps these draws unexplained is the runner-up margin ({diagnose.RUNNER_UP_MARGIN:g}): "
+                      "several candidates absorb noise alike."))
+    return out
+
+
+def calibration_lines(rel: gval.Validation) -> list[str]:
+    """The relative validation's null calibration in words (every number from its stored
+    result): the draws, their first-ranked candidates and ΔBIC, the threshold it set."""
+    c = (rel.unedited or {}).get("null_calibration")
+    if not c:
+        return ["(no null calibration stored with this validation)"]
+    best = [b for b in c["best"] if b.get("dBIC") is not None]
+    vals = sorted(best, key=lambda b: b["dBIC"])
+    eff = pd.Series([b["effect"] for b in best]).value_counts()
+    thr = min(diagnose.BIC_THRESHOLD, c["lowest_dBIC"]) if c["lowest_dBIC"] is not None else diagnose.BIC_THRESHOLD
+    out = [f"The reference redrawn {c['draws']} times within the sampling error of a difference of two group means "
+           f"(n = {c['n_subjects']}), each diagnosed relative to it: first-ranked ΔBIC from {vals[-1]['dBIC']:.0f} to "
+           f"{vals[0]['dBIC']:.0f} (" + ", ".join(f"{e} ×{k}" for e, k in eff.items()) + f"); so an effect is named only "
+           f"at ΔBIC ≤ {thr:.0f} (the threshold alone: {diagnose.BIC_THRESHOLD:g})."
+           + (f" Draws without a converged baseline: {', '.join(c['baseline_failed'])}." if c["baseline_failed"] else "")]
     return out
 
 
