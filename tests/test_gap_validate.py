@@ -437,3 +437,20 @@ def test_calibration_lines_count_the_stored_null_draws():
     assert "redrawn 3 times" in line and "(n = 41)" in line and "from -40 to -150 (ankle_offset ×2)" in line
     assert "named only at ΔBIC ≤ -150 (the threshold alone: -10)" in line and "baseline: null2." in line
     assert G.calibration_lines(V.Validation(V.pd.DataFrame(), {}, {}))[0].startswith("(no null calibration")
+
+
+def test_a_null_draw_named_says_how_small_its_change_was():
+    from gaitlib.studies import gap as G
+
+    named = V.pd.DataFrame({"named": ["ankle_offset"], "rank1": ["ankle_offset"],
+                            "rank1_change": [{"c": 0.0069}]})
+    t = G._change_clause(named)
+    assert "ankle_offset c +0.0069 rad (+0.40°)" in t and "not a change" in t
+    assert G._change_clause(named.drop(columns="rank1_change")) == ""
+    wrong = V.pd.DataFrame({"injection": ["hip_offset"], "band": ["large"], "rank1": ["hat_com"], "rank1_dBIC": [-324.2],
+                            "rank1_pct": [71.6], "expected": ["hip_offset"], "expected_dBIC": [-324.7],
+                            "expected_pct": [71.64]})
+    assert G._against_expected(wrong) == (" First-ranked against the expected effect (ΔBIC, % closed): hip_offset "
+                                          "large: hat_com -324 (72 %) vs hip_offset -325 (72 %).")
+    tie = wrong.assign(rank1="hip_offset", rank2="hat_com", rank2_dBIC=-324.2, rank2_pct=71.6)
+    assert "hip_offset large: hip_offset first at -325 (72 %), hat_com at -324 (72 %)" in G._against_expected(tie)

@@ -341,6 +341,8 @@ def _top2(d: diagnose.Diagnosis) -> dict:
             out[f"rank{i + 1}"] = str(r.iloc[i]["effect"])
             out[f"rank{i + 1}_dBIC"] = float(r.iloc[i]["dBIC"])
             out[f"rank{i + 1}_pct"] = float(r.iloc[i]["pct_closed"])
+            if "parameter_change" in r.columns and r.iloc[i]["parameter_change"]:  # relative: its change
+                out[f"rank{i + 1}_change"] = dict(r.iloc[i]["parameter_change"])
         else:
             out[f"rank{i + 1}"], out[f"rank{i + 1}_dBIC"], out[f"rank{i + 1}_pct"] = None, np.nan, np.nan
     return out

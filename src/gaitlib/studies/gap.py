@@ -553,7 +553,8 @@ def relative_lines(rel: gval.Validation, absolute: gval.Validation, target: floa
                       f"of {len(sel(a.reset_index(), ['middle', 'large']))} of its own).")
                    + (" Misnamed: " + "; ".join(f"{x} {b} ({m:+.3g} {u}) named {n}" for x, b, m, u, n in
                                               zip(wrong["injection"], wrong["band"], wrong["magnitude"], wrong["unit"],
-                                                  wrong["named"])) + "." if len(wrong) else ""))
+                                                  wrong["named"])) + "." if len(wrong) else "")
+                   + _against_expected(wrong))
     small = sel(r, ["small"])
     if len(small):
         out.append(f"Small magnitudes: {int(small['correct'].sum())} of {len(small)} named right "
@@ -588,11 +589,52 @@ def relative_lines(rel: gval.Validation, absolute: gval.Validation, target: floa
                    f"sample size (the resels of the baseline's residual, {nul['n_eff'].min():.0f}–"
                    f"{nul['n_eff'].max():.0f}) counts as very strong evidence"
                    + (f"; the null calibration's threshold ({float(nul['threshold_used'].iloc[0]):.0f}) "
-                      + (f"did not hold {len(fp)} of them." if len(fp) else "held them.")
+                      + (f"did not hold {len(fp)} of them" + _change_clause(fp) + "." if len(fp) else "held them.")
                       if "threshold_used" in nul.columns and nul["threshold_used"].notna().all() else
                       f"; what keeps these draws unexplained is the runner-up margin ({diagnose.RUNNER_UP_MARGIN:g}): "
                       "several candidates absorb noise alike."))
     return out
+
+
+def _against_expected(wrong: pd.DataFrame) -> str:
+    """For misnamed cases: the first-ranked candidate's ΔBIC and % closed against the
+    expected effect's (from the stored rows)."""
+    if wrong.empty or "expected_dBIC" not in wrong.columns:
+        return ""
+    bits = []
+    for _, r in wrong.iterrows():
+        if not (isinstance(r["rank1"], str) and np.isfinite(float(r["expected_dBIC"]))):
+            continue
+        if r["rank1"] == r["expected"]:  # first, but not named: the runner-up or the threshold
+            bits.append(f"{r['injection']} {r['band']}: {r['expected']} first at {r['expected_dBIC']:.0f} "
+                        f"({r['expected_pct']:.0f} %), {r.get('rank2')} at {float(r.get('rank2_dBIC', np.nan)):.0f} "
+                        f"({float(r.get('rank2_pct', np.nan)):.0f} %)")
+        else:
+            bits.append(f"{r['injection']} {r['band']}: {r['rank1']} {r['rank1_dBIC']:.0f} ({r['rank1_pct']:.0f} %) vs "
+                        f"{r['expected']} {r['expected_dBIC']:.0f} ({r['expected_pct']:.0f} %)")
+    return (" First-ranked against the expected effect (ΔBIC, % closed): " + "; ".join(bits) + ".") if bits else ""
+
+
+def _change_text(effect: str, change: dict) -> str:
+    """A candidate's identified change in words: each parameter with its unit (rad also in °)."""
+    e = effects_mod.EFFECTS[effect]
+    parts = []
+    for p in e.params:
+        if p.name in change:
+            v = float(change[p.name])
+            parts.append(f"{p.name} {v:+.3g} {p.unit}" + (f" ({np.degrees(v):+.2f}°)" if p.unit == "rad" else ""))
+    return ", ".join(parts)
+
+
+def _change_clause(named: pd.DataFrame) -> str:
+    """', although <effect>'s identified change was only …' for null draws named an effect
+    (relative validations that store ``rank1_change``)."""
+    if "rank1_change" not in named.columns:
+        return ""
+    bits = [f"{r['named']} {_change_text(r['named'], r['rank1_change'])}" for _, r in named.iterrows()
+            if isinstance(r["rank1_change"], dict) and r["rank1"] == r["named"]]
+    return (" — with a parameter change of only " + "; ".join(bits) + " between the reference and the draw: its fit "
+            "of the draw absorbs the sampling error differently from the baseline's, not a change") if bits else ""
 
 
 def calibration_lines(rel: gval.Validation) -> list[str]:
