@@ -442,6 +442,21 @@ def validation_cases(v: gval.Validation) -> pd.DataFrame:
               "ranked first (ΔBIC, % closed)", "second"]]
 
 
+def _small_line(small: pd.DataFrame) -> str:
+    return (f"Small magnitudes: {int(small['correct'].sum())} of {len(small)} named right "
+            f"({int((small['named'] == 'unexplained').sum())} unexplained).")
+
+
+def _ool_line(ool: pd.DataFrame, target: float) -> str:
+    un = 100.0 * (ool["named"] == "unexplained").mean()
+    named = ool[ool["named"] != "unexplained"]
+    return (f"**Out-of-library manipulations: {int((ool['named'] == 'unexplained').sum())} of {len(ool)} "
+            f"read \"unexplained\" ({un:.0f} %; target ≥ {target:g} %).**"
+            + (" A library effect was named for: " + "; ".join(
+                f"{a} {b} ({n}, {vd})" for a, b, n, vd in zip(named["injection"], named["band"], named["named"],
+                                                               named["verdict"])) + "." if len(named) else ""))
+
+
 def validation_lines(v: gval.Validation, target: float = 90.0) -> list[str]:
     """The validation in words, every number from ``v``: top-1 at middle magnitudes and
     above (independent set), the "unexplained" rate (out-of-library set), against the
@@ -461,16 +476,9 @@ def validation_lines(v: gval.Validation, target: float = 90.0) -> list[str]:
                                               zip(wrong["injection"], wrong["band"], wrong["magnitude"], wrong["unit"],
                                                   wrong["named"])) + "." if len(wrong) else ""))
     if len(small):
-        out.append(f"Small magnitudes: {int(small['correct'].sum())} of {len(small)} named right "
-                   f"({int((small['named'] == 'unexplained').sum())} unexplained).")
+        out.append(_small_line(small))
     if len(ool):
-        un = 100.0 * (ool["named"] == "unexplained").mean()
-        named = ool[ool["named"] != "unexplained"]
-        out.append(f"**Out-of-library manipulations: {int((ool['named'] == 'unexplained').sum())} of {len(ool)} "
-                   f"read \"unexplained\" ({un:.0f} %; target ≥ {target:g} %).**"
-                   + (" A library effect was named for: " + "; ".join(
-                       f"{a} {b} ({n}, {vd})" for a, b, n, vd in zip(named["injection"], named["band"], named["named"],
-                                                                      named["verdict"])) + "." if len(named) else ""))
+        out.append(_ool_line(ool, target))
     var = r[r["set"] == "model-variant"]
     if len(var):
         out.append(f"**Model-variant twins: {int(var['correct'].sum())} of {len(var)} named within the stated family "
@@ -557,8 +565,7 @@ def relative_lines(rel: gval.Validation, absolute: gval.Validation, target: floa
                    + _against_expected(wrong))
     small = sel(r, ["small"])
     if len(small):
-        out.append(f"Small magnitudes: {int(small['correct'].sum())} of {len(small)} named right "
-                   f"({int((small['named'] == 'unexplained').sum())} unexplained).")
+        out.append(_small_line(small))
     if "expected_change" in r.columns and len(ind):
         mg = relative_magnitudes(rel)
         mm = mg[mg["band"].isin(["middle", "large"])]["ratio"].dropna()
@@ -568,12 +575,7 @@ def relative_lines(rel: gval.Validation, absolute: gval.Validation, target: floa
                        f"{len(mm)} middle and large injections.")
     ool = sel(r, s="out-of-library")
     if len(ool):
-        named = ool[ool["named"] != "unexplained"]
-        out.append(f"**Out-of-library manipulations: {int((ool['named'] == 'unexplained').sum())} of {len(ool)} read "
-                   f"\"unexplained\" ({100.0 * (ool['named'] == 'unexplained').mean():.0f} %; target ≥ {target:g} %)**"
-                   + ("; a library effect was named for " + "; ".join(
-                       f"{x} {b} ({n}, {vd})" for x, b, n, vd in zip(named["injection"], named["band"], named["named"],
-                                                                      named["verdict"])) + "." if len(named) else "."))
+        out.append(_ool_line(ool, target))
     nul = sel(r, s="null")
     if len(nul):
         fp = nul[nul["named"] != "unexplained"]
