@@ -243,7 +243,10 @@ res_f = stored_consistent("the runs with the friction floor", friction_floor=fid
 if res_f is not None:
     cot_f, terms_f, slip_f = fidelity.curve_tables(res_f)
     fig = pr.cot_figure(cot_f, label=f"ours: one problem, friction ≥ {fidelity.FRICTION_FLOOR:g} (converged, valid)")
-    display(pd.concat({"as identified": slip_u, f"friction ≥ {fidelity.FRICTION_FLOOR:g}": slip_f}, axis=1),
+    display(marks.mark_table(pd.concat({"as identified": slip_u, f"friction ≥ {fidelity.FRICTION_FLOOR:g}": slip_f},
+                                       axis=1),
+                             {c: m for c, m in cot_f["mark"].items() if m},
+                             column=f"mark (friction ≥ {fidelity.FRICTION_FLOOR:g})"),
             cot_f, terms_f)
     display(Markdown("\n\n".join(fidelity.skating_findings(cot_u, slip_u, cot_f, slip_f, terms_f,
                                                             reruns=tuple(k.split()[-1] for k in res_f.rerun_used),
