@@ -464,6 +464,9 @@ display(valr.scores())
 display(gap_study.relative_cases(valr, val))
 display(gap_study.relative_magnitudes(valr).round(4))
 display(Markdown("\n\n".join(gap_study.relative_lines(valr, val))))
+_rb = gap_study.stored_reference_basin()
+display(Markdown("\n\n".join(gap_study.reference_basin_lines(_rb)) if _rb is not None
+                 else "(`benchmarks/gap_reference_basin.py`: not run)"))
 
 # %% [markdown]
 # ## 3c. Muscle-level twins: co-contraction, joint stiffness and activation timing against EMG

@@ -57,7 +57,8 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
            "VALIDATION_RUNS", "stored_validation", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
            "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines",
-           "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines"]
+           "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines",
+           "stored_reference_basin", "reference_basin_lines", "REFERENCE_BASIN_FILE"]
 
 #: Baseline of the twin study: SK, data tracking (Eq 4.11), 10 × 3 LGR — the coarse mesh (the full 20 × 5 mesh costs ≈ 10× per solve and the twin study
 #: needs ≈ 170 solves per seed).
@@ -756,6 +757,36 @@ def stored_experiment(relpath: str, script: str) -> dict | None:
         raise RuntimeError(f"{f}: made with method {r.get('method_hash')}, the method is now "
                            f"{gap_method.METHOD.hash()}: rerun benchmarks/{script}")
     return r
+
+
+#: ``benchmarks/gap_reference_basin.py``'s result, under the validation's folder.
+REFERENCE_BASIN_FILE = "reference_basin.json"
+
+
+def stored_reference_basin() -> dict | None:
+    """``benchmarks/gap_reference_basin.py``'s result (:func:`stored_experiment`), refused
+    too if made under another relative method."""
+    r = stored_experiment(f"gap_validation/{REFERENCE_BASIN_FILE}", "gap_reference_basin.py")
+    if r is not None and r.get("relative_method_hash") != gap_method.RELATIVE.hash():
+        raise RuntimeError(f"{REFERENCE_BASIN_FILE}: made under relative method {r.get('relative_method_hash')}, it "
+                           f"is now {gap_method.RELATIVE.hash()}: rerun benchmarks/gap_reference_basin.py")
+    return r
+
+
+def reference_basin_lines(res: dict, tol: float = 1e-6) -> list[str]:
+    """``benchmarks/gap_reference_basin.py``'s result in a sentence computed from it."""
+    cs = res["cases"]
+    low = [c for c in cs if c["objective_reference_from_data"] < c["objective_reference"] * (1.0 - tol)]
+    if not low:
+        return [f"Re-solving the reference from the data's continuation fit never reached a lower objective than the "
+                f"reference's kept fit ({len(cs)} null draws): the continuation stayed in its basin."]
+    return [f"**Why a null draw can be named.** Re-solving the reference from the data's continuation fit reached a "
+            f"lower objective than the reference's kept fit (best of its starts, objective "
+            f"{cs[0]['objective_reference']:.4f}) in {len(low)} of {len(cs)} null draws ("
+            + "; ".join(f"{c['case']}: {c['objective_reference_from_data']:.4f}, named {c['named']}" for c in low)
+            + "): the reference's kept fit is not the best basin within reach, and the data's continuation can move "
+              "to another one — the relative gap then carries a change of the fit, not of the data, which a "
+              "candidate that stays put is credited with closing (`benchmarks/gap_reference_basin.py`)."]
 
 
 def stored_null_refit() -> dict | None:
