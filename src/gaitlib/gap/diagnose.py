@@ -775,10 +775,10 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
         located gap has that model's own residual on the reference subtracted; the top
         effect must also beat every candidate's ΔBIC on the reference's null draws
         (:func:`null_calibration`, :data:`gaitlib.gap.method.RELATIVE`).
-        ``settings["reference"]["null_calibration"]`` holds them.
+        ``settings["reference"]`` names the reference, its fit and the null calibration;
+        :attr:`Diagnosis.reference_fit` is that fit.
     calibration : a ``null_calibration`` of an earlier diagnosis against the same reference,
-        spec, candidates and subjects (checked), used instead of redoing it. ``settings["reference"]`` names the reference and
-        its fit; :attr:`Diagnosis.reference_fit` is that fit.
+        spec, candidates and subjects (checked), used instead of redoing it.
     **sweep_kw : ``scheduler``, ``n_workers``, ``serial``, ``progress`` of :func:`gaitlib.sweep.sweep`.
 
     Raises :class:`BaselineFailed` (with every start's IPOPT status) when no start of the
@@ -814,7 +814,9 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
             all_fits = candidate_fits(spec0, {"data": ds}, {"data": base_sol}, names, objective=objective, root=root,
                                       use_cache=use_cache, alternates=alternates_of(b), scheduler=scheduler, **kw)
         else:
-            names = [n for n in names if n in candidates(spec0, ref.gait, names)[0]]
+            for n, why in candidates(spec0, ref.gait, names)[1].items():  # both data sets must admit it
+                skipped[n] = f"the reference: {why}"
+            names = [n for n in names if n not in skipped]
             # the reference: every candidate fitted as in an absolute diagnosis (every start) …
             ref_fits = candidate_fits(spec0, {"reference": ref}, {"reference": ref_fit}, names, objective=objective,
                                       root=root, use_cache=use_cache, alternates=alternates_of(rb),
