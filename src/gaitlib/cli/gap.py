@@ -206,8 +206,8 @@ def add_parsers(sub) -> None:
     g.add_argument("--speed-class", default=None, help="the speed class to diagnose if the CSV has several "
                                                        "(VerySlow|Slow|Free|Fast|VeryFast)")
     g.add_argument("--reference", default=None,
-                   help="a reference tidy CSV of the same speed class: diagnose the change from it (the baseline's "
-                        "fit of the reference + (data - reference)) instead of the whole gap")
+                   help="a reference tidy CSV of the same speed class: diagnose the change from it (each model's "
+                        "own residual on the reference subtracted; gaitlib.gap.reference) instead of the whole gap")
     g.add_argument("--reference-n-subjects", type=int_at_least(1), default=None,
                    help="subjects behind the reference's means (as --n-subjects)")
     g.add_argument("--allow-no-sd", action="store_true", help="accept curves whose SD is 0 everywhere: tracked, "

@@ -10,24 +10,26 @@ marker protocol and another, before and after a plate recalibration.
 
 Relative data
 -------------
-With R the reference data, N the new data, S_R the baseline model's fit of R and F(·) any
-model's fit of N, the *located* gap is taken against
+With R the reference data, N the new data and, for each model k (the baseline and every
+candidate), F_k(R) its fit of R (the absolute diagnosis's fits, every start) and F_k(N) its
+fit of N *continued from F_k(R)* (one warm start: the same basin, so the two fits differ by
+the change, not by the local optimum a multistart lands in), model k's located gap is
 
-    N' = N + (S_R − R)
+    [F_k(N) − N_k] − [F_k(R) − R_k]
 
 channel by channel on the data's time grid, as the gait problem tracks them (the hip as
 the thigh in the laboratory, :func:`gaitlib.problems.gait.tracking_data`; model units), with
-N's SD — i.e. each residual F − N has the reference fit's own residual S_R − R subtracted.
-Every fit is still a fit of N (the same NLP, data and cache entries as the absolute
-diagnosis); only the located gap, so the RSS, ΔBIC and ranking, is relative. So when
-nothing changed (N = R) the baseline's relative gap is zero; when N is R with an effect
-the library represents exactly (a marker offset c), the effect's fit reads N − c = R and
-gives S_R back, a relative gap of zero again; the model's own misfit to R, which swamps
-a middle-sized laboratory effect in the absolute diagnosis, cancels. A data-model effect
-(offset, plate bias, left-leg shift) adjusts N before the background is added, as it
-would the data alone. The sampling error of a difference of two independent group means
-of n_N and n_R subjects is SD·√(1/n_N + 1/n_R), so N' has
-``n = round(1 / (1/n_N + 1/n_R))`` subjects.
+N's SD; N_k, R_k are the data as model k reads them at its parameters on each (a data-model
+effect — offset, plate bias, left-leg shift — adjusts the data before the background
+F_k(R) − R_k is subtracted). Implemented as a background added to N where the gap is
+located (:func:`relative_data`, :attr:`gaitlib.gap.io.DataSet.background`); the fits never
+see it. So when nothing changed the baseline's relative gap is its response to sampling
+error; when N is R with an effect the library represents exactly (a marker offset c), that
+effect's fit reads N − c = R and continues to F_k(R), a relative gap of zero; the model's
+own misfit to R, which swamps a middle-sized laboratory effect in the absolute diagnosis,
+cancels. Each candidate's parameter change from R to N is reported. The sampling error of a
+difference of two independent group means of n_N and n_R subjects is SD·√(1/n_N + 1/n_R),
+so the relative data have ``n = round(1 / (1/n_N + 1/n_R))`` subjects.
 
 Null calibration
 ----------------
@@ -41,7 +43,7 @@ as the data are, and the top effect must also beat the lowest ΔBIC that any can
 reached on any draw (:func:`gaitlib.gap.diagnose.null_calibration`): a max-statistic test
 over the candidates at level 1/(K + 1).
 
-Assumptions, stated: the model's own misfit S_R − R does not change with the effect (first
+Assumptions, stated: the model's own misfit F_k(R) − R does not change with the effect (first
 order: an effect that changes the gait changes the misfit too); both data sets have the same
 time grid, cycle time and speed (a change of cadence is not a curve offset: refused with a
 one-line error). Channels the reference fit does not simulate (EMG for SK) get no background.
