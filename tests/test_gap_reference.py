@@ -145,7 +145,7 @@ def test_a_null_draw_is_the_reference_plus_its_sampling_error(ref):
 def test_the_relative_method_names_itself_and_the_absolute_one():
     from gaitlib.gap import method as M
 
-    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 1
+    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 2 and M.RELATIVE.reference_rounds >= 1
     h = M.RELATIVE.hash()
     assert len(h) == 16 and h != M.METHOD.hash()
     assert M.RelativeMethod(null_draws=3).hash() != h
@@ -166,3 +166,68 @@ def test_a_calibration_of_another_reference_is_refused(ref, monkeypatch):
     bad = {"relative_method_hash": "x" * 16}
     with pytest.raises(ValueError, match="another relative_method_hash"):
         D.diagnose(ref, reference=ref, calibration=bad, serial=True)
+
+
+class _Sol:
+    def __init__(self, objective, tag, status="Solve_Succeeded"):
+        self.stats = {"status": status, "objective": objective, "effects": {}}
+        self.tag = tag
+
+
+def test_the_reference_fit_is_made_self_consistent(ref, monkeypatch):
+    """consistent_fits on made-up solves: each model's reference fit is re-solved from its
+    data fit and replaced only when lower by more than the margin; the data are then
+    continued again and the lower data fit kept; a second round re-solves only the models
+    whose data fit moved; a profile candidate is never re-solved."""
+    from gaitlib.gap import method as M
+
+    R_ = {"baseline": _Sol(1.0, "R0"), "knee_offset": _Sol(0.9, "Rk"), "hip_offset": _Sol(0.8, "Rh"),
+          "ankle_offset": _Sol(0.7, "Ra")}
+    N_ = {"baseline": _Sol(2.0, "N0"), "knee_offset": _Sol(1.9, "Nk"), "hip_offset": _Sol(1.8, "Nh"),
+          "ankle_offset": _Sol(1.7, "Na")}
+    # what a solve returns: (R or N side, model, round) → objective
+    table = {("R", "baseline", 1): 0.95, ("N", "baseline", 1): 1.99,   # both lower: moved, then round 2
+             ("R", "baseline", 2): 0.95,                                # round 2: the same optimum
+             ("R", "knee_offset", 1): 0.85, ("N", "knee_offset", 1): 1.95,  # reference lower, data not
+             ("R", "hip_offset", 1): 0.81,                              # higher: kept
+             ("R", "ankle_offset", 1): 0.7 * (1 - 1e-8)}                # within the margin: kept
+    calls = []
+
+    def fake_solve_many(groups, **kw):
+        out = {}
+        for g, (spec, jobs) in groups.items():
+            side = "R" if g.startswith("consistency-R-") else "N"
+            m = g.split("-", 2)[2]
+            rnd = 1 + sum(1 for c in calls if c[:2] == (side, m))
+            calls.append((side, m, rnd))
+            assert [e for e, _ in spec.effects] == ([] if m == "baseline" else [m])
+            for key, gait, warm in jobs:
+                assert warm is not None
+                out[key] = _Sol(table[(side, m, rnd)], f"{side}{m}{rnd}")
+        return out
+
+    monkeypatch.setattr(D, "solve_many", fake_solve_many)
+    monkeypatch.setattr(D.locate, "locate", lambda *a, **k: None)
+    names = ["knee_offset", "hip_offset", "ankle_offset", "co_contraction"]
+    fit = lambda n, s: D.Fit(n, s, {}, None, 1, "nlp", "Solve_Succeeded", True)  # noqa: E731
+    ref_fits = {n: fit(n, R_[n]) for n in names[:3]}
+    fits = {"data": {n: fit(n, N_[n]) for n in names[:3]}}
+    spec0 = D.base_spec(dict(n_intervals=4, degree=2))
+    out = D.consistent_fits(spec0, ref, R_["baseline"], ref_fits, {"data": ref}, {"data": N_["baseline"]}, fits,
+                            names, method=M.RelativeMethod(reference_rounds=2))["data"]
+    assert out["ref_fit"].tag == "Rbaseline1" and out["base"].tag == "Nbaseline1"
+    assert out["ref_fits"]["knee_offset"].solution.tag == "Rknee_offset1"
+    assert out["ref_fits"]["knee_offset"].start == "data"
+    assert out["fits"]["knee_offset"].solution is N_["knee_offset"]  # its continuation was not lower
+    assert out["ref_fits"]["hip_offset"].solution is R_["hip_offset"]
+    assert out["ref_fits"]["ankle_offset"].solution is R_["ankle_offset"]
+    assert out["moved"] == {"baseline": {"reference": [1.0, 0.95], "data": [2.0, 1.99]},
+                            "knee_offset": {"reference": [0.9, 0.85]}}
+    assert sorted(calls) == sorted([("R", "baseline", 1), ("R", "knee_offset", 1), ("R", "hip_offset", 1),
+                                    ("R", "ankle_offset", 1), ("N", "baseline", 1), ("N", "knee_offset", 1),
+                                    ("R", "baseline", 2)])
+    assert ref_fits["knee_offset"].solution is R_["knee_offset"]  # the caller's fits are not changed
+    calls.clear()
+    off = D.consistent_fits(spec0, ref, R_["baseline"], ref_fits, {"data": ref}, {"data": N_["baseline"]}, fits,
+                            names, method=M.RelativeMethod(reference_rounds=0))["data"]
+    assert calls == [] and off["ref_fit"] is R_["baseline"] and off["moved"] == {}

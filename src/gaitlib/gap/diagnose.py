@@ -83,7 +83,7 @@ __all__ = ["BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "Fit", "Diagnosis", 
            "candidates", "base_spec", "as_dataset", "baseline_fits", "pick_best", "BASELINE_STARTS",
            "COARSE_MESH", "GRF_SD_FACTOR", "RETRY_MARGIN", "grf_weighted", "candidate_fits", "needs_retry",
            "alternates_of", "lowest_objective", "BaselineFailed", "nesting", "ABOVE_LOCATED", "FIT_STARTS",
-           "with_effects", "contenders_of", "relative_fits",
+           "with_effects", "contenders_of", "relative_fits", "consistent_fits",
            "null_calibration"]
 
 
@@ -477,8 +477,10 @@ GRF_SD_FACTOR = 0.1
 #: Where a candidate's kept fit started (``Fit.start``): ``"baseline"`` the kept baseline fit
 #: (the first solve; profiled effects); one of :data:`BASELINE_STARTS` the baseline's fit
 #: from that start (the retry); ``"null"`` the null start (:mod:`gaitlib.gap.nullstart`);
-#: ``"baseline (no re-solve)"`` comparison-only effects.
-FIT_STARTS = ("baseline", *BASELINE_STARTS, "null", "baseline (no re-solve)")
+#: ``"baseline (no re-solve)"`` comparison-only effects; in a relative diagnosis
+#: (:func:`consistent_fits`) ``"data"`` a fit of the reference re-solved from the model's fit
+#: of the data, ``"reference (consistent)"`` a fit of the data continued again from it.
+FIT_STARTS = ("baseline", *BASELINE_STARTS, "null", "baseline (no re-solve)", "data", "reference (consistent)")
 #: A nested candidate (its null parameters are the baseline model) whose fit ends with an
 #: objective above the baseline fit's by more than this relative margin has stopped in a
 #: worse local optimum; :func:`candidate_fits` then re-solves it from the baseline's other
@@ -833,7 +835,15 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
             warms = {"data": {n: f.solution for n, f in ref_fits.items() if f.solution is not None}}
             all_fits = candidate_fits(spec0, {"data": ds}, {"data": base_sol}, names, objective=objective, root=root,
                                       use_cache=use_cache, warms=warms, scheduler=scheduler, **kw)
-            all_fits["reference"] = ref_fits
+            # the self-consistent reference fit (RELATIVE.reference_rounds): each model's
+            # reference fit re-solved from its data fit, the lower kept, the data continued again
+            cons = consistent_fits(spec0, ref, ref_fit, ref_fits, {"data": ds}, {"data": base_sol}, all_fits, names,
+                                   objective=objective, root=root, use_cache=use_cache, scheduler=scheduler,
+                                   **kw)["data"]
+            base_sol, all_fits["data"], all_fits["reference"] = cons["base"], cons["fits"], cons["ref_fits"]
+            ref_info["moved"] = cons["moved"]
+            ref_info["consistent_fit"] = _stats(cons["ref_fit"])
+            ref_fit_multistart, ref_fit = ref_fit, cons["ref_fit"]
             n_rel = gref.relative_n(ds.n, ref.n)
             if calibration is not None:  # computed before for this reference: checked, not redone
                 want = {"relative_method_hash": RELATIVE.hash(), "reference_signature": ref.signature,
@@ -843,7 +853,8 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
                     raise ValueError(f"calibration= was made for another {', '.join(bad)}: not this diagnosis's")
                 calib = calibration
             else:
-                calib = null_calibration(spec0, ref, ref_fit, ref_fits, names, n_rel, warms, objective=objective,
+                calib = null_calibration(spec0, ref, ref_fit_multistart, ref_fits, names, n_rel, warms,
+                                         objective=objective,
                                          root=root, use_cache=use_cache, scheduler=scheduler,
                                          **kw) if RELATIVE.null_draws > 0 else None
     fits = all_fits["data"]
@@ -881,15 +892,17 @@ def null_calibration(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, names, n:
     bases = baseline_fits(spec0, draws, ref_fit, starts=("warm",), **kw)
     ok = {k: v for k, v in draws.items() if bases[k] is not None}
     nf = candidate_fits(spec0, ok, bases, names, warms={k: warms["data"] for k in ok}, **kw) if ok else {}
+    cons = consistent_fits(spec0, ref, ref_fit, ref_fits, ok, bases, nf, names, method=method, **kw) if ok else {}
     best, per = [], []
     for k, dk in draws.items():
         if bases[k] is None:
             best.append({"draw": k, "effect": "baseline failed", "dBIC": None})
             per.append({})
             continue
-        rel = gref.relative_data(dk, ref, ref_fit)
-        d = assemble(rel, spec0, bases[k], relative_fits(nf[k], ref_fits, rel, ref, bases[k]), objective=objective,
-                     resamples=0)
+        c = cons[k]
+        rel = gref.relative_data(dk, ref, c["ref_fit"])
+        d = assemble(rel, spec0, c["base"], relative_fits(c["fits"], c["ref_fits"], rel, ref, c["base"]),
+                     objective=objective, resamples=0)
         r = d.ranking[d.ranking["ok"].astype(bool) & np.isfinite(d.ranking["dBIC"].astype(float))]
         per.append({str(e): float(v) for e, v in zip(r["effect"], r["dBIC"])})
         best.append({"draw": k, "effect": str(r.iloc[0]["effect"]) if len(r) else None,
@@ -899,7 +912,92 @@ def null_calibration(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, names, n:
             "candidates": list(names), "draws": method.null_draws, "seeds": seeds, "n_subjects": n, "best": best,
             "dBIC": per,
             "lowest_dBIC": min(vals) if vals else None,
-            "baseline_failed": [b["draw"] for b in best if b["effect"] == "baseline failed"]}
+            "baseline_failed": [b["draw"] for b in best if b["effect"] == "baseline failed"],
+            "moved": {k: c["moved"] for k, c in cons.items()}}
+
+
+def _better(new, old, margin: float) -> bool:
+    """``new`` converged with an objective below ``old``'s by more than ``margin`` (relative);
+    any converged ``new`` is better than a missing or non-converged ``old``."""
+    if new is None or not _status(new)[1]:
+        return False
+    if old is None or not _status(old)[1]:
+        return True
+    f0 = float(old.stats["objective"])
+    return float(new.stats["objective"]) < f0 - margin * abs(f0)
+
+
+def consistent_fits(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, datasets: dict, bases: dict, fits: dict,
+                    names, *, method=None, **kw) -> dict:
+    """The self-consistent reference fit of a relative diagnosis
+    (:class:`gaitlib.gap.method.RelativeMethod` ``reference_rounds``).
+
+    For every data set (key → DataSet, with its baseline fit ``bases[key]`` and candidate fits
+    ``fits[key]``, both continued from the reference's fits ``ref_fit``/``ref_fits``), each
+    model's fit of the reference is re-solved from its fit of the data — the baseline and
+    every NLP-identified candidate (a profile candidate keeps its grid fits). Where that
+    reaches a lower objective on the reference by more than ``method.consistency_margin``
+    (relative), it replaces the model's fit of the reference *for that data set*, and the
+    data are continued again from it; the lower of the two data fits is kept. A further
+    round re-solves only the models whose data fit moved.
+
+    Returns key → ``{"ref_fit", "ref_fits", "base", "fits", "moved"}``: the baseline's and
+    the candidates' fits of the reference and of the data after the rounds, and per model
+    that moved, ``{"reference": [objective before, after], "data": [before, after]}``."""
+    method = method or RELATIVE
+    margin = method.consistency_margin
+    nlp = [n for n in names if effects_mod.EFFECTS[n].resolve and effects_mod.EFFECTS[n].identify == "nlp"]
+    out = {k: {"ref_fit": ref_fit, "ref_fits": dict(ref_fits), "base": bases.get(k), "fits": dict(fits.get(k) or {}),
+               "moved": {}} for k in datasets}
+
+    def spec_of(m):
+        return spec0 if m == "baseline" else with_effects(spec0, ((m, None),))
+
+    def data_sol(o, m):
+        return o["base"] if m == "baseline" else (o["fits"][m].solution if o["fits"].get(m) is not None else None)
+
+    def ref_sol(o, m):
+        return o["ref_fit"] if m == "baseline" else (o["ref_fits"][m].solution if o["ref_fits"].get(m) is not None
+                                                     else None)
+
+    todo = {(k, m) for k in datasets for m in ["baseline", *nlp]}
+    for _ in range(method.reference_rounds):
+        groups: dict = {}
+        for k, m in sorted(todo):
+            if data_sol(out[k], m) is not None and ref_sol(out[k], m) is not None:
+                groups.setdefault(m, (spec_of(m), []))[1].append((f"{k}|{m}", ref.gait, data_sol(out[k], m)))
+        res = solve_many({f"consistency-R-{m}": g for m, g in groups.items()}, **kw) if groups else {}
+        again: dict = {}
+        for k, m in sorted(todo):
+            new, o = res.get(f"{k}|{m}"), out[k]
+            if not _better(new, ref_sol(o, m), margin):
+                continue
+            o["moved"].setdefault(m, {})["reference"] = [float(ref_sol(o, m).stats["objective"]),
+                                                         float(new.stats["objective"])]
+            if m == "baseline":
+                o["ref_fit"] = new
+            else:
+                o["ref_fits"][m] = _nlp_fit(m, new, ref)
+                o["ref_fits"][m].start = "data"
+            again.setdefault(m, (spec_of(m), []))[1].append((f"{k}|{m}", datasets[k].gait, new))
+        res = solve_many({f"consistency-N-{m}": g for m, g in again.items()}, **kw) if again else {}
+        todo = set()
+        for m, (_, jobs) in again.items():
+            for key, _, _ in jobs:
+                k = key.rsplit("|", 1)[0]
+                new, o = res.get(key), out[k]
+                if not _better(new, data_sol(o, m), margin):
+                    continue
+                o["moved"][m]["data"] = [float(data_sol(o, m).stats["objective"]), float(new.stats["objective"])]
+                if m == "baseline":
+                    o["base"] = new
+                else:
+                    o["fits"][m] = _nlp_fit(m, new, datasets[k])
+                    o["fits"][m].start = "reference (consistent)"
+                todo.add((k, m))
+        if not todo:
+            break
+    return out
 
 
 def relative_fits(fits: dict, ref_fits: dict, ds: gio.DataSet, ref: gio.DataSet, base_sol) -> dict:

@@ -31,6 +31,15 @@ cancels. Each candidate's parameter change from R to N is reported. The sampling
 difference of two independent group means of n_N and n_R subjects is SD·√(1/n_N + 1/n_R),
 so the relative data have ``n = round(1 / (1/n_N + 1/n_R))`` subjects.
 
+Self-consistent reference fits
+------------------------------
+A multistart does not always find the reference's best basin, and the continuation from it
+can move into a better one on a small data change: the relative gap then carries a change of
+the fit, not of the data (Chapter 8: re-solved from a null draw's fit, the reference reached
+a lower objective than its kept fit in 2 of 4 draws). So each model's F_k(R) is re-solved
+from its F_k(N); where that is lower it replaces F_k(R) for this data set and N is continued
+again from it (:func:`gaitlib.gap.diagnose.consistent_fits`, RELATIVE ``reference_rounds``).
+
 Null calibration
 ----------------
 On this clean background a free parameter absorbs a share of pure sampling error that the
