@@ -434,6 +434,8 @@ def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_clas
                     calib = d.settings["reference"]["null_calibration"]  # the same reference: once
                     s = _summary(d, c["expected"])
                     s["threshold_used"] = d.settings.get("threshold_used")
+                    # the models whose reference fit the self-consistency moved (RELATIVE.reference_rounds)
+                    s["reference_moved"] = sorted(d.settings["reference"].get("moved") or {})
                     # on relative data the whole baseline RSS is the change (+ sampling error),
                     # as % of the reference's own gap; unrefit: at the reference's fit
                     added, gap0 = s["rss_baseline"], d.settings["reference"]["rss_reference"]
