@@ -454,3 +454,19 @@ def test_a_null_draw_named_says_how_small_its_change_was():
                                           "large: hat_com -324 (72 %) vs hip_offset -325 (72 %).")
     tie = wrong.assign(rank1="hip_offset", rank2="hat_com", rank2_dBIC=-324.2, rank2_pct=71.6)
     assert "hip_offset large: hip_offset first at -325 (72 %), hat_com at -324 (72 %)" in G._against_expected(tie)
+
+
+def test_consistency_lines_count_the_moved_reference_fits_by_hand():
+    """The self-consistent reference fit's sentence, from a made-up calibration and cases:
+    2 of 3 draws moved (one the baseline's), 3 model fits lowered by 1–10 %, 1 of 2 cases."""
+    from gaitlib.studies import gap as G
+
+    calib = {"moved": {"null0": {"baseline": {"reference": [1.0, 0.99], "data": [2.0, 1.9]},
+                                 "knee_offset": {"reference": [1.0, 0.9]}},
+                       "null1": {}, "null2": {"knee_offset": {"reference": [0.5, 0.475]}}}}
+    rows = V.pd.DataFrame([{"set": "null", "reference_moved": ["baseline"]}, {"set": "null", "reference_moved": []}])
+    (line,) = G.consistency_lines(V.Validation(rows, {"null_calibration": calib}, {"relative": True}))
+    assert "lower objective in 2 of 3 null draws (1 of them the baseline's; 3 model fits in all: knee_offset ×2, " \
+           "baseline ×1), lower by 1–10 %; in 1 of 2 validation cases (1 of them the baseline's)." in line
+    (old,) = G.consistency_lines(V.Validation(rows, {"null_calibration": {"draws": 9}}, {"relative": True}))
+    assert old.startswith("(no self-consistent reference fit")

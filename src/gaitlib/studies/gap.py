@@ -57,7 +57,7 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
            "VALIDATION_RUNS", "stored_validation", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
            "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines",
-           "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines",
+           "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines", "consistency_lines",
            "stored_reference_basin", "reference_basin_lines", "REFERENCE_BASIN_FILE"]
 
 #: Baseline of the twin study: SK, data tracking (Eq 4.11), 10 × 3 LGR — the coarse mesh (the full 20 × 5 mesh costs ≈ 10× per solve and the twin study
@@ -389,7 +389,7 @@ def stored_validation(name: str = "real") -> gval.Validation:
 
 #: A validation made by an earlier method, kept as the "before" of a method change:
 #: folder under ``gap_validation`` → the method revision that made it.
-SUPERSEDED_VALIDATIONS = {"real_rev1": 1, "relative_rev0": 0}
+SUPERSEDED_VALIDATIONS = {"real_rev1": 1, "relative_rev0": 0, "relative_rev1": 1}
 
 
 def superseded_validation(name: str = "real_rev1") -> gval.Validation:
@@ -658,6 +658,33 @@ def calibration_lines(rel: gval.Validation) -> list[str]:
     return out
 
 
+def consistency_lines(rel: gval.Validation) -> list[str]:
+    """What the self-consistent reference fit (relative method revision 2,
+    :func:`gaitlib.gap.diagnose.consistent_fits`) did in a relative validation, every number
+    from its stored result: in how many null-calibration draws and validation cases a model's
+    fit of the reference moved to a lower objective, which models, by how much."""
+    c = (rel.unedited or {}).get("null_calibration") or {}
+    moved = c.get("moved")
+    if moved is None:
+        return ["(no self-consistent reference fit in this validation: relative method revision < 2)"]
+    drops = [100.0 * (1.0 - m["reference"][1] / m["reference"][0]) for d in moved.values() for m in d.values()
+             if m.get("reference") and m["reference"][0]]
+    models = pd.Series([k for d in moved.values() for k in d]).value_counts()
+    n_draw = sum(1 for d in moved.values() if d)
+    out = (f"The self-consistent reference fit: re-solved from each model's fit of the draw, a model's fit of the "
+           f"reference reached a lower objective in {n_draw} of {len(moved)} null draws "
+           f"({sum(1 for d in moved.values() if 'baseline' in d)} of them the baseline's; {len(drops)} model fits in "
+           f"all: " + (", ".join(f"{m} ×{k}" for m, k in models.items()) if len(models) else "none") + ")")
+    if drops:
+        out += f", lower by {min(drops):.2g}–{max(drops):.2g} %"
+    r = rel.rows
+    if "reference_moved" in r.columns:
+        mv = r["reference_moved"].apply(lambda x: list(x) if isinstance(x, (list, tuple)) else [])
+        out += (f"; in {int((mv.str.len() > 0).sum())} of {len(r)} validation cases "
+                f"({int(mv.apply(lambda x: 'baseline' in x).sum())} of them the baseline's)")
+    return [out + "."]
+
+
 def visibility_text(v: gval.Validation) -> str:
     """Why injections are (not) named, from ``v``'s independent set: the RSS each adds to the
     baseline fit (% of the unedited data's), for the cases named right and the others;
@@ -764,12 +791,20 @@ REFERENCE_BASIN_FILE = "reference_basin.json"
 
 
 def stored_reference_basin() -> dict | None:
-    """``benchmarks/gap_reference_basin.py``'s result (:func:`stored_experiment`), refused
-    too if made under another relative method."""
+    """``benchmarks/gap_reference_basin.py``'s result (:func:`stored_experiment`): an
+    experiment on the stored validation it names (``"validation"``: the superseded
+    ``relative_rev1``, whose false name it explains and which the self-consistent reference
+    fit of revision 2 answers), refused if made under another relative method than that
+    validation's."""
     r = stored_experiment(f"gap_validation/{REFERENCE_BASIN_FILE}", "gap_reference_basin.py")
-    if r is not None and r.get("relative_method_hash") != gap_method.RELATIVE.hash():
-        raise RuntimeError(f"{REFERENCE_BASIN_FILE}: made under relative method {r.get('relative_method_hash')}, it "
-                           f"is now {gap_method.RELATIVE.hash()}: rerun benchmarks/gap_reference_basin.py")
+    if r is None:
+        return r
+    name = r.get("validation", "relative")
+    v = superseded_validation(name) if name in SUPERSEDED_VALIDATIONS else stored_validation(name)
+    if r.get("relative_method_hash") != v.settings.get("relative_method_hash"):
+        raise RuntimeError(f"{REFERENCE_BASIN_FILE}: made under relative method {r.get('relative_method_hash')}, the "
+                           f"validation {name} under {v.settings.get('relative_method_hash')}: rerun "
+                           f"benchmarks/gap_reference_basin.py")
     return r
 
 
