@@ -63,7 +63,26 @@ def test_the_reference_fit_has_no_gap_relative_to_its_own_data(ref):
     assert set(loc.channels["name"]) >= {"hip_r", "knee_l", "ankle_r", "grf_y_l"}
     assert np.allclose(loc.points["z"], 0.0, atol=1e-9)
     assert L.locate(sim, ref).rss > 1.0  # without the background: the fake fit's misfit
-    assert R.offset_channels(ref.gait, sim) == CHANNELS
+    assert R.offset_channels(ref.gait, sim) == CHANNELS + ["pelvis_tilt"]
+    assert R.offset_channels(ref.gait, sim, tilt=False) == CHANNELS
+
+
+def test_the_hat_tilt_is_located_only_relative_to_a_reference(ref):
+    """Relative, the HAT tilt is a located channel (side "-", the right leg's phases): a fit
+    whose HAT tilts by Δ more than the reference's fit, on unchanged data, shows z = Δ/SD*
+    there and nowhere else; absolute (no background) it is not located, and without
+    ``tilt`` it carries no background."""
+    sim = _fake_fit(CHANNELS)
+    rel = R.relative_data(ref, ref, sim)
+    tilted = sim.copy()
+    tilted["pelvis_tilt"] += 0.05
+    pts = L.locate(tilted, rel).points
+    tilt = pts["channel"] == "angle:pelvis_tilt"
+    assert tilt.sum() == L.N_GRID and set(pts.loc[tilt, "side"]) == {"-"}
+    assert np.allclose(pts.loc[tilt, "z"], 0.05 / pts.loc[tilt, "sd_eff"], atol=1e-9)
+    assert np.allclose(pts.loc[~tilt, "z"], 0.0, atol=1e-9)
+    assert "angle:pelvis_tilt" not in set(L.locate(tilted, ref).points["channel"])
+    assert "pelvis_tilt" not in R.background(ref, sim, tilt=False).columns
 
 
 def test_background_is_the_fits_residual_by_hand(ref):
@@ -145,7 +164,7 @@ def test_a_null_draw_is_the_reference_plus_its_sampling_error(ref):
 def test_the_relative_method_names_itself_and_the_absolute_one():
     from gaitlib.gap import method as M
 
-    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 2 and M.RELATIVE.reference_rounds >= 1
+    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 3 and M.RELATIVE.tilt_channel and M.RELATIVE.reference_rounds >= 1
     h = M.RELATIVE.hash()
     assert len(h) == 16 and h != M.METHOD.hash()
     assert M.RelativeMethod(null_draws=3).hash() != h

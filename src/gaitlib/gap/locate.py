@@ -3,7 +3,7 @@ where the simulation leaves the data's ±1 SD band.
 
 Channels (each leg): joint angles (hip as the thigh's angle in the laboratory — data hip
 + data pelvic tilt — as the gait problem tracks it), net joint torques, GRFs (anterior,
-vertical) and, for solutions with muscle-level outputs, EMG: NMSK excitations e(t), MSK
+vertical), in a change relative to a reference the HAT tilt (:data:`RELATIVE_ONLY`) and, for solutions with muscle-level outputs, EMG: NMSK excitations e(t), MSK
 generator activations (the muscle's generator, thesis Table 5.5), against the data's EMG
 envelope of the same muscle (:data:`gaitlib.activation.EMG_CHANNELS`; Schwartz 2008: RF, BF
 ↔ lateral hamstrings, GAM ↔ medial gastrocnemius, TA).
@@ -66,7 +66,7 @@ from ..validity import RESIDUAL_FORCE_FRACTION, RESIDUAL_MOMENT_FRACTION
 
 __all__ = ["PHASES", "PHASE_NAMES", "N_GRID", "phase_edges", "phase_of", "sim_channels", "Located", "locate",
            "resels", "periodic", "ALPHA", "SD_FLOOR", "residual_thresholds", "residual_table",
-           "COM_HEIGHT_FRACTION"]
+           "COM_HEIGHT_FRACTION", "RELATIVE_ONLY"]
 
 PHASES = ("LR", "MSt/TSt", "PSw", "ISw", "MSw", "TSw")
 #: COM height as a fraction of body height in standing (as :func:`gaitlib.validity.check`'s
@@ -78,6 +78,14 @@ N_GRID = 50
 ALPHA = 0.05
 SD_FLOOR = 0.1
 KINDS = ("angle", "torque", "grf", "emg")
+#: Channels located only against a background that carries them (a change relative to a
+#: reference, :mod:`gaitlib.gap.reference`): the HAT's tilt against the data's pelvic tilt.
+#: Absolute, the model's upright HAT against the data's ≈ 11° forward pelvis is a constant
+#: misfit of the model (why the hip is tracked as the thigh in the laboratory); relative, that
+#: constant cancels and the tilt's *change* is located — without it a hip-angle offset and a
+#: HAT COM offset are the same change on the located channels (the HAT tilts by the offset,
+#: its COM kept over the hips).
+RELATIVE_ONLY = ("pelvis_tilt",)
 UNITS = {"angle": "rad", "torque": "N*m", "grf": "N", "emg": "1"}
 
 
@@ -155,15 +163,19 @@ def resels(z: np.ndarray) -> float:
     return float(np.clip(n / fwhm, 1.0, n))
 
 
-def _channels(gait, sim_cols, exclude=()) -> tuple[list, list]:
-    """(included, excluded) channel descriptors: dict(id, kind, name, side, col)."""
+def _channels(gait, sim_cols, exclude=(), extra=()) -> tuple[list, list]:
+    """(included, excluded) channel descriptors: dict(id, kind, name, side, col); ``extra``:
+    angle channels of neither leg (side ``"-"``, the right leg's phases), e.g. the HAT tilt
+    of a relative location (:data:`RELATIVE_ONLY`)."""
     inc, exc = [], []
     cand = [("angle", j, j) for j in gait_ocp.LEG_JOINTS] + [("torque", j, f"tau_{j}") for j in gait_ocp.LEG_JOINTS] \
         + [("grf", g, g) for g in gait_ocp.GRF_CHANNELS]
     emg_cols = sorted(c for c in sim_cols if c.startswith("emg_"))
     cand += [("emg", c[4:], c) for c in emg_cols]
+    cand += [("angle", c, c) for c in extra]
     for kind, name, col in cand:
-        d = {"id": f"{kind}:{name}", "kind": kind, "name": name, "side": name[-1], "col": col}
+        d = {"id": f"{kind}:{name}", "kind": kind, "name": name, "side": "-" if name in extra else name[-1],
+             "col": col}
         if col not in gait.mean.columns or col not in sim_cols:
             d["reason"] = "not in the data" if col not in gait.mean.columns else "not in the solution"
             exc.append(d)
@@ -255,7 +267,8 @@ def locate(sim, ds, thetas: dict | None = None, exclude=(), background=None) -> 
         view = dataclasses.replace(view, mean=mean)
     tau = np.arange(N_GRID) / N_GRID
     t_data = np.asarray(view.time, float) / float(view.cycle_time)
-    inc, exc = _channels(view, set(sim.columns), exclude)
+    extra = [c for c in RELATIVE_ONLY if background is not None and c in background.columns]
+    inc, exc = _channels(view, set(sim.columns), exclude, extra)
     tau_src = sim.index.to_numpy(float)
     rows, chans = [], []
     for ch in inc:

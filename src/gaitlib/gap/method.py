@@ -102,14 +102,21 @@ class RelativeMethod:
         (:func:`gaitlib.gap.diagnose.consistent_fits`). The null draws are fitted the same way.
     consistency_margin : relative objective decrease that counts as a better fit of the
         reference (below it, the same optimum reached again).
+    tilt_channel : locate the HAT's tilt against the data's pelvic tilt too
+        (:data:`gaitlib.gap.locate.RELATIVE_ONLY`): relative, the model's constant misfit of
+        the tilt cancels, and without it a hip-angle offset and a HAT COM offset are the same
+        change on the located channels (the HAT tilts by the offset, its COM kept over the
+        hips; revision 2's validation: ΔBIC equal to 0.1 in both hip-offset cases).
     revision : bumped when the relative diagnosis decides differently for a reason outside
-        these fields. 1: the null calibration; 2: the self-consistent reference fit.
+        these fields. 1: the null calibration; 2: the self-consistent reference fit; 3: the
+        HAT tilt located.
     """
 
     null_draws: int = 9
     reference_rounds: int = 2
     consistency_margin: float = 1e-6
-    revision: int = 2
+    tilt_channel: bool = True
+    revision: int = 3
 
     def to_dict(self) -> dict:
         return json.loads(json.dumps(asdict(self)))

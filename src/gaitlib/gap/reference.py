@@ -31,6 +31,15 @@ cancels. Each candidate's parameter change from R to N is reported. The sampling
 difference of two independent group means of n_N and n_R subjects is SD·√(1/n_N + 1/n_R),
 so the relative data have ``n = round(1 / (1/n_N + 1/n_R))`` subjects.
 
+The HAT tilt
+------------
+Relative, the located channels include the HAT's tilt against the data's pelvic tilt
+(:data:`gaitlib.gap.locate.RELATIVE_ONLY`; RELATIVE ``tilt_channel``): the model's upright
+HAT against the data's forward-tilted pelvis is a constant misfit that cancels in
+[F_k(N) − N] − [F_k(R) − R], and without the tilt a hip-angle offset and a HAT COM offset
+are the same change on the other channels (the HAT tilts by the offset with its COM kept
+over the hips; Chapter 8: ΔBIC equal to 0.1 in both hip-offset cases of revision 2).
+
 Self-consistent reference fits
 ------------------------------
 A multistart does not always find the reference's best basin, and the continuation from it
@@ -70,6 +79,7 @@ from .. import effects as effects_mod
 from ..problems import gait as gait_ocp
 from . import io as gio
 from . import locate
+from .method import RELATIVE
 from .noise import smooth_noise
 
 __all__ = ["relative_data", "relative_n", "check_same_grid", "offset_channels", "background", "null_draw",
@@ -99,25 +109,29 @@ def check_same_grid(ds: gio.DataSet, ref: gio.DataSet) -> None:
                          "needs the same speed class and time grid")
 
 
-def offset_channels(gait, sim) -> list:
+def offset_channels(gait, sim, tilt: bool | None = None) -> list:
     """The channels N' replaces: those the fit tracks or locates (angles, net torques, GRFs,
-    EMG) that both the data and the reference fit have."""
+    EMG) that both the data and the reference fit have, and (``tilt``, default
+    ``RELATIVE.tilt_channel``) the HAT tilt (:data:`gaitlib.gap.locate.RELATIVE_ONLY`),
+    which :func:`gaitlib.gap.locate.locate` then locates."""
+    tilt = RELATIVE.tilt_channel if tilt is None else tilt
     cols = [j for j in gait_ocp.LEG_JOINTS] + [f"tau_{j}" for j in gait_ocp.LEG_JOINTS] + list(gait_ocp.GRF_CHANNELS)
     cols += sorted(c for c in sim.columns if c.startswith("emg_"))
+    cols += list(locate.RELATIVE_ONLY) if tilt else []
     return [c for c in cols if c in gait.mean.columns and c in sim.columns]
 
 
-def background(ref: gio.DataSet, ref_fit, thetas: dict | None = None):
+def background(ref: gio.DataSet, ref_fit, thetas: dict | None = None, tilt: bool | None = None):
     """S_R − R (module docstring) on the reference's time grid, one column per
-    :func:`offset_channels` (model units, the tracked representation); ``thetas``: the
-    fit's effect parameters, for the data-model effects that change how R is read
-    (:func:`gaitlib.effects.adjust_data`)."""
+    :func:`offset_channels` (model units, the tracked representation; ``tilt`` as there);
+    ``thetas``: the fit's effect parameters, for the data-model effects that change how R
+    is read (:func:`gaitlib.effects.adjust_data`)."""
     sim = ref_fit if hasattr(ref_fit, "columns") else locate.sim_channels(ref_fit, ref.gait.source)
     g0 = effects_mod.adjust_data(ref.gait, thetas) if thetas else ref.gait
     view0 = gait_ocp.tracking_data(g0)
     t = np.asarray(view0.time, float) / float(view0.cycle_time)
     tau_src = sim.index.to_numpy(float)
-    cols = offset_channels(ref.gait, sim)
+    cols = offset_channels(ref.gait, sim, tilt)
     return pd.DataFrame({c: locate.periodic(tau_src, sim[c].to_numpy(), t) - view0.mean[c].to_numpy() for c in cols},
                         index=view0.mean.index)
 
