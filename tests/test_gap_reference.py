@@ -164,7 +164,7 @@ def test_a_null_draw_is_the_reference_plus_its_sampling_error(ref):
 def test_the_relative_method_names_itself_and_the_absolute_one():
     from gaitlib.gap import method as M
 
-    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 3 and M.RELATIVE.tilt_channel and M.RELATIVE.reference_rounds >= 1
+    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 4 and M.RELATIVE.tilt_channel and M.RELATIVE.reference_rounds >= 1
     h = M.RELATIVE.hash()
     assert len(h) == 16 and h != M.METHOD.hash()
     assert M.RelativeMethod(null_draws=3).hash() != h
@@ -233,7 +233,7 @@ def test_the_reference_fit_is_made_self_consistent(ref, monkeypatch):
     fits = {"data": {n: fit(n, N_[n]) for n in names[:3]}}
     spec0 = D.base_spec(dict(n_intervals=4, degree=2))
     out = D.consistent_fits(spec0, ref, R_["baseline"], ref_fits, {"data": ref}, {"data": N_["baseline"]}, fits,
-                            names, method=M.RelativeMethod(reference_rounds=2))["data"]
+                            names, method=M.RelativeMethod(reference_rounds=2, baseline_from_candidates=False))["data"]
     assert out["ref_fit"].tag == "Rbaseline1" and out["base"].tag == "Nbaseline1"
     assert out["ref_fits"]["knee_offset"].solution.tag == "Rknee_offset1"
     assert out["ref_fits"]["knee_offset"].start == "data"
@@ -248,5 +248,37 @@ def test_the_reference_fit_is_made_self_consistent(ref, monkeypatch):
     assert ref_fits["knee_offset"].solution is R_["knee_offset"]  # the caller's fits are not changed
     calls.clear()
     off = D.consistent_fits(spec0, ref, R_["baseline"], ref_fits, {"data": ref}, {"data": N_["baseline"]}, fits,
-                            names, method=M.RelativeMethod(reference_rounds=0))["data"]
+                            names, method=M.RelativeMethod(reference_rounds=0, baseline_from_candidates=False))["data"]
     assert calls == [] and off["ref_fit"] is R_["baseline"] and off["moved"] == {}
+
+
+def test_the_baseline_is_refitted_from_the_nested_candidates_fits(ref, monkeypatch):
+    """baseline_from_candidates: the baseline's data fit re-solved (baseline spec) from each
+    nested NLP candidate's converged data fit; the lowest replaces the continuation only if
+    lower by more than the margin, and its source is recorded."""
+    from gaitlib.gap import method as M
+
+    seen = []
+
+    def fake_solve_many(groups, **kw):
+        ((g, (spec, jobs)),) = groups.items()
+        assert g == "consistency-N-baseline-from" and spec.effects == ()
+        seen.extend(key for key, _, _ in jobs)
+        obj = {"data|knee_offset": 1.5, "data|hip_offset": 1.2, "other|knee_offset": 2.0 * (1 - 1e-9)}
+        return {key: _Sol(obj[key], key) for key, _, _ in jobs}
+
+    monkeypatch.setattr(D, "solve_many", fake_solve_many)
+    monkeypatch.setattr(D.locate, "locate", lambda *a, **k: None)
+    fit = lambda n, s: D.Fit(n, s, {}, None, 1, "nlp", "Solve_Succeeded", True)  # noqa: E731
+    fits = {"data": {"knee_offset": fit("knee_offset", _Sol(1.4, "k")), "hip_offset": fit("hip_offset", _Sol(1.1, "h")),
+                     "ankle_offset": fit("ankle_offset", _Sol(1.0, "a", "Maximum_Iterations_Exceeded"))},
+            "other": {"knee_offset": fit("knee_offset", _Sol(1.9, "k2"))}}
+    bases = {"data": _Sol(2.0, "N0"), "other": _Sol(2.0, "N1")}
+    spec0 = D.base_spec(dict(n_intervals=4, degree=2))
+    out = D.consistent_fits(spec0, ref, _Sol(1.0, "R0"), {}, {"data": ref, "other": ref}, bases, fits,
+                            ["knee_offset", "hip_offset", "ankle_offset", "co_contraction"],
+                            method=M.RelativeMethod(reference_rounds=0))
+    assert sorted(seen) == ["data|hip_offset", "data|knee_offset", "other|knee_offset"]  # not the unconverged one
+    assert out["data"]["base"].tag == "data|hip_offset"
+    assert out["data"]["moved"] == {"baseline": {"data": [2.0, 1.2], "data_from": "hip_offset"}}
+    assert out["other"]["base"] is bases["other"] and out["other"]["moved"] == {}  # within the margin

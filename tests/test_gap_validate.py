@@ -470,3 +470,16 @@ def test_consistency_lines_count_the_moved_reference_fits_by_hand():
            "baseline ×1), lower by 1–10 %; in 1 of 2 validation cases (1 of them the baseline's)." in line
     (old,) = G.consistency_lines(V.Validation(rows, {"null_calibration": {"draws": 9}}, {"relative": True}))
     assert old.startswith("(no self-consistent reference fit")
+
+
+def test_tie_lines_read_both_candidates_dbic_from_the_cases():
+    from gaitlib.studies import gap as G
+
+    rows = V.pd.DataFrame([
+        {"case": "h_m", "expected": "hip_offset", "band": "middle", "dBIC": {"hip_offset": -135.15, "hat_com": -135.05}},
+        {"case": "h_l", "expected": "hip_offset", "band": "large", "dBIC": {"hip_offset": -312.66, "hat_com": -312.62}},
+        {"case": "h_s", "expected": "hip_offset", "band": "small", "dBIC": {"hip_offset": 2.0, "hat_com": 40.0}},
+        {"case": "k_m", "expected": "knee_offset", "band": "middle", "dBIC": {"hip_offset": 0.0, "hat_com": 9.0}}])
+    (line,) = G.tie_lines(V.Validation(rows, {}, {"relative": True}))
+    assert line.startswith("In the 2 hip_offset injections at middle and large magnitudes, hat_com's ΔBIC differs "
+                           "from hip_offset's by at most 0.1 (h_m: -135.2 vs -135.1; h_l: -312.7 vs -312.6)")

@@ -939,7 +939,11 @@ def consistent_fits(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, datasets: 
     reaches a lower objective on the reference by more than ``method.consistency_margin``
     (relative), it replaces the model's fit of the reference *for that data set*, and the
     data are continued again from it; the lower of the two data fits is kept. A further
-    round re-solves only the models whose data fit moved.
+    round re-solves only the models whose data fit moved. First (``method.
+    baseline_from_candidates``), the baseline's fit of the data is re-solved from every
+    nested candidate's fit of it (:func:`_nested`: the baseline is a member of each) and the
+    lowest kept if lower than the continuation's — a baseline stopped in a worse optimum
+    than its own extensions reach would credit every candidate with closing the difference.
 
     Returns key → ``{"ref_fit", "ref_fits", "base", "fits", "moved"}``: the baseline's and
     the candidates' fits of the reference and of the data after the rounds, and per model
@@ -960,6 +964,20 @@ def consistent_fits(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, datasets: 
         return o["ref_fit"] if m == "baseline" else (o["ref_fits"][m].solution if o["ref_fits"].get(m) is not None
                                                      else None)
 
+    if method.baseline_from_candidates:
+        # the baseline's fit of the data from every nested candidate's (a member of each):
+        # the continuation from the reference's fit can stop in a worse optimum than they reach
+        jobs = [(f"{k}|{n}", datasets[k].gait, o["fits"][n].solution) for k, o in out.items() if o["base"] is not None
+                for n in nlp if _nested(effects_mod.EFFECTS[n]) and o["fits"].get(n) is not None
+                and _status(o["fits"][n].solution)[1]]
+        res = solve_many({"consistency-N-baseline-from": (spec0, jobs)}, **kw) if jobs else {}
+        for k, o in out.items():
+            tried = {n: res[f"{k}|{n}"] for n in nlp if res.get(f"{k}|{n}") is not None}
+            best = pick_best(list(tried.values()))
+            if _better(best, o["base"], margin):
+                o["moved"]["baseline"] = {"data": [float(o["base"].stats["objective"]), float(best.stats["objective"])],
+                                          "data_from": next(n for n, s in tried.items() if s is best)}
+                o["base"] = best
     todo = {(k, m) for k in datasets for m in ["baseline", *nlp]}
     for _ in range(method.reference_rounds):
         groups: dict = {}
@@ -988,7 +1006,8 @@ def consistent_fits(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, datasets: 
                 new, o = res.get(key), out[k]
                 if not _better(new, data_sol(o, m), margin):
                     continue
-                o["moved"][m]["data"] = [float(data_sol(o, m).stats["objective"]), float(new.stats["objective"])]
+                o["moved"][m]["data" if "data" not in o["moved"][m] else "data_again"] = [
+                    float(data_sol(o, m).stats["objective"]), float(new.stats["objective"])]
                 if m == "baseline":
                     o["base"] = new
                 else:

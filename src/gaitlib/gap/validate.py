@@ -435,7 +435,10 @@ def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_clas
                     s = _summary(d, c["expected"])
                     s["threshold_used"] = d.settings.get("threshold_used")
                     # the models whose reference fit the self-consistency moved (RELATIVE.reference_rounds)
-                    s["reference_moved"] = sorted(d.settings["reference"].get("moved") or {})
+                    mv = d.settings["reference"].get("moved") or {}
+                    s["reference_moved"] = sorted(m for m, x in mv.items() if "reference" in x)
+                    # the baseline's data fit from a candidate's (RELATIVE.baseline_from_candidates)
+                    s["baseline_from"] = (mv.get("baseline") or {}).get("data_from")
                     # on relative data the whole baseline RSS is the change (+ sampling error),
                     # as % of the reference's own gap; unrefit: at the reference's fit
                     added, gap0 = s["rss_baseline"], d.settings["reference"]["rss_reference"]

@@ -57,7 +57,7 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
            "VALIDATION_RUNS", "stored_validation", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
            "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines",
-           "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines", "consistency_lines",
+           "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines", "consistency_lines", "tie_lines",
            "stored_reference_basin", "reference_basin_lines", "REFERENCE_BASIN_FILE"]
 
 #: Baseline of the twin study: SK, data tracking (Eq 4.11), 10 × 3 LGR — the coarse mesh (the full 20 × 5 mesh costs ≈ 10× per solve and the twin study
@@ -389,7 +389,7 @@ def stored_validation(name: str = "real") -> gval.Validation:
 
 #: A validation made by an earlier method, kept as the "before" of a method change:
 #: folder under ``gap_validation`` → the method revision that made it.
-SUPERSEDED_VALIDATIONS = {"real_rev1": 1, "relative_rev0": 0, "relative_rev1": 1}
+SUPERSEDED_VALIDATIONS = {"real_rev1": 1, "relative_rev0": 0, "relative_rev1": 1, "relative_rev2": 2}
 
 
 def superseded_validation(name: str = "real_rev1") -> gval.Validation:
@@ -667,14 +667,15 @@ def consistency_lines(rel: gval.Validation) -> list[str]:
     moved = c.get("moved")
     if moved is None:
         return ["(no self-consistent reference fit in this validation: relative method revision < 2)"]
-    drops = [100.0 * (1.0 - m["reference"][1] / m["reference"][0]) for d in moved.values() for m in d.values()
-             if m.get("reference") and m["reference"][0]]
-    models = pd.Series([k for d in moved.values() for k in d]).value_counts()
-    n_draw = sum(1 for d in moved.values() if d)
+    ref_moved = {k: {m: x for m, x in d.items() if x.get("reference")} for k, d in moved.items()}
+    drops = [100.0 * (1.0 - m["reference"][1] / m["reference"][0]) for d in ref_moved.values() for m in d.values()
+             if m["reference"][0]]
+    models = pd.Series([k for d in ref_moved.values() for k in d]).value_counts()
+    n_draw = sum(1 for d in ref_moved.values() if d)
     out = (f"The self-consistent reference fit: re-solved from each model's fit of the draw, a model's fit of the "
            f"reference reached a lower objective in {n_draw} of {len(moved)} null draws "
-           f"({sum(1 for d in moved.values() if 'baseline' in d)} of them the baseline's; {len(drops)} model fits in "
-           f"all: " + (", ".join(f"{m} ×{k}" for m, k in models.items()) if len(models) else "none") + ")")
+           f"({sum(1 for d in ref_moved.values() if 'baseline' in d)} of them the baseline's; {len(drops)} model fits "
+           f"in all: " + (", ".join(f"{m} ×{k}" for m, k in models.items()) if len(models) else "none") + ")")
     if drops:
         out += f", lower by {min(drops):.2g}–{max(drops):.2g} %"
     r = rel.rows
@@ -682,7 +683,30 @@ def consistency_lines(rel: gval.Validation) -> list[str]:
         mv = r["reference_moved"].apply(lambda x: list(x) if isinstance(x, (list, tuple)) else [])
         out += (f"; in {int((mv.str.len() > 0).sum())} of {len(r)} validation cases "
                 f"({int(mv.apply(lambda x: 'baseline' in x).sum())} of them the baseline's)")
-    return [out + "."]
+    out = [out + "."]
+    frm = [d["baseline"]["data_from"] for d in moved.values() if (d.get("baseline") or {}).get("data_from")]
+    if "baseline_from" in r.columns or frm:
+        bf = r["baseline_from"].dropna() if "baseline_from" in r.columns else pd.Series(dtype=object)
+        cnt = pd.Series(frm + list(bf)).value_counts()
+        out.append(f"The baseline's fit of the data, re-solved from each nested candidate's, was lower than its "
+                   f"continuation in {len(frm)} of {len(moved)} null draws and {len(bf)} of {len(r)} validation cases"
+                   + (" (from " + ", ".join(f"{m} ×{k}" for m, k in cnt.items()) + ")." if len(cnt) else "."))
+    return out
+
+
+def tie_lines(v: gval.Validation, effect: str = "hip_offset", other: str = "hat_com") -> list[str]:
+    """How close ``other`` came to ``effect`` in the cases whose expected effect is
+    ``effect`` (middle and large), from each stored case's ΔBIC of every candidate."""
+    r = v.rows
+    r = r[(r["expected"] == effect) & r["band"].isin(["middle", "large"])]
+    pairs = [(c, d[effect], d[other]) for c, d in zip(r["case"], r["dBIC"])
+             if isinstance(d, dict) and effect in d and other in d]
+    if not pairs:
+        return [f"(no {effect} case with both {effect} and {other} ranked)"]
+    gap = max(abs(a - b) for _, a, b in pairs)
+    return [f"In the {len(pairs)} {effect} injections at middle and large magnitudes, {other}'s ΔBIC differs from "
+            f"{effect}'s by at most {gap:.2g} (" + "; ".join(f"{c}: {a:.1f} vs {b:.1f}" for c, a, b in pairs)
+            + f"), while the runner-up margin is {diagnose.RUNNER_UP_MARGIN:g}."]
 
 
 def visibility_text(v: gval.Validation) -> str:
