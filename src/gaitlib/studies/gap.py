@@ -389,7 +389,8 @@ def stored_validation(name: str = "real") -> gval.Validation:
 
 #: A validation made by an earlier method, kept as the "before" of a method change:
 #: folder under ``gap_validation`` → the method revision that made it.
-SUPERSEDED_VALIDATIONS = {"real_rev1": 1, "relative_rev0": 0, "relative_rev1": 1, "relative_rev2": 2}
+SUPERSEDED_VALIDATIONS = {"real_rev1": 1, "relative_rev0": 0, "relative_rev1": 1, "relative_rev2": 2,
+                          "relative_rev3": 3}
 
 
 def superseded_validation(name: str = "real_rev1") -> gval.Validation:
