@@ -48,6 +48,10 @@ the fit, not of the data (Chapter 8: re-solved from a null draw's fit, the refer
 a lower objective than its kept fit in 2 of 4 draws). So each model's F_k(R) is re-solved
 from its F_k(N); where that is lower it replaces F_k(R) for this data set and N is continued
 again from it (:func:`gaitlib.gap.diagnose.consistent_fits`, RELATIVE ``reference_rounds``).
+Before that, the baseline's F(N) is also re-solved from every nested candidate's F_k(N) and
+the lowest kept (RELATIVE ``baseline_from_candidates``): a baseline continuation stopped in
+a worse optimum than its own extensions reach would credit every candidate with the
+difference (Chapter 8, revision 3's null draws).
 
 Null calibration
 ----------------

@@ -58,7 +58,8 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "VALIDATION_RUNS", "stored_validation", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
            "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines",
            "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines", "consistency_lines", "tie_lines",
-           "stored_reference_basin", "reference_basin_lines", "REFERENCE_BASIN_FILE"]
+           "stored_reference_basin", "reference_basin_lines", "REFERENCE_BASIN_FILE", "stored_baseline_basin",
+           "baseline_basin_lines", "BASELINE_BASIN_FILE"]
 
 #: Baseline of the twin study: SK, data tracking (Eq 4.11), 10 × 3 LGR — the coarse mesh (the full 20 × 5 mesh costs ≈ 10× per solve and the twin study
 #: needs ≈ 170 solves per seed).
@@ -847,6 +848,46 @@ def reference_basin_lines(res: dict, tol: float = 1e-6) -> list[str]:
             + "): the reference's kept fit is not the best basin within reach, and the data's continuation can move "
               "to another one — the relative gap then carries a change of the fit, not of the data, which a "
               "candidate that stays put is credited with closing (`benchmarks/gap_reference_basin.py`)."]
+
+
+#: ``benchmarks/gap_baseline_basin.py``'s result, under the validation's folder.
+BASELINE_BASIN_FILE = "baseline_basin.json"
+
+
+def stored_baseline_basin() -> dict | None:
+    """``benchmarks/gap_baseline_basin.py``'s result (:func:`stored_experiment`): an
+    experiment on the superseded validation it names (``relative_rev3``), refused if made
+    under another relative method than that validation's."""
+    r = stored_experiment(f"gap_validation/{BASELINE_BASIN_FILE}", "gap_baseline_basin.py")
+    if r is None:
+        return r
+    v = superseded_validation(r["validation"])
+    if r.get("relative_method_hash") != v.settings.get("relative_method_hash"):
+        raise RuntimeError(f"{BASELINE_BASIN_FILE}: made under relative method {r.get('relative_method_hash')}, the "
+                           f"validation {r['validation']} under {v.settings.get('relative_method_hash')}: rerun "
+                           f"benchmarks/gap_baseline_basin.py")
+    return r
+
+
+def baseline_basin_lines(res: dict) -> list[str]:
+    """``benchmarks/gap_baseline_basin.py``'s result in a sentence computed from it: per null
+    draw, the first-ranked ΔBIC and the % closed by the ranked candidates as run and with the
+    baseline re-fitted from the candidates' fits, and the baseline's worst channel."""
+    bits = []
+    for c in res["cases"]:
+        a, b = c["as_run"], c["from_candidates"]
+        bits.append(f"{c['case']}: {a['rank1']} {a['rank1_dBIC']:.0f}, the {a['ranked']} ranked candidates closing "
+                    f"{a['pct_closed_min']:.0f}–{a['pct_closed_max']:.0f} % (the baseline's {a['worst_channel']} "
+                    f"{a['worst_rss_baseline']:.2f} against the candidates' median {a['worst_rss_candidates_median']:.2f})"
+                    f" → {b['rank1']} {b['rank1_dBIC']:.0f}, {b['pct_closed_min']:.0f}–{b['pct_closed_max']:.0f} % "
+                    + (f"(baseline from {b['baseline_from']})" if b["baseline_from"] else "(baseline unchanged)"))
+    moved = sum(1 for c in res["cases"] if c["from_candidates"]["baseline_from"])
+    return [f"**Why revision 3's null draws reached so far.** Re-diagnosed without the calibration "
+            f"(`benchmarks/gap_baseline_basin.py`), as run → with the baseline's fit of the draw re-solved from every "
+            f"nested candidate's fit (first-ranked ΔBIC, % closed by the ranked candidates): " + "; ".join(bits)
+            + f". The re-fit found a lower baseline in {moved} of {len(res['cases'])} draws: where every candidate "
+              "closes about the same share, the baseline's continuation had stopped in a worse optimum than its own "
+              "extensions reach, and each candidate was credited with the difference."]
 
 
 def stored_null_refit() -> dict | None:
