@@ -406,6 +406,10 @@ def test_relative_lines_count_both_runs_on_the_same_cases():
     assert "(other draws than the absolute validation's" in G.relative_lines(rel, absolute)[0]
     assert "absolute diagnosis named 1 of 2 of its own" in G.relative_lines(rel, absolute)[0]
     assert set(G.relative_cases(rel, absolute)["named (absolute)"]) == {"—"}
+    rel.rows["rank1_dBIC"] = -4.0  # null draws within the threshold: not "beyond" it
+    nul = G.relative_lines(rel, absolute)[-1]
+    assert "reached ΔBIC -4 to -4 (unexplained, closing 30 %): within the threshold (-10) even without" in nul
+    assert "beyond" not in nul
 
 
 @pytest.mark.parametrize("name,m", [("hip_offset", 2.5), ("knee_offset", -3.0), ("ankle_offset", 4.0),
