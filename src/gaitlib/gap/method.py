@@ -109,9 +109,9 @@ class RelativeMethod:
         hips; revision 2's validation: ΔBIC equal to 0.1 in both hip-offset cases).
     baseline_from_candidates : before the rounds, the baseline's fit of the data is also
         re-solved from every nested candidate's fit of it and the lowest kept (revision 3's
-        validation: in a null draw the baseline's continuation carried an anterior-GRF misfit
-        that every candidate's fit lacked — RSS 7.5 vs ≈ 0.5 on that channel — so all eleven
-        candidates closed 30–38 % of the difference, ΔBIC down to −136).
+        validation, ``benchmarks/gap_baseline_basin.py``: in two null draws the baseline's
+        continuation carried an anterior-GRF misfit the candidates' fits lacked, so candidates
+        were credited with closing up to 38 % of the difference, first-ranked ΔBIC down to −136).
     revision : bumped when the relative diagnosis decides differently for a reason outside
         these fields. 1: the null calibration; 2: the self-consistent reference fit; 3: the
         HAT tilt located; 4: the baseline from the candidates' fits.

@@ -889,9 +889,10 @@ def baseline_basin_lines(res: dict) -> list[str]:
     return [f"**Why revision 3's null draws reached so far.** Re-diagnosed without the calibration "
             f"(`benchmarks/gap_baseline_basin.py`), as run → with the baseline's fit of the draw re-solved from every "
             f"nested candidate's fit (first-ranked ΔBIC, % closed by the ranked candidates): " + "; ".join(bits)
-            + f". The re-fit found a lower baseline in {moved} of {len(res['cases'])} draws: where every candidate "
-              "closes about the same share, the baseline's continuation had stopped in a worse optimum than its own "
-              "extensions reach, and each candidate was credited with the difference."]
+            + f". The re-fit found a lower baseline in {moved} of {len(res['cases'])} draws: where the baseline's "
+              "relative RSS on one channel is many times the candidates' median, its continuation had stopped in a "
+              "worse optimum than its own extensions reach, and every candidate that reached a better one was "
+              "credited with the difference."]
 
 
 def stored_null_refit() -> dict | None:
