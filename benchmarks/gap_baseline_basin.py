@@ -70,34 +70,24 @@ def table(res: dict) -> str:
 
 def main() -> int:
     from gaitlib.gap import diagnose as D
-    from gaitlib.gap import io as gio
     from gaitlib.gap import validate as V
     from gaitlib.studies import gap as gap_study
 
     val = gap_study.superseded_validation(VALIDATION)
     base = val.settings["base"]
-    frame = V.real_frame(base.get("speed_class", "Free"))
-    rows = val.rows[val.rows["set"] == "null"]
     rel0 = D.RELATIVE
     res = {"method_hash": V.METHOD.hash(), "relative_method_hash": val.settings["relative_method_hash"],
            "validation": VALIDATION, "base": base, "cases": []}
     with tempfile.TemporaryDirectory() as td:
-        p0 = Path(td) / "unedited.csv"
-        frame.to_csv(p0, index=False)
-        n0 = gio.read_data(p0).n
-        pr = Path(td) / "reference.csv"
-        V.resample(frame, int(val.unedited["reference_seed"]), n0).to_csv(pr, index=False)
-        ref = gio.read_data(pr)
+        ref, nulls = V.relative_null_sets(val, td)
         try:
-            for _, c in rows.iterrows():
-                p = Path(td) / f"{c['case']}.csv"
-                V.resample(frame, int(c["magnitude"]), n0).to_csv(p, index=False)
+            for c, ds in nulls:
                 row = {"case": str(c["case"]), "named": str(c["named"])}
                 for run, flag in (("as_run", False), ("from_candidates", True)):
                     # revision 3's relative method, the ranking only (no null calibration)
                     D.RELATIVE = dataclasses.replace(rel0, null_draws=0, tilt_channel=True, reference_rounds=2,
                                                      baseline_from_candidates=flag)
-                    d = D.diagnose(gio.read_data(p), base=base, resamples=0, reference=ref, serial=True)
+                    d = D.diagnose(ds, base=base, resamples=0, reference=ref, serial=True)
                     row[run] = run_summary(d)
                 res["cases"].append(row)
                 print(json.dumps(row), flush=True)

@@ -57,7 +57,6 @@ def table(res: dict) -> str:
 
 def main() -> int:
     from gaitlib.gap import diagnose as D
-    from gaitlib.gap import io as gio
     from gaitlib.gap import locate as L
     from gaitlib.gap import reference as R
     from gaitlib.gap import validate as V
@@ -67,30 +66,20 @@ def main() -> int:
     val = gap_study.superseded_validation(VALIDATION)  # revision 1: the false name revision 2 answers
     base = val.settings["base"]
     spec0 = D.base_spec(base)
-    frame = V.real_frame(base.get("speed_class", "Free"))
-    rows = val.rows[val.rows["set"] == "null"]
     res = {"method_hash": V.METHOD.hash(), "relative_method_hash": val.settings["relative_method_hash"],
            "validation": VALIDATION, "base": base,
            "cases": []}
     with tempfile.TemporaryDirectory() as td:
-        p0 = Path(td) / "unedited.csv"
-        frame.to_csv(p0, index=False)
-        n0 = gio.read_data(p0).n
-        pr = Path(td) / "reference.csv"
-        V.resample(frame, int(val.unedited["reference_seed"]), n0).to_csv(pr, index=False)
-        ref = gio.read_data(pr)
+        ref, nulls = V.relative_null_sets(val, td)
         s_r = D.baseline_fits(spec0, {"reference": ref}, None, serial=True)["reference"]
-        for _, c in rows.iterrows():
-            p = Path(td) / f"{c['case']}.csv"
-            V.resample(frame, int(c["magnitude"]), n0).to_csv(p, index=False)
-            ds = gio.read_data(p)
+        for c, ds in nulls:
             f_n = solve_on(spec0, ds.gait, s_r)
             back = solve_on(spec0, ref.gait, f_n)
             row = {"case": str(c["case"]), "named": str(c["named"]), "reference_start": s_r.stats.get("start"),
                    "objective_reference": float(s_r.stats["objective"]), "objective_data": float(f_n.stats["objective"]),
                    "objective_reference_from_data": float(back.stats["objective"]),
                    "status_reference_from_data": back.stats["status"],
-                   "rss_relative": float(L.locate(f_n, R.relative_data(ds, ref, s_r)).rss)}
+                   "rss_relative": float(L.locate(f_n, R.relative_data(ds, ref, s_r, tilt=False)).rss)}  # rev. 1: no tilt
             res["cases"].append(row)
             print(json.dumps(row), flush=True)
     res["summary"] = summary(res)

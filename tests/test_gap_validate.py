@@ -487,3 +487,20 @@ def test_tie_lines_read_both_candidates_dbic_from_the_cases():
     (line,) = G.tie_lines(V.Validation(rows, {}, {"relative": True}))
     assert line.startswith("In the 2 hip_offset injections at middle and large magnitudes, hat_com's ΔBIC differs "
                            "from hip_offset's by at most 0.1 (h_m: -135.2 vs -135.1; h_l: -312.7 vs -312.6)")
+
+
+def test_relative_null_sets_regenerate_the_stored_draws(tmp_path, frame):
+    """The reference and null draws of a stored relative validation, regenerated from its
+    seeds: the same means as resample(frame, seed) read back; an absolute one is refused."""
+    rows = V.pd.DataFrame([{"set": "null", "case": "null_0", "magnitude": 11.0},
+                           {"set": "independent", "case": "knee_offset_middle_0", "magnitude": 2.0}])
+    v = V.Validation(rows, {"reference_seed": 5}, {"relative": True, "speed_class": "Free"})
+    ref, nulls = V.relative_null_sets(v, tmp_path)
+    n = gio.read_data(tmp_path / "unedited.csv").n
+    V.resample(frame, 5, n).to_csv(tmp_path / "r.csv", index=False)
+    V.resample(frame, 11, n).to_csv(tmp_path / "n.csv", index=False)
+    assert ref.gait.mean.equals(gio.read_data(tmp_path / "r.csv").gait.mean)
+    assert [c["case"] for c, _ in nulls] == ["null_0"]
+    assert nulls[0][1].gait.mean.equals(gio.read_data(tmp_path / "n.csv").gait.mean)
+    with pytest.raises(ValueError, match="not a relative validation"):
+        V.relative_null_sets(V.Validation(rows, {}, {}), tmp_path)

@@ -140,13 +140,13 @@ def background(ref: gio.DataSet, ref_fit, thetas: dict | None = None, tilt: bool
                         index=view0.mean.index)
 
 
-def relative_data(ds: gio.DataSet, ref: gio.DataSet, ref_fit) -> gio.DataSet:
+def relative_data(ds: gio.DataSet, ref: gio.DataSet, ref_fit, tilt: bool | None = None) -> gio.DataSet:
     """``ds`` (N) located relative to ``ref`` (R): the same data and fits, with the background
     S_R − R (:func:`background`; ``ref_fit``, the baseline's fit of R: a GaitSolution or its
-    :func:`gaitlib.gap.locate.sim_channels` frame) that :func:`gaitlib.gap.locate.locate` adds
-    to the data it locates against."""
+    :func:`gaitlib.gap.locate.sim_channels` frame; ``tilt`` as there) that
+    :func:`gaitlib.gap.locate.locate` adds to the data it locates against."""
     check_same_grid(ds, ref)
-    bg = background(ref, ref_fit)
+    bg = background(ref, ref_fit, tilt=tilt)
     note = (f"located relative to {ref.label}: {bg.shape[1]} channels carry the reference fit's residual "
             f"(N' = N + S_R - R, gaitlib.gap.reference)")
     return dataclasses.replace(ds, background=bg, label=f"{ds.label} − {ref.label}", n=relative_n(ds.n, ref.n),

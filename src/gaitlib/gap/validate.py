@@ -58,7 +58,8 @@ from .method import BIC_THRESHOLD, METHOD, RELATIVE, RUNNER_UP_MARGIN, Method
 from .noise import smooth_noise
 
 __all__ = ["Injection", "INJECTIONS", "SETS", "BANDS", "PLATE_THRESHOLD_BW", "VARIANTS", "VARIANT_SEEDS", "ALL_SETS",
-           "NULL_DRAWS", "REFERENCE_DRAW", "draws", "effect_magnitude", "inject", "resample", "run", "Validation", "null_spread", "visibility"]
+           "NULL_DRAWS", "REFERENCE_DRAW", "draws", "effect_magnitude", "inject", "resample", "run", "Validation", "null_spread", "visibility",
+           "relative_null_sets"]
 
 #: Vertical force (body weights) above which a foot counts as on the plate in the AP-bias
 #: manipulation: 10 N for the Schwartz 2008 mean child (41.4 kg), a typical plate threshold.
@@ -474,6 +475,28 @@ def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_clas
     if relative:
         settings.update(relative_method=RELATIVE.to_dict(), relative_method_hash=RELATIVE.hash())
     return Validation(pd.DataFrame(rows), unedited, settings)
+
+
+def relative_null_sets(v: Validation, folder) -> tuple:
+    """The reference and the ``null`` draws of a stored relative validation, regenerated as
+    :func:`run` made them (the unedited data resampled with the stored seeds, written as CSV
+    to ``folder`` and read back as ``gaitlib gap --data`` reads them): ``(reference DataSet,
+    [(case row, DataSet), …])``."""
+    if not v.settings.get("relative"):
+        raise ValueError("relative_null_sets: not a relative validation (gap-validate --relative)")
+    folder = Path(folder)
+    frame = real_frame(v.settings.get("speed_class", "Free"))
+    p0 = folder / "unedited.csv"
+    frame.to_csv(p0, index=False)
+    n0 = gio.read_data(p0).n
+    pr = folder / "reference.csv"
+    resample(frame, int(v.unedited["reference_seed"]), n0).to_csv(pr, index=False)
+    out = []
+    for _, c in v.rows[v.rows["set"] == "null"].iterrows():
+        p = folder / f"{c['case']}.csv"
+        resample(frame, int(c["magnitude"]), n0).to_csv(p, index=False)
+        out.append((c, gio.read_data(p)))
+    return gio.read_data(pr), out
 
 
 def null_spread(null: Validation) -> dict:
