@@ -947,7 +947,9 @@ def consistent_fits(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, datasets: 
 
     Returns key → ``{"ref_fit", "ref_fits", "base", "fits", "moved"}``: the baseline's and
     the candidates' fits of the reference and of the data after the rounds, and per model
-    that moved, ``{"reference": [objective before, after], "data": [before, after]}``."""
+    that moved, ``{"reference": [objective before, after], "data": [before, after]}`` (the
+    baseline re-fitted from a candidate's fit: ``"data"`` and ``"data_from"``, the candidate;
+    a later move of its data fit: ``"data_again"``)."""
     method = method or RELATIVE
     margin = method.consistency_margin
     nlp = [n for n in names if effects_mod.EFFECTS[n].resolve and effects_mod.EFFECTS[n].identify == "nlp"]
