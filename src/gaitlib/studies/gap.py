@@ -886,7 +886,8 @@ def baseline_basin_lines(res: dict) -> list[str]:
                     f" → {b['rank1']} {b['rank1_dBIC']:.0f}, {b['pct_closed_min']:.0f}–{b['pct_closed_max']:.0f} % "
                     + (f"(baseline from {b['baseline_from']})" if b["baseline_from"] else "(baseline unchanged)"))
     moved = sum(1 for c in res["cases"] if c["from_candidates"]["baseline_from"])
-    return [f"**Why revision 3's null draws reached so far.** Re-diagnosed without the calibration "
+    rev = SUPERSEDED_VALIDATIONS.get(res.get("validation"), "?")
+    return [f"**Why revision {rev}'s null draws reached so far.** Re-diagnosed without the calibration "
             f"(`benchmarks/gap_baseline_basin.py`), as run → with the baseline's fit of the draw re-solved from every "
             f"nested candidate's fit (first-ranked ΔBIC, % closed by the ranked candidates): " + "; ".join(bits)
             + f". The re-fit found a lower baseline in {moved} of {len(res['cases'])} draws: where the baseline's "
