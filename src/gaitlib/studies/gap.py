@@ -366,8 +366,8 @@ VALIDATION_RUNS = {
     "variants": "gaitlib gap-validate --set model-variant --derivatives nodes --out "
                 "benchmarks/results/gap_validation/variants",
     "null": "gaitlib gap-validate --set null --derivatives nodes --out benchmarks/results/gap_validation/null",
-    "relative": "gaitlib gap-validate --relative --set independent,out-of-library,null --derivatives nodes --out "
-                "benchmarks/results/gap_validation/relative",
+    "relative": "gaitlib gap-validate --relative --set independent,out-of-library,null --per-band 2 --derivatives nodes "
+                "--out benchmarks/results/gap_validation/relative",
 }
 
 
