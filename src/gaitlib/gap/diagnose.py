@@ -777,8 +777,10 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
         located gap has that model's own residual on the reference subtracted; the top
         effect must also beat every candidate's ΔBIC on the reference's null draws
         (:func:`null_calibration`, :data:`gaitlib.gap.method.RELATIVE`).
-        ``settings["reference"]`` names the reference, its fit and the null calibration;
-        :attr:`Diagnosis.reference_fit` is that fit.
+        ``settings["reference"]`` names the reference, its multistart fit (``"fit"``), the
+        self-consistent fit the data were located against (``"consistent_fit"``), the fits
+        :func:`consistent_fits` moved (``"moved"``) and the null calibration;
+        :attr:`Diagnosis.reference_fit` is the self-consistent fit.
     calibration : a ``null_calibration`` of an earlier diagnosis against the same reference,
         spec, candidates and subjects (checked), used instead of redoing it.
     **sweep_kw : ``scheduler``, ``n_workers``, ``serial``, ``progress`` of :func:`gaitlib.sweep.sweep`.

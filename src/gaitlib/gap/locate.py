@@ -3,8 +3,9 @@ where the simulation leaves the data's ±1 SD band.
 
 Channels (each leg): joint angles (hip as the thigh's angle in the laboratory — data hip
 + data pelvic tilt — as the gait problem tracks it), net joint torques, GRFs (anterior,
-vertical), in a change relative to a reference the HAT tilt (:data:`RELATIVE_ONLY`) and, for solutions with muscle-level outputs, EMG: NMSK excitations e(t), MSK
-generator activations (the muscle's generator, thesis Table 5.5), against the data's EMG
+vertical), in a change relative to a reference the HAT tilt (:data:`RELATIVE_ONLY`) and,
+for solutions with muscle-level outputs, EMG: NMSK excitations e(t), MSK generator
+activations (the muscle's generator, thesis Table 5.5), against the data's EMG
 envelope of the same muscle (:data:`gaitlib.activation.EMG_CHANNELS`; Schwartz 2008: RF, BF
 ↔ lateral hamstrings, GAM ↔ medial gastrocnemius, TA).
 
