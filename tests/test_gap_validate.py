@@ -183,6 +183,23 @@ def test_resample_adds_only_the_sampling_error_of_the_means(tmp_path, frame):
         V.resample(frame, 7, 0)
 
 
+def test_a_replicate_draws_afresh_with_the_method_unchanged():
+    h = M.RELATIVE.hash()
+    assert V.replicate_hash(h, 0) == h  # replicate 0: the stored validation's own draws
+    sets = ("independent", "out-of-library", "null")
+    d0 = V.draws(sets, 2, seed_hash=V.replicate_hash(h, 0))
+    d1 = V.draws(sets, 2, seed_hash=V.replicate_hash(h, 1))
+    assert d0.equals(V.draws(sets, 2, seed_hash=h))
+    assert list(d1["case"]) == list(d0["case"])  # the same cases, other draws
+    assert (d1["magnitude"] != d0["magnitude"]).all()
+    assert d1.equals(V.draws(sets, 2, seed_hash=V.replicate_hash(h, 1)))  # reproducible
+    for _, r in d1[d1["set"] != "null"].iterrows():
+        lo, hi = V.INJECTIONS[r["injection"]].bands[V.BANDS.index(r["band"])]
+        assert lo <= abs(r["magnitude"]) <= hi
+    with pytest.raises(ValueError, match="replicate"):
+        V.replicate_hash(h, -1)
+
+
 def test_null_draws_follow_the_method_hash():
     d = V.draws(("null",))
     assert len(d) == V.NULL_DRAWS and (d["unit"] == "seed").all() and d["magnitude"].nunique() == V.NULL_DRAWS

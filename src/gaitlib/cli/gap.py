@@ -173,7 +173,7 @@ def cmd_gap_validate(args) -> int:
                     what="the validation's files (validation.json, cases.csv, scores.csv, confusion.csv)") as o:
         v = V.run(sets, per_band=args.per_band, speed_class=args.speed, base=base, root=root,
                   use_cache=not args.no_cache, serial=args.serial, n_workers=args.workers, scheduler=args.scheduler,
-                  progress=True, relative=args.relative)
+                  progress=True, relative=args.relative, replicate=args.replicate)
         v.save(o.tmp)
     print(v.scores().to_string(index=False, float_format=lambda x: f"{x:.0f}"))
     print(f"wrote {out / 'validation.json'}")
@@ -247,6 +247,9 @@ def add_parsers(sub) -> None:
                    help="diagnose each manipulated data set relative to the unedited data (gaitlib gap --reference), "
                         "both resampled within their sampling error")
     v.add_argument("--per-band", type=int_at_least(1), default=1, help="draws per manipulation and magnitude band")
+    v.add_argument("--replicate", type=int_at_least(0), default=0,
+                   help="0 (default): the method's own draws; k > 0: every draw (magnitudes, signs, resampling "
+                        "seeds, the reference) afresh, the method unchanged")
     v.add_argument("--speed", default="Free", help="speed class of the real data (default Free)")
     v.add_argument("--serial", action="store_true", help="solve in this process without dask")
     v.add_argument("--workers", type=int_at_least(1), default=None, help="LocalCluster workers (default: cores)")

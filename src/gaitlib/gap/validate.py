@@ -198,6 +198,16 @@ def _seed(method_hash: str, name: str, draw: int) -> int:
     return int(hashlib.sha256(f"{method_hash}|{name}|{draw}".encode()).hexdigest()[:12], 16)
 
 
+def replicate_hash(method_hash: str, replicate: int = 0) -> str:
+    """The hash every draw of a validation is seeded from: the method's own for replicate 0,
+    a fresh set of draws (magnitudes, signs, resampling seeds, the reference) per further
+    replicate — the same method run again on other draws, to measure how much its rates and
+    its null threshold depend on the draws."""
+    if replicate < 0:
+        raise ValueError(f"replicate: {replicate}, expected an integer >= 0")
+    return method_hash if replicate == 0 else f"{method_hash}/replicate{replicate}"
+
+
 def draws(sets=("independent", "out-of-library"), per_band: int = 1, method: Method = METHOD,
           seed_hash: str | None = None) -> pd.DataFrame:
     """The validation's draws: one row per (manipulation, band, draw) with its magnitude and
@@ -369,7 +379,7 @@ def _summary(d: diagnose.Diagnosis, expected: str | None = None) -> dict:
 
 def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_class: str = "Free",
         base: dict | None = None, work_dir=None, resamples: int = 0, progress: bool = False,
-        relative: bool = False, **diag_kw) -> Validation:
+        relative: bool = False, replicate: int = 0, **diag_kw) -> Validation:
     """Diagnose every draw of :func:`draws` (and the unedited data) with
     :func:`gaitlib.gap.diagnose` — baseline ``base`` (default: the method's), all
     applicable library effects as candidates. The manipulated CSVs are written to
@@ -384,14 +394,17 @@ def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_clas
     two independent groups; a ``null`` draw's right answer is then "unexplained" (nothing
     changed). Magnitudes and signs are drawn from the relative method's hash (fresh draws
     when that method changes). The reference's null calibration is computed with the first
-    case and reused. No ``model-variant`` set (a variant's twin has no reference of its own)."""
+    case and reused. No ``model-variant`` set (a variant's twin has no reference of its own).
+
+    ``replicate``: 0 for the method's own draws; k > 0 draws everything afresh
+    (:func:`replicate_hash`) with the method unchanged."""
     import tempfile
 
     if relative and "model-variant" in sets:
         raise ValueError("run(relative=True): the model-variant set has no reference data set; "
                          "run it without relative")
     method = METHOD  # the diagnosis runs with it: the draws are its own
-    h = RELATIVE.hash() if relative else method.hash()  # the relative method's own draws
+    h = replicate_hash(RELATIVE.hash() if relative else method.hash(), replicate)  # the relative method's own draws
     base = dict(method.base if base is None else base, speed_class=speed_class)
     table = draws(sets, per_band, method, seed_hash=h)
     frame = real_frame(speed_class)
@@ -471,7 +484,8 @@ def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_clas
                 print(f"{c['case']}: {c['magnitude']:+g} {c['unit']} -> {row['named']} ({row['verdict']}), "
                       f"expected {c['expected']}", flush=True)
     settings = {"method": method.to_dict(), "method_hash": method.hash(), "base": base, "per_band": per_band,
-                "sets": list(sets), "speed_class": speed_class, "relative": bool(relative)}
+                "sets": list(sets), "speed_class": speed_class, "relative": bool(relative),
+                "replicate": int(replicate)}
     if relative:
         settings.update(relative_method=RELATIVE.to_dict(), relative_method_hash=RELATIVE.hash())
     return Validation(pd.DataFrame(rows), unedited, settings)
