@@ -6,6 +6,7 @@
     .venv/bin/python benchmarks/bench_ipopt_options.py --model NMSK --only default "bound_push/frac 1e-6" "mu_init 1e-2"
     .venv/bin/python benchmarks/bench_ipopt_options.py --only default "mumps_pivtol 1e-4" "mumps_pivtol 1e-2" --stem ipopt_options_mumps
     .venv/bin/python benchmarks/bench_ipopt_options.py --only default "mumps_mem_percent 100" "mumps_mem_percent 20" --stem ipopt_options_mumps_mem
+    .venv/bin/python benchmarks/bench_ipopt_options.py --only default "no MUMPS scaling" "no MUMPS scaling or permuting" --stem ipopt_options_mumps_scaling
 
 The problem of ``gaitlib run gait --model MSK --cost DT --speed Free`` (the book's Ch 5 MSK
 data-tracking solve's spec, from its data-based guess), built once on the per-node path with
@@ -57,6 +58,8 @@ VARIANTS = (
     ("mumps_pivtol 1e-2", {"mumps_pivtol": 1e-2}),
     ("mumps_mem_percent 100", {"mumps_mem_percent": 100}),
     ("mumps_mem_percent 20", {"mumps_mem_percent": 20}),
+    ("no MUMPS scaling", {"mumps_scaling": 0}),
+    ("no MUMPS scaling or permuting", {"mumps_scaling": 0, "mumps_permuting_scaling": 0}),
 )
 
 _ITER = re.compile(r"^\s*(\d+)(r?)\s+(-?\d\.\d+e[+-]\d+)\s+\S+\s+\S+\s+\S+\s+\S+\s+(\S+)\s+\S+\s+\S+")

@@ -521,3 +521,48 @@ def test_relative_null_sets_regenerate_the_stored_draws(tmp_path, frame):
     assert nulls[0][1].gait.mean.equals(gio.read_data(tmp_path / "n.csv").gait.mean)
     with pytest.raises(ValueError, match="not a relative validation"):
         V.relative_null_sets(V.Validation(rows, {}, {}), tmp_path)
+
+
+def test_wilson_interval_by_hand():
+    from gaitlib.studies import gap as G
+
+    # 22 of 24: p = 0.9167, z² = 3.8415; centre 0.8592, half-width 0.1177 (by hand)
+    lo, hi = G.wilson(22, 24)
+    assert lo == pytest.approx(74.15, abs=0.05) and hi == pytest.approx(97.68, abs=0.05)
+    lo, hi = G.wilson(0, 4)  # none of 4: from 0 to 4/(4 + z²) = 49.0 %
+    assert lo == 0.0 and hi == pytest.approx(100 * 3.8415 / (4 + 3.8415), abs=0.05)
+
+
+def test_replicate_table_pools_the_groups_by_hand():
+    import pandas as pd
+    from gaitlib.studies import gap as G
+
+    def val(rows, lowest):
+        cols = ("set", "band", "case", "magnitude", "unit", "named", "correct")
+        return V.Validation(pd.DataFrame([dict(zip(cols, r)) for r in rows]),
+                            {"named": "unexplained", "null_calibration": {"lowest_dBIC": lowest}},
+                            {"relative": True})
+
+    r0 = val([("independent", "middle", "a_middle_0", 0.1, "1", "body_mass", True),
+              ("independent", "large", "a_large_0", 0.2, "1", "grf_scale", False),
+              ("independent", "small", "a_small_0", 0.05, "1", "unexplained", False),
+              ("out-of-library", "large", "o_large_0", 0.2, "1", "unexplained", True),
+              ("null", "—", "null_0", 7.0, "seed", "unexplained", True)], -30.0)
+    r1 = val([("independent", "middle", "a_middle_0", 0.11, "1", "body_mass", True),
+              ("independent", "large", "a_large_0", 0.21, "1", "body_mass", True),
+              ("independent", "small", "a_small_0", 0.06, "1", "body_mass", True),
+              ("out-of-library", "large", "o_large_0", 0.25, "1", "foot_contact", False),
+              ("null", "—", "null_0", 8.0, "seed", "unexplained", True)], -80.0)
+    t = G.replicate_table({"replicate 0": r0, "replicate 1": r1})
+    assert t.loc["independent, middle + large", "replicate 0"] == "1/2"
+    assert t.loc["independent, middle + large", "pooled"] == "3/4"
+    assert t.loc["independent, middle + large", "pooled %"] == 75.0
+    assert t.loc["out-of-library", "pooled"] == "1/2" and t.loc["independent, small", "pooled"] == "1/2"
+    assert t.loc["null (nothing changed)", "pooled"] == "2/2"
+    assert t.loc["threshold (ΔBIC ≤)", "replicate 0"] == "-30" and t.loc["threshold (ΔBIC ≤)", "replicate 1"] == "-80"
+    lines = G.replicate_lines({"replicate 0": r0, "replicate 1": r1})
+    assert "moves by 50" in lines[0]
+    assert any(x.startswith("independent, middle + large: replicate 0 1/2, replicate 1 2/2; pooled 3/4 = 75 %")
+               and "target not met" in x for x in lines)
+    assert any("o_large_0 (+0.25 1) named foot_contact" in x for x in lines)
+    assert not any("a_small_0" in x for x in lines)  # small injections are not a target

@@ -55,7 +55,8 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "book_gaps", "twin_validation_full_mesh", "twin_full_mesh_lines", "twin_full_mesh_verdict",
            "left_leg_flips", "co_contraction_text", "findings",
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
-           "VALIDATION_RUNS", "stored_validation", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
+           "VALIDATION_RUNS", "stored_validation", "calibration_threshold", "wilson", "TARGET_GROUPS",
+           "replicate_table", "replicate_lines", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
            "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines",
            "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines", "consistency_lines", "tie_lines",
            "stored_reference_basin", "reference_basin_lines", "REFERENCE_BASIN_FILE", "stored_baseline_basin",
@@ -646,6 +647,97 @@ def _change_clause(named: pd.DataFrame) -> str:
             "of the draw absorbs the sampling error differently from the baseline's, not a change") if bits else ""
 
 
+def calibration_threshold(rel: gval.Validation) -> float | None:
+    """The ΔBIC a relative validation's null calibration set (the fixed threshold or the
+    lowest first-ranked ΔBIC of its null draws, whichever is lower); None without one."""
+    c = (rel.unedited or {}).get("null_calibration")
+    if not c:
+        return None
+    lo = c.get("lowest_dBIC")
+    return diagnose.BIC_THRESHOLD if lo is None else min(diagnose.BIC_THRESHOLD, lo)
+
+
+def wilson(k: int, n: int, z: float = 1.959964) -> tuple[float, float]:
+    """Wilson's score interval of a proportion k/n (95 % for the default z), in %."""
+    if n <= 0:
+        return (float("nan"), float("nan"))
+    p = k / n
+    d = 1.0 + z * z / n
+    c = (p + z * z / (2 * n)) / d
+    h = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
+    return (100.0 * max(0.0, c - h), 100.0 * min(1.0, c + h))
+
+
+#: The groups the validation's targets are stated on: label → (set, bands or None for all).
+TARGET_GROUPS = {"independent, middle + large": ("independent", ("middle", "large")),
+                 "independent, small": ("independent", ("small",)),
+                 "out-of-library": ("out-of-library", None),
+                 "null (nothing changed)": ("null", None)}
+
+
+def replicate_table(reps: dict) -> pd.DataFrame:
+    """Named right per target group (:data:`TARGET_GROUPS`) in each replicate of a validation
+    (label → :class:`~gaitlib.gap.validate.Validation`, the same method on other draws) and
+    pooled over them, with Wilson's 95 % interval of the pooled rate; the threshold each
+    replicate's null calibration set is the last row."""
+    rows = []
+    for g, (st, bands) in TARGET_GROUPS.items():
+        row, k_all, n_all = {"group": g}, 0, 0
+        for lab, v in reps.items():
+            r = v.rows[v.rows["set"] == st]
+            if bands is not None:
+                r = r[r["band"].isin(bands)]
+            k, n = int(r["correct"].astype(bool).sum()), len(r)
+            row[lab] = f"{k}/{n}" if n else "—"
+            k_all, n_all = k_all + k, n_all + n
+        lo, hi = wilson(k_all, n_all)
+        row.update({"pooled": f"{k_all}/{n_all}" if n_all else "—",
+                    "pooled %": 100.0 * k_all / n_all if n_all else np.nan, "95 % interval": (
+                        f"{lo:.0f}–{hi:.0f} %" if n_all else "—")})
+        rows.append(row)
+    thr = {lab: calibration_threshold(v) for lab, v in reps.items()}
+    rows.append({"group": "threshold (ΔBIC ≤)", **{lab: (f"{t:.0f}" if t is not None else "—") for lab, t in thr.items()},
+                 "pooled": "", "pooled %": np.nan, "95 % interval": ""})
+    return pd.DataFrame(rows).set_index("group")
+
+
+def replicate_lines(reps: dict, target: float = 90.0) -> list[str]:
+    """The replicates of a validation in words, every number from their stored results: the
+    threshold each null calibration set, the pooled rate of each target group against the
+    target with its 95 % interval, and the cases the further replicates got wrong."""
+    if len(reps) < 2:
+        return ["(one replicate only)"]
+    tab = replicate_table(reps)
+    labs = list(reps)
+    thr = [calibration_threshold(reps[x]) for x in labs]
+    out = ["The same method on other draws: " + "; ".join(
+        f"{x}: threshold ΔBIC ≤ {t:.0f}" if t is not None else f"{x}: no calibration" for x, t in zip(labs, thr))
+        + (f" — the threshold moves by {max(thr) - min(thr):.0f} with the draws alone (the reference and its "
+           "null draws), the method unchanged." if None not in thr else ".")]
+    for g in ("independent, middle + large", "out-of-library", "null (nothing changed)", "independent, small"):
+        r = tab.loc[g]
+        if r["pooled"] in ("—", ""):
+            continue
+        line = (f"{g}: " + ", ".join(f"{x} {r[x]}" for x in labs) + f"; pooled {r['pooled']} = {r['pooled %']:.0f} % "
+                f"(95 % interval {r['95 % interval']})")
+        if g != "independent, small":
+            met = r["pooled %"] >= target
+            line += f" — the ≥ {target:g} % target {'met' if met else 'not met'} on the pooled rate"
+            lo = float(r["95 % interval"].split("–")[0])
+            if met and lo < target:
+                line += f", though the interval reaches below it ({lo:.0f} %)"
+        out.append(line + ".")
+    for x in labs[1:]:
+        v = reps[x].rows
+        wrong = v[(v["set"] != "independent") | v["band"].isin(["middle", "large"])]
+        wrong = wrong[~wrong["correct"].astype(bool)]
+        if len(wrong):
+            out.append(f"Wrong in {x}: " + "; ".join(
+                f"{c} ({m:+.3g} {u}) named {n}" for c, m, u, n in zip(wrong["case"], wrong["magnitude"],
+                                                                       wrong["unit"], wrong["named"])) + ".")
+    return out
+
+
 def calibration_lines(rel: gval.Validation) -> list[str]:
     """The relative validation's null calibration in words (every number from its stored
     result): the draws, their first-ranked candidates and ΔBIC, the threshold it set."""
@@ -655,7 +747,7 @@ def calibration_lines(rel: gval.Validation) -> list[str]:
     best = [b for b in c["best"] if b.get("dBIC") is not None]
     vals = sorted(best, key=lambda b: b["dBIC"])
     eff = pd.Series([b["effect"] for b in best]).value_counts()
-    thr = min(diagnose.BIC_THRESHOLD, c["lowest_dBIC"]) if c["lowest_dBIC"] is not None else diagnose.BIC_THRESHOLD
+    thr = calibration_threshold(rel)
     out = [f"The reference redrawn {c['draws']} times within the sampling error of a difference of two group means "
            f"(n = {c['n_subjects']}), each diagnosed relative to it: first-ranked ΔBIC from {vals[-1]['dBIC']:.0f} to "
            f"{vals[0]['dBIC']:.0f} (" + ", ".join(f"{e} ×{k}" for e, k in eff.items()) + f"); so an effect is named only "
