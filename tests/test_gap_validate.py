@@ -566,3 +566,11 @@ def test_replicate_table_pools_the_groups_by_hand():
                and "target not met" in x for x in lines)
     assert any("o_large_0 (+0.25 1) named foot_contact" in x for x in lines)
     assert not any("a_small_0" in x for x in lines)  # small injections are not a target
+    # ranked first, named or not: needs the rank1/expected columns
+    for v in (r0, r1):
+        v.rows["rank1"] = ["body_mass", "body_mass", "x", "y", "z"]
+        v.rows["expected"] = ["body_mass", "body_mass", "body_mass", "unexplained", "unexplained"]
+    r0.rows.loc[1, "named"] = "unexplained"  # replicate 0's large miss: right effect first, within the threshold
+    line = [x for x in G.replicate_lines({"replicate 0": r0, "replicate 1": r1}) if "ranked first" in x][0]
+    assert "replicate 0 2/2; of its 1 misses 1 had it ranked first" in line
+    assert "replicate 1 2/2; of its 0 misses 0 had" in line
