@@ -571,6 +571,11 @@ def test_replicate_table_pools_the_groups_by_hand():
         v.rows["rank1"] = ["body_mass", "body_mass", "x", "y", "z"]
         v.rows["expected"] = ["body_mass", "body_mass", "body_mass", "unexplained", "unexplained"]
     r0.rows.loc[1, "named"] = "unexplained"  # replicate 0's large miss: right effect first, within the threshold
+    r0.rows["rank1_dBIC"] = r1.rows["rank1_dBIC"] = [-50.0, -25.0, -5.0, -5.0, -5.0]
     line = [x for x in G.replicate_lines({"replicate 0": r0, "replicate 1": r1}) if "ranked first" in x][0]
-    assert "replicate 0 2/2; of its 1 misses 1 had it ranked first" in line
+    assert "replicate 0 2/2; of its 1 misses 1 had it ranked first and were read \"unexplained\" — 1 with the " \
+           "first-ranked ΔBIC within that replicate's threshold;" in line  # -25 > -30
     assert "replicate 1 2/2; of its 0 misses 0 had" in line
+    r0.rows.loc[1, "rank1_dBIC"] = -40.0  # beyond -30: held by another test
+    line = [x for x in G.replicate_lines({"replicate 0": r0, "replicate 1": r1}) if "ranked first" in x][0]
+    assert "— 0 with the first-ranked ΔBIC within that replicate's threshold, 1 beyond it" in line
