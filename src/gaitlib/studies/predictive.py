@@ -184,11 +184,12 @@ def default_params() -> dict:
 
 #: How the runs of each model are started (see :func:`run_guess`): ``"thesis"`` — the
 #: thesis's partial guess of Sec 6.1 (:func:`thesis_guess`); ``"ch5"`` — the whole Ch 5
-#: solution (every state and control, time-scaled for Ch 7). MSK runs use the thesis's guess.
-#: NMSK runs use ``"ch5"``: from the thesis's partial guess, several NMSK runs at the full
-#: mesh stop at IPOPT's 1000-iteration limit (environment.md, "Measured choices") — the
-#: chapters show those statuses beside the runs they report.
-GUESS_POLICY = {"MSK": "thesis", "NMSK": "ch5"}
+#: solution (every state and control, time-scaled for Ch 7). Both models use ``"ch5"``: from
+#: the thesis's partial guess, several runs of either model at the full mesh stop at IPOPT's
+#: 1000-iteration limit (NMSK: environment.md, "Measured choices"; MSK: Ch 6's SDT3 and SP3)
+#: — the chapters show the runs from the thesis's guess, with their statuses, beside the
+#: runs they report.
+GUESS_POLICY = {"MSK": "ch5", "NMSK": "ch5"}
 GUESSES = ("thesis", "ch5")
 
 
