@@ -272,8 +272,9 @@ def test_mean_nrmse_weighs_kinds_equally():
     assert pr.mean_nrmse(sc)[("MSK", "DT")] == pytest.approx((0.2 + 0.4 + 0.6) / 3)
 
 
-def _study(stats, scores, marks_):
-    return SimpleNamespace(stats=lambda: stats, marks=lambda: marks_, converged_scores=lambda: scores)
+def _study(stats, scores, marks_, guess=None):
+    return SimpleNamespace(stats=lambda: stats, marks=lambda: marks_, converged_scores=lambda: scores,
+                           guess=guess or {"MSK": "ch5", "NMSK": "ch5"})
 
 
 def test_ch6_findings_verdicts():
@@ -288,13 +289,21 @@ def test_ch6_findings_verdicts():
     tg = pd.DataFrame({"status": ["Solve_Succeeded", "Maximum_Iterations_Exceeded"]}, index=["NMSK DT", "NMSK FP"])
     f = pr.ch6_findings(_study(stats, _scores(rows), {r: None for r in runs}), tg, {}, None)
     assert f[0].startswith("- 6 of 6 runs converged (IPOPT Solve_Succeeded). IPOPT solve time per run 10–50 s here")
-    assert f[0].endswith("1 of 2 NMSK runs converged (not: NMSK FP Maximum_Iterations_Exceeded).")
+    assert f[0].endswith("(Table 6.3). The runs of MSK and NMSK start from the whole Ch 5 solution of their model; "
+                         "from the thesis's partial guess 1 of 2 NMSK runs converged "
+                         "(not: NMSK FP Maximum_Iterations_Exceeded).")
     assert f[1] == "- Mean NRMSE over angles, torques and forces: MSK DT 0.200 → FP 0.500; NMSK DT 0.250 → FP 0.400."
     assert f[2].startswith("- NMSK is more accurate than MSK (mean NRMSE) for SDT3, FP (of 3 cost functions where both "
                            "runs converged and pass the validity gates; not compared: SDT1, SDT2, SP1, SP2, SP3); the "
                            "thesis")
     assert "*NMSK FP more accurate than MSK FP*: holds on our data (0.400 vs 0.500)" in f[3]
-    assert "*NMSK FP faster than MSK FP*: holds (25 s vs 30 s;" in f[3]
+    assert "*NMSK FP faster than MSK FP*: holds (25 s vs 30 s)." in f[3]  # both from the same start
+    mixed = pr.ch6_findings(_study(stats, _scores(rows), {r: None for r in runs}, {"MSK": "thesis", "NMSK": "ch5"}),
+                            tg, {}, None)
+    assert "holds (25 s vs 30 s; not a like-for-like comparison: the MSK runs start from the thesis's partial " \
+           "guess; the NMSK runs start from the whole Ch 5 solution)." in mixed[3]
+    assert "The MSK runs start from the thesis's partial guess; the NMSK runs start from the whole Ch 5 " \
+           "solution; from the thesis's partial guess 1 of 2 NMSK runs" in mixed[0]
     # SDT3 0.27 ≤ 1.1 × 0.25 = 0.275: holds
     assert f[4] == "- Thesis claim *SDT3 (Trq + Ang) is enough for NMSK*: NMSK SDT3 mean NRMSE 0.270 vs DT 0.250 — " \
                    "holds (within 10 %)."

@@ -57,14 +57,20 @@ pr.readings_table({"book's reading": res, "thesis's reading": res_thesis},
                   columns=("mark", "status", "iterations", "COT (J/kg/m)"))
 
 # %% [markdown]
-# **Initial guesses.** MSK: the thesis's (Sec 7.1) — the time-scaled *Free* data with the
-# Ch 5 HAT and metatarsal motion and MTG activations. NMSK: the *whole* Ch 5 NMSK solution
-# scaled in time (a departure, as in Ch 6); from the thesis's partial guess the NMSK runs
-# gave these statuses (not used anywhere else on this page):
+# **Initial guesses.** Both models: the *whole* Ch 5 solution of the model scaled in time (a
+# departure, as in Ch 6; `pr.GUESS_POLICY`). The thesis's (Sec 7.1) is the time-scaled
+# *Free* data with the Ch 5 HAT and metatarsal motion (MSK: and MTG activations); from it
+# the runs gave these statuses (not used anywhere else on this page):
 
 # %%
 res_thesis_guess = pr.speed_study(("NMSK",), classes, progress=False, guess={"NMSK": "thesis"}, reading="book")
-tg = res_thesis_guess.stats()[["mark", "status", "iterations", "solve (s)", "objective", "max violation"]]
+res_msk_tg = pr.speed_study(("MSK",), classes, progress=False, guess={"MSK": "thesis"}, reading="book")
+print("\n".join(pr.guess_lines({"from the whole Ch 5 solution (the page's runs)": res,
+                                 "from the thesis's guess": res_msk_tg}, "MSK")
+                 + pr.guess_lines({"from the whole Ch 5 solution (the page's runs)": res,
+                                   "from the thesis's guess": res_thesis_guess}, "NMSK")))
+_cols = ["mark", "status", "iterations", "solve (s)", "objective", "max violation"]
+tg = pd.concat([res_msk_tg.stats()[_cols], res_thesis_guess.stats()[_cols]])
 tg
 
 # %% [markdown]
@@ -91,16 +97,6 @@ res.rerun_table(inv) if inv else "every run converged"
 inv_int = res.rerun_failed(max_iter=1000, defects="integral")
 res.rerun_table(inv_int) if inv_int else "every run converged"
 
-# %% [markdown]
-# The MSK runs once more from the *whole* Ch 5 MSK solution scaled in time (the NMSK runs'
-# start), as in Ch 6, at the same 1000-iteration limit. A separate, labelled result: the
-# page's MSK runs keep the thesis's guess, and nothing below uses these.
-
-# %%
-res_msk_ch5 = pr.speed_study(("MSK",), classes, progress=False, guess={"MSK": "ch5"}, reading="book")
-print("\n".join(pr.guess_lines({"from the thesis's guess (the page's MSK runs)": res,
-                                 "from the whole Ch 5 MSK solution": res_msk_ch5}, "MSK")))
-res_msk_ch5.stats()[["mark", "status", "iterations", "solve (s)", "objective", "max violation"]]
 
 # %% [markdown]
 # ## Compute times (thesis Table 7.2)

@@ -740,6 +740,19 @@ def _converged_line(stats: pd.DataFrame, extra: str = "") -> str:
             + ("" if ok.all() else "; not converged: " + ", ".join(f"{k} ({v})" for k, v in stats.loc[~ok, 'status'].items())))
 
 
+_START_WORDS = {"ch5": "the whole Ch 5 solution", "thesis": "the thesis's partial guess"}
+
+
+def _starts_text(how: Mapping[str, str], lead: bool = True) -> str:
+    """How a study's runs were started (model → ``"thesis"`` | ``"ch5"``), in words
+    (``lead``: as the start of a sentence)."""
+    the = "The" if lead else "the"
+    if len(set(how.values())) == 1:
+        return f"{the} runs of {' and '.join(how)} start from {_START_WORDS[next(iter(how.values()))]} of their model"
+    return "; ".join(f"{the if i == 0 else 'the'} {m} runs start from {_START_WORDS[h]}"
+                     for i, (m, h) in enumerate(how.items()))
+
+
 def guess_lines(by_guess: Mapping[str, StudyResult], model: str, limit: int = 1000) -> list[str]:
     """One sentence per start (``by_guess``: label → a study of the same runs from that
     start): how many of ``model``'s runs converged within ``limit`` iterations, their
@@ -770,8 +783,8 @@ def ch6_findings(res: StudyResult, thesis_guess_stats: pd.DataFrame, reruns: dic
     more accurate and faster than MSK FP, SDT3 enough for NMSK — within
     :data:`SDT3_ENOUGH_FACTOR`, using the converged 3000-iteration rerun of ``reruns`` when the
     study's own run did not converge), and the excitation RMSE against the EMG.
-    ``thesis_guess_stats``: :meth:`StudyResult.stats` of the NMSK runs from the thesis's
-    partial guess; ``gait``: the data the runs are scored against."""
+    ``thesis_guess_stats``: :meth:`StudyResult.stats` of the runs from the thesis's partial
+    guess (either model or both); ``gait``: the data the runs are scored against."""
     stats, run_marks = res.stats(), res.marks()
     csc = res.converged_scores()
     nr = mean_nrmse(csc)
@@ -787,8 +800,9 @@ def ch6_findings(res: StudyResult, thesis_guess_stats: pd.DataFrame, reruns: dic
     tg_ok = tg["status"] == "Solve_Succeeded"
     lines = [_converged_line(stats, " (IPOPT Solve_Succeeded)")
              + f". IPOPT solve time per run {stats['solve (s)'].min():.0f}–{stats['solve (s)'].max():.0f} s here, "
-             f"against 1–15 h in the thesis (Table 6.3). NMSK runs start from the whole Ch 5 NMSK solution; from the "
-             f"thesis's partial guess {int(tg_ok.sum())} of {len(tg)} NMSK runs converged"
+             f"against 1–15 h in the thesis (Table 6.3). " + _starts_text(res.guess)
+             + f"; from the thesis's partial guess {int(tg_ok.sum())} of {len(tg)} "
+             + " and ".join(dict.fromkeys(k.split(" ", 1)[0] for k in tg.index)) + " runs converged"
              + ("" if tg_ok.all() else " (not: " + ", ".join(f"{k} {v}" for k, v in tg.loc[~tg_ok, 'status'].items()) + ")")
              + ".",
              f"- Mean NRMSE over angles, torques and forces: MSK DT {_f('MSK', 'DT')} → FP {_f('MSK', 'FP')}; "
@@ -806,9 +820,9 @@ def ch6_findings(res: StudyResult, thesis_guess_stats: pd.DataFrame, reruns: dic
         lines.append(f"- Thesis claim *NMSK FP more accurate than MSK FP*: "
                      f"{'holds' if _nr('NMSK', 'FP') < _nr('MSK', 'FP') else 'does not hold'} on our data "
                      f"({_f('NMSK', 'FP')} vs {_f('MSK', 'FP')}). *NMSK FP faster than MSK FP*: "
-                     f"{'holds' if t_n < t_m else 'does not hold'} ({t_n:.0f} s vs {t_m:.0f} s; not a like-for-like "
-                     "comparison: the NMSK runs start from the whole Ch 5 solution, the MSK runs from the thesis's "
-                     "partial guess).")
+                     f"{'holds' if t_n < t_m else 'does not hold'} ({t_n:.0f} s vs {t_m:.0f} s"
+                     + ("" if res.guess.get("MSK") == res.guess.get("NMSK") else
+                        "; not a like-for-like comparison: " + _starts_text(res.guess, lead=False)) + ").")
     else:
         lines.append("- Thesis claims *NMSK FP more accurate / faster than MSK FP*: not tested — "
                      f"MSK FP {_f('MSK', 'FP')}, NMSK FP {_f('NMSK', 'FP')}.")
