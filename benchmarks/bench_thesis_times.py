@@ -17,9 +17,9 @@ the book's notebooks call* (book/src/ch02_gait.py … ch07_speed.py):
         optimal_control() (3 continuation stages + the problem), (c)
         optimal_control_body(warm=b), (c') the same with widened contact bounds
   ch05  studies.mtg_id.identify (tol 1e-10 and 1e-5), studies.msk.solve("MSK"), ("NMSK")
-  ch06  studies.predictive.cost_function_study (16 runs), its NMSK runs from the thesis's
-        partial guess (8), and the 3000-iteration reruns of the runs that stopped at the limit
-  ch07  studies.predictive.speed_study (8 runs), NMSK from the thesis's guess (4), reruns
+  ch06  studies.predictive.cost_function_study (16 runs), its runs from the thesis's
+        partial guess (16), and the 3000-iteration reruns of the runs that stopped at the limit
+  ch07  studies.predictive.speed_study (8 runs), from the thesis's guess (8), reruns
   ch08  studies.gap (our chapter, not in the thesis): twin_validation(),
         twin_validation_full_mesh(), sk_diagnosis
         ("schwartz2008"), ("gaitutils"), nmsk_attribution() — one row per study, summed
@@ -369,7 +369,7 @@ def _reruns(chapter, res, failed, call, item_of, label_of):
 
 
 def _predictive(chapter, study, items, item_of, label_of):
-    """Ch 6/7: the study as the book calls it (serial), NMSK from the thesis's guess, reruns."""
+    """Ch 6/7: the study as the book calls it (serial), from the thesis's guess, reruns."""
     from gaitlib.studies import predictive as pr
 
     fn = getattr(pr, study)
@@ -385,9 +385,9 @@ def _predictive(chapter, study, items, item_of, label_of):
     r, failed = _study_rows(chapter, res, f"{call}(('MSK', 'NMSK'))", item_of, label_of)
     rows += r
     rows += _reruns(chapter, res, failed, "res", item_of, label_of)
-    tg = fn(("NMSK",), items, progress=False, serial=True, guess={"NMSK": "thesis"})
-    r, _ = _study_rows(chapter, tg, f'{call}(("NMSK",), guess={{"NMSK": "thesis"}})', item_of, label_of,
-                       guess_note=" (thesis's partial guess)")
+    tg = fn(("MSK", "NMSK"), items, progress=False, serial=True, guess={"MSK": "thesis", "NMSK": "thesis"})
+    r, _ = _study_rows(chapter, tg, f'{call}(("MSK", "NMSK"), guess={{"MSK": "thesis", "NMSK": "thesis"}})',
+                       item_of, label_of, guess_note=" (thesis's partial guess)")
     rows += r
     return rows
 

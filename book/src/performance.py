@@ -241,8 +241,8 @@ for name in ("ipopt_options", "ipopt_options_nmsk"):  # MSK (all variants), then
 # GPOPS-II in MATLAB (IPOPT, first derivatives) on an i7-6700, on other data: a labelled
 # reference, not a like-for-like benchmark. The runs marked *investigation* are the book's
 # 3000-iteration reruns of runs that stopped at 1000 iterations; *thesis's partial guess*
-# are the NMSK runs from the thesis's initial guess, which the chapters show beside the runs
-# they use.
+# are the runs from the thesis's initial guess, which the chapters show beside the runs they
+# use.
 
 # %%
 tt = perf.load("thesis_times")
