@@ -397,3 +397,26 @@ def test_ch5_profile_rows_and_emg_share(monkeypatch):
     # 150 → 70: 53.3 % closed, of which the EMG's 60 of 80 = 75 %
     assert t["% closed"].iloc[1] == pytest.approx(100 * 80 / 150)
     assert t["EMG share of the closed gap (%)"].iloc[1] == pytest.approx(75.0)
+
+
+def test_thesis_guess_runs_beside_the_page_runs():
+    def st(status):
+        idx = [f"{m} {c}" for m in ("MSK", "NMSK") for c in ("DT", "SP3")]
+        return pd.DataFrame({"mark": ["" if s == "Solve_Succeeded" else "NOT CONVERGED" for s in status],
+                             "status": status, "converged": [s == "Solve_Succeeded" for s in status],
+                             "iterations": [300, 400, 500, 1000], "solve (s)": 1.0, "objective": 0.1,
+                             "max violation": 0.0}, index=idx)
+
+    page = SimpleNamespace(stats=lambda: st(["Solve_Succeeded"] * 4))
+    tg_msk = SimpleNamespace(stats=lambda: st(["Solve_Succeeded", "Maximum_Iterations_Exceeded"] + ["x"] * 2)
+                             .loc[["MSK DT", "MSK SP3"]])
+    tg_nmsk = SimpleNamespace(stats=lambda: st(["x"] * 2 + ["Solve_Succeeded", "Maximum_Iterations_Exceeded"])
+                              .loc[["NMSK DT", "NMSK SP3"]])
+    lines, tab = pr.thesis_guess_runs(page, {"MSK": tg_msk, "NMSK": tg_nmsk})
+    assert lines[0] == "- from the whole Ch 5 solution (the page's runs): MSK 2 of 2 runs converged within 1000 " \
+                       "iterations (300–400 iterations)."
+    assert lines[1] == "- from the thesis's partial guess: MSK 1 of 2 runs converged within 1000 iterations " \
+                       "(300–300 iterations); not converged: MSK SP3 (Maximum_Iterations_Exceeded)."
+    assert len(lines) == 4 and lines[3].endswith("not converged: NMSK SP3 (Maximum_Iterations_Exceeded).")
+    assert list(tab.index) == ["MSK DT", "MSK SP3", "NMSK DT", "NMSK SP3"]
+    assert list(tab.columns) == pr.START_COLUMNS

@@ -120,12 +120,8 @@ res.rerun_table(inv) if inv else "every run converged"
 res_thesis_guess = pr.cost_function_study(("NMSK",), pr.CH6_COSTS, progress=False, guess={"NMSK": "thesis"},
                                           reading="book")
 res_msk_tg = pr.cost_function_study(("MSK",), pr.CH6_COSTS, progress=False, guess={"MSK": "thesis"}, reading="book")
-print("\n".join(pr.guess_lines({"from the whole Ch 5 solution (the page's runs)": res,
-                                 "from the thesis's partial guess": res_msk_tg}, "MSK")
-                 + pr.guess_lines({"from the whole Ch 5 solution (the page's runs)": res,
-                                   "from the thesis's partial guess": res_thesis_guess}, "NMSK")))
-_cols = ["mark", "status", "iterations", "solve (s)", "objective", "max violation"]
-tg = pd.concat([res_msk_tg.stats()[_cols], res_thesis_guess.stats()[_cols]])
+_lines, tg = pr.thesis_guess_runs(res, {"MSK": res_msk_tg, "NMSK": res_thesis_guess})
+print("\n".join(_lines))
 tg
 
 # %% [markdown]

@@ -65,12 +65,8 @@ pr.readings_table({"book's reading": res, "thesis's reading": res_thesis},
 # %%
 res_thesis_guess = pr.speed_study(("NMSK",), classes, progress=False, guess={"NMSK": "thesis"}, reading="book")
 res_msk_tg = pr.speed_study(("MSK",), classes, progress=False, guess={"MSK": "thesis"}, reading="book")
-print("\n".join(pr.guess_lines({"from the whole Ch 5 solution (the page's runs)": res,
-                                 "from the thesis's guess": res_msk_tg}, "MSK")
-                 + pr.guess_lines({"from the whole Ch 5 solution (the page's runs)": res,
-                                   "from the thesis's guess": res_thesis_guess}, "NMSK")))
-_cols = ["mark", "status", "iterations", "solve (s)", "objective", "max violation"]
-tg = pd.concat([res_msk_tg.stats()[_cols], res_thesis_guess.stats()[_cols]])
+_lines, tg = pr.thesis_guess_runs(res, {"MSK": res_msk_tg, "NMSK": res_thesis_guess}, "from the thesis's guess")
+print("\n".join(_lines))
 tg
 
 # %% [markdown]

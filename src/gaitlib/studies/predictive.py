@@ -50,7 +50,7 @@ from ..marks import failure_label
 
 __all__ = ["CH6_COSTS", "CH7_CLASSES", "THESIS_CLASS", "THESIS_HOURS_TABLE_6_3", "THESIS_HOURS_TABLE_7_2",
            "THESIS_COT_FIG_7_5", "THESIS_FP_GAIN_PCT", "THESIS_FP_EXCITATION_GAIN_PCT",
-           "THESIS_TORQUE_GAIN_PCT_CH7", "BASELINE_COST", "GUESS_POLICY", "baseline", "default_params", "thesis_guess", "run_guess", "ch6_specs", "ch7_specs",
+           "THESIS_TORQUE_GAIN_PCT_CH7", "BASELINE_COST", "GUESS_POLICY", "START_COLUMNS", "thesis_guess_runs", "baseline", "default_params", "thesis_guess", "run_guess", "ch6_specs", "ch7_specs",
            "score", "excitation_score", "StudyResult", "cost_function_study", "speed_study", "cot_table", "u_breaks",
            "times_table", "guess_lines", "SDT3_ENOUGH_FACTOR", "COT_CURVE_MIN_POINTS", "kind_nrmse", "mean_nrmse", "ch6_findings",
            "ch7_findings", "cot_figure"]
@@ -773,6 +773,21 @@ def guess_lines(by_guess: Mapping[str, StudyResult], model: str, limit: int = 10
             line += "; converged but invalid: " + ", ".join(f"{k} ({v})" for k, v in bad["mark"].items())
         out.append(line + ".")
     return out
+
+
+#: Columns of :func:`thesis_guess_runs`'s table.
+START_COLUMNS = ["mark", "status", "iterations", "solve (s)", "objective", "max violation"]
+
+
+def thesis_guess_runs(res: StudyResult, from_thesis: Mapping[str, StudyResult],
+                      label: str = "from the thesis's partial guess") -> tuple[list[str], pd.DataFrame]:
+    """The runs from the thesis's guess (model → the study of that model's runs from it)
+    beside the page's ``res`` (from :data:`GUESS_POLICY`): :func:`guess_lines` per model and
+    one table of their statuses (:data:`START_COLUMNS`)."""
+    lines = []
+    for m, r in from_thesis.items():
+        lines += guess_lines({"from the whole Ch 5 solution (the page's runs)": res, label: r}, m)
+    return lines, pd.concat([r.stats()[START_COLUMNS] for r in from_thesis.values()])
 
 
 def ch6_findings(res: StudyResult, thesis_guess_stats: pd.DataFrame, reruns: dict,
