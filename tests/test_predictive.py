@@ -82,6 +82,7 @@ def test_full_guess_scales_every_state_and_control_consistently(base):
     for c in ("tau_mtp_r", "R_y", gait_ocp.MTG_CONTROLS[0]):
         np.testing.assert_array_equal(ph.controls[c], src.controls[c])
     assert pr.GUESS_POLICY == {"MSK": "ch5", "NMSK": "ch5"}
+    assert pr.GUESS_POLICY_CH7 == {"MSK": "thesis", "NMSK": "ch5"}
     # guesses derived differently from one solution are cached under different keys
     spec = pr.ch6_specs("MSK", base, ("DT",), **MESH)["MSK DT"]
     dirs = {gait_ocp.cache_dir(spec, guess=g) for g in (pr.run_guess(base, "thesis"), pr.run_guess(base, "ch5"),

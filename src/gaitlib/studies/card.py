@@ -843,7 +843,8 @@ def _runs(bases: dict, which: str, reading: str = "thesis", policy: str | None =
     ``changes``: GaitSpec fields of a variant of those runs (e.g. ``max_iter=3000``: the
     reruns of :meth:`gaitlib.studies.predictive.StudyResult.rerun_failed`; ``weights=``: the
     Ch 7 pin experiment); ``policy``: the runs' start (:data:`gaitlib.studies.predictive.
-    GUESS_POLICY` by default; ``"thesis"``: the thesis's partial guess, Ch 6 only)."""
+    GUESS_POLICY` for Ch 6, ``GUESS_POLICY_CH7`` for Ch 7, by default; ``"thesis"``: the
+    thesis's partial guess, Ch 6 only)."""
     out = {}
     for m, base in bases.items():
         if which == "ch6":
@@ -854,7 +855,7 @@ def _runs(bases: dict, which: str, reading: str = "thesis", policy: str | None =
             guesses = {}
             for k, s in specs.items():
                 g = data_mod.load_gait_data(s.speed_class, s.source)
-                guesses[k] = pr.run_guess(base, pr.GUESS_POLICY[m], cycle_time=g.cycle_time,
+                guesses[k] = pr.run_guess(base, pr.GUESS_POLICY_CH7[m], cycle_time=g.cycle_time,
                                           stride=g.speed * g.cycle_time)
         for k, s in specs.items():
             s = replace(s, **changes) if changes else s
