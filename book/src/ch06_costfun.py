@@ -113,8 +113,7 @@ res.rerun_table(inv) if inv else "every run converged"
 # **The runs from the thesis's partial guess** (Sec 6.1: HAT and metatarsal motion (MSK:
 # and the 12 MTG activations) from Ch 5, everything else from the data and EMG), in the
 # book's reading, at the thesis's 1000-iteration limit and otherwise unchanged — the runs
-# we tried first (until this revision the page's MSK runs). They are not used anywhere else
-# on this page:
+# we tried first. They are not used anywhere else on this page:
 
 # %%
 res_thesis_guess = pr.cost_function_study(("NMSK",), pr.CH6_COSTS, progress=False, guess={"NMSK": "thesis"},

@@ -1481,8 +1481,7 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
                    "--reference`: each model's own residual on the reference subtracted). "
                    + " ".join(relative_lines(valr, val)))
     if valr_reps is not None and len(valr_reps) > 1:
-        out.append("**The relative diagnosis on a second set of draws** (the same method): "
-                   + " ".join(replicate_lines(valr_reps)))
+        out.append("**The relative diagnosis on a second set of draws.** " + " ".join(replicate_lines(valr_reps)))
     if valv is not None:
         out.append(" ".join(validation_lines(valv)[:-1]))
     if tv_muscle is not None:
