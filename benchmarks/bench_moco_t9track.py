@@ -15,7 +15,8 @@ first use, then for each scheme runs, each in its own process with one BLAS thre
    numbers, so the same iterations). The libraries are compiled once per machine: a first,
    untimed run of the compiled variant per scheme compiles them (its setup time, compile
    included, is recorded as ``compile_first_use_setup_s``), so the timed repeats load them;
-5. gaitlib with an unexpanded MX graph (builds in a fraction of a second, evaluates slower).
+5. gaitlib with an unexpanded MX graph (builds in a fraction of a second, evaluates slower);
+6. the compiled per-node variant with MUMPS's scaling switched off (:data:`MUMPS_UNSCALED`).
 
 It prints one table (setup time, solve time, iterations, time per iteration, objective,
 max constraint violation, RMS per coordinate), writes ``results/moco_t9track.json`` and
@@ -64,6 +65,13 @@ SCHEMES = ("trapezoidal", "hermite-simpson")
 COORDS = ("pelvis_tilt", "pelvis_tx", "pelvis_ty", "hip_flexion_l", "hip_flexion_r",
           "knee_angle_l", "knee_angle_r", "ankle_angle_l", "ankle_angle_r")
 ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")
+
+
+#: The compiled per-node variant with MUMPS's row/column scaling and its permuting scaling
+#: switched off (IPOPT's ``mumps_scaling``, ``mumps_permuting_scaling``): a linear-solver
+#: setting, measured on the MSK gait problem in results/ipopt_options_mumps_scaling.md.
+MUMPS_UNSCALED = {"mumps_scaling": 0, "mumps_permuting_scaling": 0}
+UNSCALED = "gaitlib (per-node derivatives, compiled, MUMPS unscaled)"
 
 
 def ensure_moco_venv():
@@ -164,6 +172,10 @@ def main(argv=None):
                              [sys.executable, str(HERE / "t9track.py"), "--scheme", scheme,
                               "--derivatives", "nodes", "--compiled", "--out", str(RAW)],
                              f"gaitlib_{scheme}_nodes_compiled"))
+            variants.append((UNSCALED, [sys.executable, str(HERE / "t9track.py"), "--scheme", scheme,
+                                        "--derivatives", "nodes", "--compiled", "--ipopt", json.dumps(MUMPS_UNSCALED),
+                                        "--tag", f"{scheme}_nodes_compiled_unscaled", "--out", str(RAW)],
+                             f"gaitlib_{scheme}_nodes_compiled_unscaled"))
             if not args.no_mx_variant:
                 variants.append(("gaitlib (MX, not expanded)",
                                  [sys.executable, str(HERE / "t9track.py"), "--scheme", scheme,
@@ -211,7 +223,8 @@ def main(argv=None):
     # ------------------------------------------------------------------ summary
     tools = ["moco", "gaitlib"] + ([] if args.no_defaults_variant else
                                    ["gaitlib (IPOPT defaults)"]) + ["gaitlib (per-node derivatives)",
-                                                                     "gaitlib (per-node derivatives, compiled)"] + (
+                                                                     "gaitlib (per-node derivatives, compiled)",
+                                                                     UNSCALED] + (
         [] if args.no_mx_variant else ["gaitlib (MX, not expanded)"])
     speedups, lines = {}, []
     head = ("| scheme | tool | rep | status | setup s | solve s | it | ms/it | objective | "
@@ -240,6 +253,7 @@ def main(argv=None):
         for tool, key in (("gaitlib (IPOPT defaults)", "speedup_ipopt_defaults"),
                           ("gaitlib (per-node derivatives)", "speedup_nodes"),
                           ("gaitlib (per-node derivatives, compiled)", "speedup_nodes_compiled"),
+                          (UNSCALED, "speedup_nodes_compiled_unscaled"),
                           ("gaitlib (MX, not expanded)", "speedup_mx_noexpand")):
             if tool in med:
                 speedups[scheme][key] = med["moco"] / med[tool]
@@ -301,6 +315,8 @@ def main(argv=None):
                      if "speedup_nodes" in s else "")
                   + (f"; gaitlib with per-node derivatives, compiled {s['speedup_nodes_compiled']:.1f}×"
                      if "speedup_nodes_compiled" in s else "")
+                  + (f"; the same with MUMPS's scaling off {s['speedup_nodes_compiled_unscaled']:.1f}×"
+                     if "speedup_nodes_compiled_unscaled" in s else "")
                   + (f"; gaitlib MX not expanded {s['speedup_mx_noexpand']:.1f}×"
                      if "speedup_mx_noexpand" in s else "")
                   + "; setup + solve: " + ", ".join(
