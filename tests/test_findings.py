@@ -407,7 +407,7 @@ def test_thesis_guess_runs_beside_the_page_runs():
                              "iterations": [300, 400, 500, 1000], "solve (s)": 1.0, "objective": 0.1,
                              "max violation": 0.0}, index=idx)
 
-    page = SimpleNamespace(stats=lambda: st(["Solve_Succeeded"] * 4))
+    page = SimpleNamespace(stats=lambda: st(["Solve_Succeeded"] * 4), guess={"MSK": "ch5", "NMSK": "ch5"})
     tg_msk = SimpleNamespace(stats=lambda: st(["Solve_Succeeded", "Maximum_Iterations_Exceeded"] + ["x"] * 2)
                              .loc[["MSK DT", "MSK SP3"]])
     tg_nmsk = SimpleNamespace(stats=lambda: st(["x"] * 2 + ["Solve_Succeeded", "Maximum_Iterations_Exceeded"])

@@ -919,15 +919,6 @@ def _short(label: str) -> str:
     return ", ".join(dict.fromkeys(n for n in names if n))
 
 
-def _whole_start_runs(bases: dict, model: str) -> dict:
-    """The Ch 6 runs of ``model`` started from its whole Ch 5 solution (the start the NMSK
-    runs use, :data:`gaitlib.studies.predictive.GUESS_POLICY`), where that is not the model's
-    own policy and they are stored (name → StoredGait); else empty."""
-    if model not in bases or pr.GUESS_POLICY.get(model) == "ch5":
-        return {}
-    return {k: v for k, v in _runs({model: bases[model]}, "ch6", "book", policy="ch5").items() if v is not None}
-
-
 def _ch6(bases: dict, runs: dict, valid: dict, reruns: dict | None = None) -> list[Row]:
     reruns = reruns or {}
     rows = []
@@ -935,17 +926,12 @@ def _ch6(bases: dict, runs: dict, valid: dict, reruns: dict | None = None) -> li
     where = _anchor("ch06_costfun", "FP with the gait's phase timing")
     timed = _fp_timed(bases)
     for model, hours in pr.THESIS_HOURS_TABLE_6_3.items():
-        whole = _whole_start_runs(bases, model)
         for c, h in hours.items():
             k = f"{model} {c}"
             row = _converges_row(6, f"{k} converges (Table 6.3: {h} h)", f"converged, {h} h", runs.get(k),
                                  reruns.get(k), valid.get(k, ""), status)
             if k in timed and _blocked(row.valid):
                 row.cause = _fp_as_printed(row.valid, where, timed[k])
-            w = whole.get(k)
-            if runs.get(k) is not None and not runs[k].success and w is not None:
-                row.cause += (f"; from the whole Ch 5 solution (the NMSK runs' start), the same limit: "
-                              f"{w.stats['status']} in {w.stats['iterations']} iterations [{status}]")
             rows.append(row)
     free = data_mod.load_gait_data("Free")
     rows += _ch6_claims(bases, runs, valid, free, reruns)

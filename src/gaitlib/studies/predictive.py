@@ -9,10 +9,10 @@ problems. As in the thesis:
 - the initial guess of the MSK runs is the data-based guess with the HAT coordinates, the
   metatarsal angles and torques and the 12 MTG activations taken from that Ch 5 solution
   (:func:`thesis_guess`); NMSK excitations would start from the EMG where the data have
-  the muscle (``excitation_guess="emg"``, Sec 5.3.4). **Departure:** the NMSK runs start
-  from the whole Ch 5 NMSK solution (:data:`GUESS_POLICY`, :func:`run_guess`), because
-  from the thesis's partial guess several stop at the iteration limit (the chapters show
-  those runs' statuses);
+  the muscle (``excitation_guess="emg"``, Sec 5.3.4). **Departure:** the Ch 6 runs of both
+  models and the Ch 7 NMSK runs start from the whole Ch 5 solution (:data:`GUESS_POLICY`,
+  :data:`GUESS_POLICY_CH7`, :func:`run_guess`), because from the thesis's partial guess
+  several stop at the iteration limit (the chapters show those runs' statuses);
 - no parameter is identified (contact, MTG and activation parameters fixed).
 
 Ch 7 (thesis Sec 7.1) — semi-predictive slow and fast gaits: the DT cost function (Table
@@ -788,11 +788,11 @@ START_COLUMNS = ["mark", "status", "iterations", "solve (s)", "objective", "max 
 def thesis_guess_runs(res: StudyResult, from_thesis: Mapping[str, StudyResult],
                       label: str = "from the thesis's partial guess") -> tuple[list[str], pd.DataFrame]:
     """The runs from the thesis's guess (model → the study of that model's runs from it)
-    beside the page's ``res`` (from :data:`GUESS_POLICY`): :func:`guess_lines` per model and
-    one table of their statuses (:data:`START_COLUMNS`)."""
+    beside the page's ``res`` (started as its ``guess`` says): :func:`guess_lines` per model
+    and one table of their statuses (:data:`START_COLUMNS`)."""
     lines = []
     for m, r in from_thesis.items():
-        lines += guess_lines({"from the whole Ch 5 solution (the page's runs)": res, label: r}, m)
+        lines += guess_lines({f"from {_START_WORDS[res.guess[m]]} (the page's runs)": res, label: r}, m)
     return lines, pd.concat([r.stats()[START_COLUMNS] for r in from_thesis.values()])
 
 
