@@ -164,12 +164,29 @@ def test_a_null_draw_is_the_reference_plus_its_sampling_error(ref):
 def test_the_relative_method_names_itself_and_the_absolute_one():
     from gaitlib.gap import method as M
 
-    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 4 and M.RELATIVE.tilt_channel and M.RELATIVE.reference_rounds >= 1
+    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 5 and M.RELATIVE.tilt_channel and M.RELATIVE.reference_rounds >= 1
     h = M.RELATIVE.hash()
     assert len(h) == 16 and h != M.METHOD.hash()
-    assert M.RelativeMethod(null_draws=3).hash() != h
+    assert M.RelativeMethod(null_draws=3).hash() != h and M.RelativeMethod(null_rank=1).hash() != h
     with pytest.raises(dataclasses.FrozenInstanceError):
         M.RELATIVE.null_draws = 1
+
+
+def test_the_null_threshold_is_the_rank_th_lowest_draw_statistic():
+    """Revision 5's rule by hand: each draw's statistic is its lowest ΔBIC over candidates;
+    the threshold the r-th lowest statistic; unranked draws carry none; a calibration stored
+    before revision 5 keeps its own rule (the lowest)."""
+    from gaitlib.gap import diagnose as D
+    from gaitlib.gap import method as M
+
+    per = [{"a": -5.0, "b": -82.0}, {}, {"a": 3.0}, {"b": -30.0, "c": -12.0}, {"c": -20.0}]
+    # statistics: -82, 3, -30, -20 -> sorted -82, -30, -20, 3
+    assert M.null_threshold(per, 1) == -82.0 and M.null_threshold(per, 2) == -30.0
+    assert M.null_threshold(per, 9) == 3.0 and M.null_threshold([{}, {}], 2) is None
+    assert D.calibration_dBIC({"lowest_dBIC": -82.0}) == -82.0
+    assert D.calibration_dBIC({"lowest_dBIC": -82.0, "threshold_dBIC": -30.0}) == -30.0
+    assert D.calibration_dBIC(None) is None
+    assert M.RELATIVE.null_rank / (M.RELATIVE.null_draws + 1) <= 0.1 + 1e-12
 
 
 def test_a_calibration_of_another_reference_is_refused(ref, monkeypatch):

@@ -456,7 +456,11 @@ def test_calibration_lines_count_the_stored_null_draws():
     v = V.Validation(V.pd.DataFrame(), {"null_calibration": calib}, {"relative": True})
     (line,) = G.calibration_lines(v)
     assert "redrawn 3 times" in line and "(n = 41)" in line and "from -40 to -150 (ankle_offset ×2)" in line
-    assert "named only at ΔBIC ≤ -150 (the threshold alone: -10)" in line and "baseline: null2." in line
+    assert "named only at ΔBIC ≤ -150 (the lowest of the draws, level 1/4; the threshold alone: -10)" in line
+    assert "baseline: null2." in line
+    calib.update(rank=2, threshold_dBIC=-40.0)  # revision 5's rule: the second lowest
+    (line,) = G.calibration_lines(v)
+    assert "named only at ΔBIC ≤ -40 (the second lowest of the draws, level 2/4;" in line
     assert G.calibration_lines(V.Validation(V.pd.DataFrame(), {}, {}))[0].startswith("(no null calibration")
 
 

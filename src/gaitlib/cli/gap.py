@@ -87,6 +87,7 @@ def cmd_gap(args) -> int:
     calib = ((getattr(d, "settings", None) or {}).get("reference") or {}).get("null_calibration")
     if calib is not None:  # the relative diagnosis's null calibration
         summary.update(null_draws=calib["draws"], null_lowest_dBIC=calib["lowest_dBIC"],
+                       null_rank=calib.get("rank", 1),
                        threshold_used=d.settings.get("threshold_used"))
     print(json.dumps(summary, indent=1))
     print(f"wrote {out / 'diagnosis.json'}")

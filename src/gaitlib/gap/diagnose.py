@@ -72,7 +72,8 @@ from .. import sweep as sweep_mod
 from . import io as gio
 from . import locate
 from . import reference as gref
-from .method import BIC_THRESHOLD, DEFAULT_BASE, EXPLAINED_PCT, METHOD, PROFILE_GRID, RELATIVE, RUNNER_UP_MARGIN
+from .method import (BIC_THRESHOLD, DEFAULT_BASE, EXPLAINED_PCT, METHOD, PROFILE_GRID, RELATIVE, RUNNER_UP_MARGIN,
+                     null_threshold)
 from .noise import smooth_noise
 from .nullstart import null_start_many
 from .solve import solve_many
@@ -84,7 +85,7 @@ __all__ = ["BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "Fit", "Diagnosis", 
            "COARSE_MESH", "GRF_SD_FACTOR", "RETRY_MARGIN", "grf_weighted", "candidate_fits", "needs_retry",
            "alternates_of", "lowest_objective", "BaselineFailed", "nesting", "ABOVE_LOCATED", "FIT_STARTS",
            "with_effects", "contenders_of", "relative_fits", "consistent_fits",
-           "null_calibration"]
+           "null_calibration", "calibration_dBIC"]
 
 
 def base_spec(base=None) -> gait_ocp.GaitSpec:
@@ -867,13 +868,23 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
         ref_info["relative_method"] = RELATIVE.to_dict()
         ref_info["relative_method_hash"] = RELATIVE.hash()
         ref_info["null_calibration"] = calib
-        if calib is not None and calib["lowest_dBIC"] is not None:
-            threshold = min(BIC_THRESHOLD, calib["lowest_dBIC"])
+        t = calibration_dBIC(calib)
+        if t is not None:
+            threshold = min(BIC_THRESHOLD, t)
     settings = {"objective": objective, "candidates": names, "warm": warm is not None, "reference": ref_info}
     d = assemble(ds, spec0, base_sol, fits, objective=objective, resamples=resamples, seed=seed, skipped=skipped,
                  settings=settings, solution=solution, threshold=threshold)
     d.reference_fit = ref_fit
     return d
+
+
+def calibration_dBIC(calib: dict | None) -> float | None:
+    """The ΔBIC a stored null calibration sets as the threshold: its ``threshold_dBIC``
+    (revision 5 on, :func:`gaitlib.gap.method.null_threshold`), or for a calibration made
+    before it, the lowest ΔBIC of its draws (revisions 1–4's rule); None without one."""
+    if not calib:
+        return None
+    return calib["threshold_dBIC"] if "threshold_dBIC" in calib else calib.get("lowest_dBIC")
 
 
 def null_calibration(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, names, n: int, warms: dict, *,
@@ -886,6 +897,7 @@ def null_calibration(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, names, n:
     and every ranked candidate's ΔBIC kept. Returns ``{"draws", "seeds", "n_subjects",
     "best" (per draw: its first-ranked effect and ΔBIC, or its failure), "dBIC" (per draw:
     effect → ΔBIC), "lowest_dBIC" (over draws and candidates; None if no draw was ranked),
+    "rank" and "threshold_dBIC" (:func:`gaitlib.gap.method.null_threshold`),
     "baseline_failed" (draws none of whose baseline fits converged)}``."""
     method = method or RELATIVE
     seeds = [gref.null_seed(ref, j, method.hash()) for j in range(method.null_draws)]
@@ -913,7 +925,8 @@ def null_calibration(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, names, n:
     return {"relative_method_hash": method.hash(), "reference_signature": ref.signature, "spec": spec0.to_dict(),
             "candidates": list(names), "draws": method.null_draws, "seeds": seeds, "n_subjects": n, "best": best,
             "dBIC": per,
-            "lowest_dBIC": min(vals) if vals else None,
+            "lowest_dBIC": min(vals) if vals else None, "rank": method.null_rank,
+            "threshold_dBIC": null_threshold(per, method.null_rank),
             "baseline_failed": [b["draw"] for b in best if b["effect"] == "baseline failed"],
             "moved": {k: c["moved"] for k, c in cons.items()}}
 

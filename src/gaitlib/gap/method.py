@@ -14,7 +14,8 @@ import hashlib
 import json
 from dataclasses import asdict, dataclass
 
-__all__ = ["Method", "METHOD", "RelativeMethod", "RELATIVE", "BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "EXPLAINED_PCT", "RUNNER_UP_MARGIN"]
+__all__ = ["Method", "METHOD", "RelativeMethod", "RELATIVE", "BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "EXPLAINED_PCT", "RUNNER_UP_MARGIN",
+           "null_threshold"]
 
 
 @dataclass(frozen=True)
@@ -87,9 +88,15 @@ class RelativeMethod:
         So the reference is redrawn K times within the sampling error of a difference of two
         group means (:func:`gaitlib.gap.reference.null_draw`, seeds from this hash and the
         reference's signature), each draw diagnosed relative to the reference exactly as the
-        data are, and a top effect is named only if its ΔBIC is also below the lowest ΔBIC
-        that any candidate reached on any of the K draws: a max-statistic test, family-wise
-        over the candidates, at level 1/(K + 1). 0: no calibration.
+        data are, and each draw's lowest ΔBIC over the candidates kept (a max statistic,
+        family-wise over the candidates). 0: no calibration.
+    null_rank : r. A top effect is named only if its ΔBIC is also below the r-th lowest of the
+        K draws' statistics (:func:`null_threshold`): a rank test at level r/(K + 1). Up to
+        revision 4, r = 1 of K = 9 (level 0.1): the threshold was one extreme of 9 draws, and
+        it moved from −27 to −82 with the draws alone (Chapter 8, replicate 1 of revision 4,
+        where one draw's baseline reached a better fit of the reference than the candidates'
+        and every candidate gained 46–82); revision 5 keeps the level, 2 of 19, so that one
+        such draw does not set the threshold.
     reference_rounds : rounds of the self-consistent reference fit (0: off). A multistart
         does not always find the reference's best basin, and the data's continuation can move
         into a better one: the relative gap then carries a change of the fit, not of the data
@@ -114,15 +121,17 @@ class RelativeMethod:
         were credited with closing up to 38 % of the difference, first-ranked ΔBIC down to −136).
     revision : bumped when the relative diagnosis decides differently for a reason outside
         these fields. 1: the null calibration; 2: the self-consistent reference fit; 3: the
-        HAT tilt located; 4: the baseline from the candidates' fits.
+        HAT tilt located; 4: the baseline from the candidates' fits; 5: the threshold the
+        second lowest of 19 null draws (``null_rank``) instead of the lowest of 9.
     """
 
-    null_draws: int = 9
+    null_draws: int = 19
+    null_rank: int = 2
     reference_rounds: int = 2
     consistency_margin: float = 1e-6
     tilt_channel: bool = True
     baseline_from_candidates: bool = True
-    revision: int = 4
+    revision: int = 5
 
     def to_dict(self) -> dict:
         return json.loads(json.dumps(asdict(self)))
@@ -132,6 +141,15 @@ class RelativeMethod:
         text = json.dumps({"method": METHOD.to_dict(), "relative": self.to_dict()}, sort_keys=True,
                           separators=(",", ":"))
         return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def null_threshold(per_draw: list, rank: int) -> float | None:
+    """The null calibration's threshold: the ``rank``-th lowest of the draws' statistics, each
+    the lowest ΔBIC any candidate reached on that draw (``per_draw``: one ``{effect: ΔBIC}``
+    per draw; draws with no ranked candidate carry no statistic and are left out). With fewer
+    ranked draws than ``rank``, the highest of them; None if none was ranked."""
+    stats = sorted(min(p.values()) for p in per_draw if p)
+    return stats[min(rank, len(stats)) - 1] if stats else None
 
 
 #: The relative method in use.

@@ -651,11 +651,12 @@ def _change_clause(named: pd.DataFrame) -> str:
 
 def calibration_threshold(rel: gval.Validation) -> float | None:
     """The ΔBIC a relative validation's null calibration set (the fixed threshold or the
-    lowest first-ranked ΔBIC of its null draws, whichever is lower); None without one."""
+    calibration's, :func:`gaitlib.gap.diagnose.calibration_dBIC`, whichever is lower); None
+    without one."""
     c = (rel.unedited or {}).get("null_calibration")
     if not c:
         return None
-    lo = c.get("lowest_dBIC")
+    lo = diagnose.calibration_dBIC(c)
     return diagnose.BIC_THRESHOLD if lo is None else min(diagnose.BIC_THRESHOLD, lo)
 
 
@@ -758,6 +759,9 @@ def replicate_lines(reps: dict, target: float = 90.0) -> list[str]:
     return out
 
 
+_ORDINAL = {1: "the lowest", 2: "the second lowest", 3: "the third lowest"}
+
+
 def calibration_lines(rel: gval.Validation) -> list[str]:
     """The relative validation's null calibration in words (every number from its stored
     result): the draws, their first-ranked candidates and ΔBIC, the threshold it set."""
@@ -767,11 +771,12 @@ def calibration_lines(rel: gval.Validation) -> list[str]:
     best = [b for b in c["best"] if b.get("dBIC") is not None]
     vals = sorted(best, key=lambda b: b["dBIC"])
     eff = pd.Series([b["effect"] for b in best]).value_counts()
-    thr = calibration_threshold(rel)
+    thr, r = calibration_threshold(rel), int(c.get("rank", 1))
     out = [f"The reference redrawn {c['draws']} times within the sampling error of a difference of two group means "
            f"(n = {c['n_subjects']}), each diagnosed relative to it: first-ranked ΔBIC from {vals[-1]['dBIC']:.0f} to "
            f"{vals[0]['dBIC']:.0f} (" + ", ".join(f"{e} ×{k}" for e, k in eff.items()) + f"); so an effect is named only "
-           f"at ΔBIC ≤ {thr:.0f} (the threshold alone: {diagnose.BIC_THRESHOLD:g})."
+           f"at ΔBIC ≤ {thr:.0f} ({_ORDINAL.get(r, f'{r}th')} of the draws, level {r}/{c['draws'] + 1}; "
+           f"the threshold alone: {diagnose.BIC_THRESHOLD:g})."
            + (f" Draws without a converged baseline: {', '.join(c['baseline_failed'])}." if c["baseline_failed"] else "")]
     return out
 
