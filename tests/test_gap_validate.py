@@ -525,6 +525,16 @@ def test_relative_null_sets_regenerate_the_stored_draws(tmp_path, frame):
     assert nulls[0][1].gait.mean.equals(gio.read_data(tmp_path / "n.csv").gait.mean)
     with pytest.raises(ValueError, match="not a relative validation"):
         V.relative_null_sets(V.Validation(rows, {}, {}), tmp_path)
+    # a manipulated case: injected, then resampled with the seed of the validation's own draws
+    rows["injection"] = [None, "knee_offset"]
+    v = V.Validation(rows, {"reference_seed": 5}, {"relative": True, "speed_class": "Free",
+                                                     "relative_method_hash": "h" * 16, "replicate": 1})
+    _, ((c, ds),) = V.relative_case_sets(v, tmp_path, ["knee_offset_middle_0"])
+    seed = V._seed(V.replicate_hash("h" * 16, 1), "knee_offset_middle_0", 1) % 2**31
+    V.resample(V.inject(frame, "knee_offset", 2.0), seed, n).to_csv(tmp_path / "k.csv", index=False)
+    assert c["case"] == "knee_offset_middle_0" and ds.gait.mean.equals(gio.read_data(tmp_path / "k.csv").gait.mean)
+    with pytest.raises(ValueError, match="no case nope"):
+        V.relative_case_sets(v, tmp_path, ["nope"])
 
 
 def test_wilson_interval_by_hand():
@@ -583,3 +593,78 @@ def test_replicate_table_pools_the_groups_by_hand():
     r0.rows.loc[1, "rank1_dBIC"] = -40.0  # beyond -30: held by another test
     line = [x for x in G.replicate_lines({"replicate 0": r0, "replicate 1": r1}) if "ranked first" in x][0]
     assert "— 0 with the first-ranked ΔBIC within that replicate's threshold, 1 beyond it" in line
+
+
+def test_replaying_a_stored_relative_validation_at_its_threshold_gives_back_every_verdict():
+    """gap_study.named_at replays assemble's rule (first-ranked ΔBIC at or below the
+    threshold, no runner-up within the margin) on the stored rankings: at each stored
+    validation's own threshold it must give back every stored verdict; a looser threshold
+    can only name more, a stricter one only fewer."""
+    from gaitlib.studies import gap as G
+
+    for name in ("relative_rev4", "relative_rev4_r1", "relative_rev3"):
+        v = G.superseded_validation(name)
+        t = G.calibration_threshold(v)
+        r = G.named_at(v, t)
+        assert (r["named"] == v.rows["named"]).all() and (r["correct"] == v.rows["correct"].astype(bool)).all()
+        loose, strict = G.named_at(v, t + 20), G.named_at(v, t - 20)
+        named = lambda x: (x["named"] != "unexplained").sum()  # noqa: E731
+        assert named(strict) <= named(r) <= named(loose)
+
+
+def test_threshold_sweep_and_the_ranking_ceiling_by_hand():
+    """Two independent cases, one out-of-library: a case ranked right with ΔBIC −40 is named
+    right at −30 but not at −50; one ranked wrong is never right (the ceiling); the
+    out-of-library case (ΔBIC −35 first) is right only where its ΔBIC misses the threshold."""
+    from gaitlib.studies import gap as G
+
+    rows = V.pd.DataFrame({
+        "case": ["a_middle_0", "b_large_0", "c_middle_0"], "set": ["independent", "independent", "out-of-library"],
+        "band": ["middle", "large", "middle"], "expected": ["knee_offset", "body_mass", "unexplained"],
+        "rank1": ["knee_offset", "grf_scale", "foot_contact"], "rank1_dBIC": [-40.0, -200.0, -35.0],
+        "rank2": ["hip_offset", "body_mass", "friction"], "rank2_dBIC": [-5.0, -150.0, -1.0],
+        "contenders": [["knee_offset"], ["grf_scale"], ["foot_contact"]], "expected_rank": [1, 2, None],
+        "magnitude": [3.0, 0.2, 0.1], "verdict": ["partial"] * 3, "named": ["knee_offset", "grf_scale", "foot_contact"],
+        "correct": [True, False, False]})
+    v = V.Validation(rows, {}, {"relative": True})
+    sw = G.threshold_sweep({"r0": v}, thresholds=(-30, -50))
+    assert sw.loc[-30, "independent, middle + large"] == "1/2 (50 %)" and sw.loc[-30, "out-of-library"] == "0/1 (0 %)"
+    assert sw.loc[-50, "independent, middle + large"] == "0/2 (0 %)" and sw.loc[-50, "out-of-library"] == "1/1 (100 %)"
+    miss = G.ranking_misses({"r0": v})
+    assert miss["case"].tolist() == ["b_large_0"] and miss["why"].iloc[0] == "another effect ranked first"
+    (line,) = G.threshold_lines({"r0": v})
+    assert "1 cases no threshold names right — 1 of the body_mass injections" in line
+    assert "b_large_0 (r0): grf_scale -200, body_mass -150" in line
+
+
+def test_load_confusion_lines_by_hand():
+    """The experiment's sentence from a made-up result: the torque share of the baseline's
+    change, the medians left by each effect, the ranked-first counts, the swing cells."""
+    from gaitlib.studies import gap as G
+
+    def case(rank1, bm_grf, gs_grf, cell):
+        return {"injection": "load_scale", "expected": "body_mass", "magnitude": 0.1, "rank1": rank1,
+                "baseline": {"angle": 10.0, "grf": 60.0, "torque": 30.0},
+                "body_mass": {"angle": 9.0, "grf": bm_grf, "torque": 5.0, "worst_grf_cell": cell, "change": 0.09},
+                "grf_scale": {"angle": 9.0, "grf": gs_grf, "torque": 29.0, "worst_grf_cell": "grf:grf_y_r LR",
+                              "change": 0.12}}
+
+    res = {"cases": [case("grf_scale", 8.0, 2.0, "grf:grf_y_l TSw"), case("body_mass", 4.0, 3.0, "grf:grf_x_r LR")]}
+    a, b = G.load_confusion_lines(res)
+    assert "torque channels carry 30–30 %" in a and "GRF channels: body_mass 6.0, grf_scale 2.5" in a
+    assert "Ranked first: grf_scale 1×, body_mass 1×" in a and "+0.090 for +0.100" in a
+    assert "identifies the injected magnitude (within 10 %)" in b
+    assert "leaves 3.5 more GRF RSS than `grf_scale` (median; more in 2 of 2 cases; its largest GRF cell lies in a " \
+           "swing phase in 1 of them" in b
+    assert "it leaves 24.0 less (median), more than its GRF excess in 2 of 2 cases" in b
+
+
+def test_threshold_draw_lines_name_the_draw_that_sets_the_lowest_statistic():
+    from gaitlib.studies import gap as G
+
+    calib = {"dBIC": [{"a": -10.0, "b": 2.0}, {"a": -80.0, "b": -50.0, "c": -30.0}, {}],
+             "moved": {"null0": {"baseline": {"reference": [0.78, 0.75]}},
+                       "null1": {"baseline": {"reference": [0.73, 0.70]}}}}
+    (line,) = G.threshold_draw_lines(V.Validation(V.pd.DataFrame(), {"null_calibration": calib}, {}), "rep")
+    assert line.startswith("The draw that sets rep's lowest statistic (null1): a at ΔBIC -80; 2 of its 3 ranked")
+    assert "from -50 to -80" in line and "objective 0.700, against a median of 0.750 in the other 1 draws" in line

@@ -61,9 +61,11 @@ evidence: in the first relative validation (Chapter 8), draws in which nothing c
 reached ΔBIC −134. So the reference is redrawn K times within the sampling error of the
 difference (:func:`null_draw`; K and the seeds from
 :data:`gaitlib.gap.method.RELATIVE`), each draw diagnosed relative to the reference exactly
-as the data are, and the top effect must also beat the lowest ΔBIC that any candidate
-reached on any draw (:func:`gaitlib.gap.diagnose.null_calibration`): a max-statistic test
-over the candidates at level 1/(K + 1).
+as the data are; each draw's statistic is the lowest ΔBIC any candidate reached on it (a
+max statistic over the candidates), and the top effect must also beat the r-th lowest of
+the K statistics (:func:`gaitlib.gap.diagnose.null_calibration`,
+:func:`gaitlib.gap.method.null_threshold`): a rank test at level r/(K + 1) (revision 5:
+r = 2 of K = 19; revisions 1–4: the lowest of 9).
 
 Assumptions, stated: the model's own misfit F_k(R) − R does not change with the effect (first
 order: an effect that changes the gait changes the misfit too); both data sets have the same

@@ -59,7 +59,7 @@ from .noise import smooth_noise
 
 __all__ = ["Injection", "INJECTIONS", "SETS", "BANDS", "PLATE_THRESHOLD_BW", "VARIANTS", "VARIANT_SEEDS", "ALL_SETS",
            "NULL_DRAWS", "REFERENCE_DRAW", "draws", "effect_magnitude", "inject", "resample", "run", "Validation", "null_spread", "visibility",
-           "relative_null_sets"]
+           "relative_null_sets", "relative_case_sets"]
 
 #: Vertical force (body weights) above which a foot counts as on the plate in the AP-bias
 #: manipulation: 10 N for the Schwartz 2008 mean child (41.4 kg), a typical plate threshold.
@@ -498,6 +498,17 @@ def relative_null_sets(v: Validation, folder) -> tuple:
     [(case row, DataSet), …])``."""
     if not v.settings.get("relative"):
         raise ValueError("relative_null_sets: not a relative validation (gap-validate --relative)")
+    return relative_case_sets(v, folder, list(v.rows.loc[v.rows["set"] == "null", "case"]))
+
+
+def relative_case_sets(v: Validation, folder, cases) -> tuple:
+    """The reference and the named ``cases`` (any set) of a stored relative validation,
+    regenerated as :func:`run` made them — the reference and null draws with their stored
+    seeds, a manipulated case injected and resampled with the seed of the validation's own
+    draws (its relative method's hash and replicate) — written as CSV to ``folder`` and read
+    back as ``gaitlib gap --data`` reads them: ``(reference DataSet, [(case row, DataSet), …])``."""
+    if not v.settings.get("relative"):
+        raise ValueError("relative_case_sets: not a relative validation (gap-validate --relative)")
     folder = Path(folder)
     frame = real_frame(v.settings.get("speed_class", "Free"))
     p0 = folder / "unedited.csv"
@@ -505,10 +516,19 @@ def relative_null_sets(v: Validation, folder) -> tuple:
     n0 = gio.read_data(p0).n
     pr = folder / "reference.csv"
     resample(frame, int(v.unedited["reference_seed"]), n0).to_csv(pr, index=False)
+    rows = v.rows.set_index("case", drop=False)
+    unknown = [c for c in cases if c not in rows.index]
+    if unknown:
+        raise ValueError(f"relative_case_sets: no case {', '.join(unknown)} in this validation")
     out = []
-    for _, c in v.rows[v.rows["set"] == "null"].iterrows():
-        p = folder / f"{c['case']}.csv"
-        resample(frame, int(c["magnitude"]), n0).to_csv(p, index=False)
+    for case in cases:
+        c = rows.loc[case]
+        p = folder / f"{case}.csv"
+        if c["set"] == "null":
+            resample(frame, int(c["magnitude"]), n0).to_csv(p, index=False)
+        else:  # the seed of the validation's own draws: its relative method's hash and replicate
+            h = replicate_hash(v.settings["relative_method_hash"], int(v.settings.get("replicate", 0)))
+            resample(inject(frame, c["injection"], c["magnitude"]), _seed(h, case, 1) % 2**31, n0).to_csv(p, index=False)
         out.append((c, gio.read_data(p)))
     return gio.read_data(pr), out
 

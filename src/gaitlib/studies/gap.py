@@ -56,7 +56,8 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "left_leg_flips", "co_contraction_text", "findings",
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
            "VALIDATION_RUNS", "stored_validation", "calibration_threshold", "wilson", "TARGET_GROUPS",
-           "replicate_table", "replicate_lines", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
+           "replicate_table", "replicate_lines", "named_at", "rule_table", "threshold_sweep", "ranking_misses", "threshold_lines",
+           "threshold_draw_lines", "stored_load_confusion", "load_confusion_lines", "LOAD_CONFUSION_FILE", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
            "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines",
            "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines", "consistency_lines", "tie_lines",
            "stored_reference_basin", "reference_basin_lines", "REFERENCE_BASIN_FILE", "stored_baseline_basin",
@@ -394,7 +395,7 @@ def stored_validation(name: str = "real") -> gval.Validation:
 #: A validation made by an earlier method, kept as the "before" of a method change:
 #: folder under ``gap_validation`` → the method revision that made it.
 SUPERSEDED_VALIDATIONS = {"real_rev1": 1, "relative_rev0": 0, "relative_rev1": 1, "relative_rev2": 2,
-                          "relative_rev3": 3}
+                          "relative_rev3": 3, "relative_rev4": 4, "relative_rev4_r1": 4}
 
 
 def superseded_validation(name: str = "real_rev1") -> gval.Validation:
@@ -683,14 +684,11 @@ def replicate_table(reps: dict) -> pd.DataFrame:
     (label → :class:`~gaitlib.gap.validate.Validation`, the same method on other draws) and
     pooled over them, with Wilson's 95 % interval of the pooled rate; the threshold each
     replicate's null calibration set is the last row."""
-    rows = []
-    for g, (st, bands) in TARGET_GROUPS.items():
+    rows, counts = [], {lab: _group_counts(v.rows) for lab, v in reps.items()}
+    for g in TARGET_GROUPS:
         row, k_all, n_all = {"group": g}, 0, 0
-        for lab, v in reps.items():
-            r = v.rows[v.rows["set"] == st]
-            if bands is not None:
-                r = r[r["band"].isin(bands)]
-            k, n = int(r["correct"].astype(bool).sum()), len(r)
+        for lab in reps:
+            k, n = counts[lab][g]
             row[lab] = f"{k}/{n}" if n else "—"
             k_all, n_all = k_all + k, n_all + n
         lo, hi = wilson(k_all, n_all)
@@ -702,6 +700,220 @@ def replicate_table(reps: dict) -> pd.DataFrame:
     rows.append({"group": "threshold (ΔBIC ≤)", **{lab: (f"{t:.0f}" if t is not None else "—") for lab, t in thr.items()},
                  "pooled": "", "pooled %": np.nan, "95 % interval": ""})
     return pd.DataFrame(rows).set_index("group")
+
+
+def named_at(v: gval.Validation, threshold: float) -> pd.DataFrame:
+    """The cases of a relative validation decided again at another threshold: a case names
+    its first-ranked effect if that effect's ΔBIC is at or below ``threshold`` (and the fixed
+    :data:`gaitlib.gap.method.BIC_THRESHOLD`) and no runner-up is within the margin (its
+    stored ``contenders``), else "unexplained" — :func:`gaitlib.gap.diagnose.assemble`'s rule
+    replayed on the stored ranking (the contenders do not depend on the threshold). Returns
+    the rows with ``named`` and ``correct`` replaced; a failed baseline stays as stored."""
+    thr = min(diagnose.BIC_THRESHOLD, float(threshold))
+    r = v.rows.copy()
+
+    def one(row):
+        if row["verdict"] == "baseline failed":
+            return row["named"]
+        c = row["contenders"] if isinstance(row["contenders"], (list, tuple)) else []
+        ok = pd.notna(row["rank1_dBIC"]) and float(row["rank1_dBIC"]) <= thr and len(c) <= 1
+        return str(row["rank1"]) if ok else "unexplained"
+
+    r["named"] = r.apply(one, axis=1)
+    r["correct"] = [n in str(e).split("|") for n, e in zip(r["named"], r["expected"])]
+    return r
+
+
+def _group_counts(rows: pd.DataFrame) -> dict:
+    """Named right / cases per target group (:data:`TARGET_GROUPS`): group → (k, n)."""
+    out = {}
+    for g, (st, bands) in TARGET_GROUPS.items():
+        r = rows[rows["set"] == st]
+        if bands is not None:
+            r = r[r["band"].isin(bands)]
+        out[g] = (int(r["correct"].astype(bool).sum()), len(r))
+    return out
+
+
+def rule_table(v: gval.Validation) -> pd.DataFrame:
+    """One relative validation's cases decided by the null threshold of revisions 1–4 (the
+    lowest statistic of the calibration's first 9 draws — the draws a K = 9 calibration of
+    this method would have made, the seeds being per draw) and by its own rule
+    (:func:`gaitlib.gap.method.null_threshold`, ``rank`` of all its draws): per target group,
+    named right / cases, and each rule's threshold. Paired: the same cases, the same
+    rankings, only the threshold differs (:func:`named_at`)."""
+    c = (v.unedited or {}).get("null_calibration") or {}
+    per, rank = c.get("dBIC") or [], int(c.get("rank", 1))
+    rules = {f"lowest of the first {min(9, len(per))} draws (revisions 1–4)": gap_method.null_threshold(per[:9], 1),
+             f"{_ORDINAL.get(rank, f'{rank}th')} of {len(per)} draws (this revision)": gap_method.null_threshold(per, rank)}
+    rows = []
+    for lab, t in rules.items():
+        k = _group_counts(named_at(v, t)) if t is not None else {}
+        rows.append({"rule": lab, "threshold (ΔBIC ≤)": t,
+                     **{g: (f"{a}/{n}" if n else "—") for g, (a, n) in k.items()}})
+    return pd.DataFrame(rows).set_index("rule")
+
+
+def threshold_sweep(reps: dict, thresholds=(-10, -20, -30, -40, -50, -60, -80, -100, -150)) -> pd.DataFrame:
+    """Named right per target group, pooled over the replicates ``reps`` (label →
+    :class:`~gaitlib.gap.validate.Validation`), had every case been decided at each of
+    ``thresholds`` (ΔBIC ≤) instead of its own calibration's (:func:`named_at`): what the
+    threshold alone can trade between naming an injected effect and saying "unexplained"."""
+    rows = []
+    for t in thresholds:
+        tot = {g: [0, 0] for g in TARGET_GROUPS}
+        for v in reps.values():
+            for g, (k, n) in _group_counts(named_at(v, t)).items():
+                tot[g][0] += k
+                tot[g][1] += n
+        rows.append({"threshold (ΔBIC ≤)": t, **{g: (f"{k}/{n} ({100.0 * k / n:.0f} %)" if n else "—")
+                                                  for g, (k, n) in tot.items()}})
+    return pd.DataFrame(rows).set_index("threshold (ΔBIC ≤)")
+
+
+def ranking_misses(reps: dict, bands=("middle", "large")) -> pd.DataFrame:
+    """The independent injections (in ``bands``) that no threshold names right: the expected
+    effect not ranked first, or a runner-up within the margin (the stored ``contenders``) —
+    with the first two ranked effects and their ΔBIC. The ceiling of :func:`threshold_sweep`."""
+    out = []
+    for lab, v in reps.items():
+        r = v.rows[(v.rows["set"] == "independent") & v.rows["band"].isin(bands)]
+        for _, x in r.iterrows():
+            c = x["contenders"] if isinstance(x["contenders"], (list, tuple)) else []
+            if x["rank1"] == x["expected"] and len(c) <= 1:
+                continue
+            out.append({"replicate": lab, "case": x["case"], "expected": x["expected"], "magnitude": x["magnitude"],
+                        "rank1": x["rank1"], "rank1_dBIC": x["rank1_dBIC"], "rank2": x["rank2"],
+                        "rank2_dBIC": x["rank2_dBIC"], "expected_rank": x["expected_rank"],
+                        "why": "ranked first, runner-up within the margin" if x["rank1"] == x["expected"]
+                        else "another effect ranked first"})
+    return pd.DataFrame(out)
+
+
+def threshold_lines(reps: dict, target: float = 90.0) -> list[str]:
+    """:func:`threshold_sweep` and :func:`ranking_misses` in words, every number from the
+    stored results: the best rate any threshold gives the independent middle+large group,
+    the thresholds at which the out-of-library group reaches the target, and the cases no
+    threshold names right."""
+    sw = threshold_sweep(reps)
+    g_in, g_ool = "independent, middle + large", "out-of-library"
+
+    def pct(s):
+        return float(s.split("(")[1].split(" %")[0]) if "(" in s else np.nan
+
+    best_in = max(sw[g_in], key=pct)
+    ool_ok = [t for t in sw.index if pct(sw.loc[t, g_ool]) >= target]
+    miss = ranking_misses(reps)
+    fams = miss["expected"].value_counts() if len(miss) else pd.Series(dtype=int)
+    line = (f"Decided again at fixed thresholds ({len(reps)} replicates pooled, the same rankings): the independent "
+            f"middle+large group reaches at best {best_in} (at any threshold from {max(t for t in sw.index if sw.loc[t, g_in] == best_in):g} "
+            f"to {min(t for t in sw.index if sw.loc[t, g_in] == best_in):g}); the out-of-library group reaches "
+            f"{target:.0f} % " + (f"only at ΔBIC ≤ {max(ool_ok):g} or lower" if ool_ok else "at no threshold tried")
+            + f". {len(miss)} cases no threshold names right")
+    if len(miss):
+        line += (" — " + ", ".join(f"{k} of the {e} injections" for e, k in fams.items()) + ": "
+                 + "; ".join(f"{r['case']} ({r['replicate']}): {r['rank1']} {r['rank1_dBIC']:.0f}, {r['rank2']} "
+                             f"{r['rank2_dBIC']:.0f}" for _, r in miss.iterrows())
+                 + ". These are the target's ceiling under this ranking: a threshold cannot move it.")
+    else:
+        line += "."
+    return [line]
+
+
+def threshold_draw_lines(v: gval.Validation, label: str = "") -> list[str]:
+    """The null draw whose statistic is the lowest of a relative validation's calibration, in
+    words computed from the stored calibration: its first-ranked effect and ΔBIC, how many of
+    the ranked candidates reached at least half that ΔBIC (a shift shared by unrelated
+    candidates rather than one effect absorbing noise), and the baseline's fit of the
+    reference in that draw (its objective after the self-consistency rounds) against the
+    other draws' median."""
+    c = (v.unedited or {}).get("null_calibration") or {}
+    per = c.get("dBIC") or []
+    stats = [(min(p.values()), j) for j, p in enumerate(per) if p]
+    if not stats:
+        return ["(no ranked null draw stored)"]
+    lo, j = min(stats)
+    vals = per[j]
+    eff = min(vals, key=vals.get)
+    near = sorted(x for x in vals.values() if x <= lo / 2)
+    line = (f"The draw that sets {label or 'this calibration'}'s lowest statistic (null{j}): {eff} at ΔBIC {lo:.0f}; "
+            f"{len(near)} of its {len(vals)} ranked candidates reached ΔBIC ≤ {lo / 2:.0f} (half of it), from "
+            f"{near[-1]:.0f} to {near[0]:.0f}")
+    moved = c.get("moved") or {}
+
+    def ref_after(k):
+        b = (moved.get(k) or {}).get("baseline") or {}
+        return b["reference"][1] if b.get("reference") else None
+
+    mine = ref_after(f"null{j}")
+    others = [x for k in moved if k != f"null{j}" and (x := ref_after(k)) is not None]
+    if mine is not None and others:
+        line += (f"; in it the baseline's fit of the reference reached objective {mine:.3f}, against a median of "
+                 f"{float(np.median(others)):.3f} in the other {len(others)} draws where it moved")
+    return [line + "."]
+
+
+#: The swing phases of :mod:`gaitlib.gap.locate` (a GRF there is the model's, not the data's).
+SWING_PHASES = locate.PHASES[3:]
+#: ``benchmarks/gap_load_confusion.py``'s result, under the validation's folder.
+LOAD_CONFUSION_FILE = "load_confusion.json"
+
+
+def stored_load_confusion() -> dict | None:
+    """``benchmarks/gap_load_confusion.py``'s result (:func:`stored_experiment`), refused if a
+    validation it names was made under another relative method than the stored one."""
+    r = stored_experiment(f"gap_validation/{LOAD_CONFUSION_FILE}", "gap_load_confusion.py")
+    if r is None:
+        return r
+    for name, h in r["validations"].items():
+        if superseded_validation(name).settings.get("relative_method_hash") != h:
+            raise RuntimeError(f"{LOAD_CONFUSION_FILE}: {name} was re-diagnosed under relative method {h}, it is "
+                               f"stored under another: rerun benchmarks/gap_load_confusion.py")
+    return r
+
+
+def load_confusion_lines(res: dict) -> list[str]:
+    """``benchmarks/gap_load_confusion.py``'s result in words, every number from it: per
+    manipulation, the share of the baseline's located change in the torque channels, what
+    ``body_mass`` and ``grf_scale`` leave in the GRF and torque channels (medians), and how
+    often each was ranked first."""
+    cs = pd.DataFrame(res["cases"])
+    out = []
+    for inj, g in cs.groupby("injection", sort=False):
+        def med(m, k):
+            return float(np.median([x[m][k] for _, x in g.iterrows()]))
+
+        tq = [x["baseline"]["torque"] / (x["baseline"]["torque"] + x["baseline"]["grf"] + x["baseline"]["angle"])
+              for _, x in g.iterrows()]
+        first = g["rank1"].value_counts()
+        exp = str(g["expected"].iloc[0])
+        chg = [(x["magnitude"], x[exp]["change"]) for _, x in g.iterrows()]
+        out.append(
+            f"`{inj}` (expected `{exp}`, {len(g)} middle/large cases): the torque channels carry "
+            f"{100 * min(tq):.0f}–{100 * max(tq):.0f} % of the baseline's located change. Median RSS left in the "
+            f"GRF channels: body_mass {med('body_mass', 'grf'):.1f}, grf_scale {med('grf_scale', 'grf'):.1f} "
+            f"(baseline {med('baseline', 'grf'):.1f}); in the torque channels: body_mass "
+            f"{med('body_mass', 'torque'):.1f}, grf_scale {med('grf_scale', 'torque'):.1f} (baseline "
+            f"{med('baseline', 'torque'):.1f}). Ranked first: " + ", ".join(f"{e} {k}×" for e, k in first.items())
+            + f". `{exp}`'s identified change against the injected magnitude: "
+            + ", ".join(f"{c:+.3f} for {m:+.3f}" for m, c in chg) + ".")
+    bm = cs.apply(lambda x: x["body_mass"]["grf"] - x["grf_scale"]["grf"], axis=1)
+    tq = cs.apply(lambda x: x["grf_scale"]["torque"] - x["body_mass"]["torque"], axis=1)
+    ls = cs["injection"] == "load_scale"
+    swing = cs.loc[ls, "body_mass"].apply(lambda x: str(x["worst_grf_cell"]).split(" ")[-1] in SWING_PHASES)
+    if ls.any():
+        err = [abs(x["body_mass"]["change"] / x["magnitude"] - 1.0) for _, x in cs[ls].iterrows()]
+        out.append(f"So on a normalising-mass error the model's `body_mass` — the dynamic body made heavier, "
+                   f"contact and data unchanged — identifies the injected magnitude (within {100 * max(err):.0f} %) "
+                   f"but does not fit the scaled GRFs as a plate gain does: it leaves {bm[ls].median():.1f} more GRF "
+                   f"RSS than `grf_scale` (median; more in {int((bm[ls] > 0).sum())} of {int(ls.sum())} cases; its "
+                   f"largest GRF cell lies in a swing phase in {int(swing.sum())} of them, where the data carry no "
+                   f"load and the model's foot does). In the torque channels, where a gain and a mass differ, it "
+                   f"leaves {tq[ls].median():.1f} less (median), more than its GRF excess in "
+                   f"{int((tq[ls] > bm[ls]).sum())} of {int(ls.sum())} cases. The library has no effect that scales "
+                   "the data's loads as a normalising mass does, so the choice between a mass and a plate gain rests "
+                   "on that balance: with the runner-up margin, this family is the ceiling of the threshold sweep.")
+    return out
 
 
 def replicate_lines(reps: dict, target: float = 90.0) -> list[str]:
@@ -1416,7 +1628,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
              check_u: dict, gaps: pd.DataFrame, emg: pd.DataFrame, val: gval.Validation | None = None,
              valv: gval.Validation | None = None, diag_m: diagnose.Diagnosis | None = None,
              profile_m: pd.DataFrame | None = None, valn: gval.Validation | None = None, tv_muscle=None,
-             valr: gval.Validation | None = None, valr_reps: dict | None = None) -> list[str]:
+             valr: gval.Validation | None = None, valr_reps: dict | None = None,
+             load_confusion: dict | None = None) -> list[str]:
     """The chapter's findings as Markdown paragraphs, every number and verdict from the
     results: the twin checks (``tv`` on the coarse mesh, :func:`twin_validation`;
     ``tv_full`` on 20 × 5, :func:`twin_validation_full_mesh`), the SK diagnoses of Schwartz
@@ -1428,9 +1641,12 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     (``diag_m``, :func:`ch5_attribution`, with its top effect profiled beyond the grid,
     ``profile_m``, :func:`ch5_profile`); ``valn``: the null draws (why the manipulated data's
     injections are or are not named, :func:`null_lines`); ``valr``: the same manipulations
-    diagnosed relative to the unedited data (:func:`relative_lines`), ``valr_reps`` its
-    replicates on other draws (label → validation, :func:`replicate_lines`); ``tv_muscle``: the
-    muscle-level twins (:func:`muscle_twin_validation`)."""
+    diagnosed relative to the unedited data (:func:`relative_lines`, with the two threshold
+    rules on its cases, :func:`rule_table`), ``valr_reps`` an earlier revision's replicates on
+    other draws (label → validation, :func:`replicate_lines`, with what a fixed threshold
+    gives on them, :func:`threshold_lines`); ``load_confusion``: why the load family holds
+    that ceiling (:func:`load_confusion_lines`); ``tv_muscle``: the muscle-level twins
+    (:func:`muscle_twin_validation`)."""
     s, sf = tv.summary(), tv_full.summary()
     acc = tv.accuracy()
     sS, sU = summary(diag_s), summary(diag_u)
@@ -1485,8 +1701,19 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
         out.append("**The same manipulations as a change relative to the unedited data** (`gaitlib gap "
                    "--reference`: each model's own residual on the reference subtracted). "
                    + " ".join(relative_lines(valr, val)))
+    if valr is not None:
+        rt = rule_table(valr)
+        g = "independent, middle + large"
+        out.append(f"**The relative method's threshold rule** (revision {valr.settings['relative_method']['revision']}"
+                   f"): on its own cases, " + "; ".join(
+                       f"{lab}: ΔBIC ≤ {r['threshold (ΔBIC ≤)']:.0f}, {g} {r[g]}, out-of-library {r['out-of-library']}"
+                       for lab, r in rt.iterrows()) + ".")
     if valr_reps is not None and len(valr_reps) > 1:
-        out.append("**The relative diagnosis on a second set of draws.** " + " ".join(replicate_lines(valr_reps)))
+        rev = next(iter(valr_reps.values())).settings["relative_method"]["revision"]
+        out.append(f"**Revision {rev} on a second set of draws.** " + " ".join(replicate_lines(valr_reps))
+                   + " " + " ".join(threshold_lines(valr_reps)))
+    if load_confusion is not None:
+        out.append(" ".join(load_confusion_lines(load_confusion)))
     if valv is not None:
         out.append(" ".join(validation_lines(valv)[:-1]))
     if tv_muscle is not None:
