@@ -908,7 +908,8 @@ def load_confusion_lines(res: dict) -> list[str]:
                    f"but does not fit the scaled GRFs as a plate gain does: it leaves {bm[ls].median():.1f} more GRF "
                    f"RSS than `grf_scale` (median; more in {int((bm[ls] > 0).sum())} of {int(ls.sum())} cases; its "
                    f"largest GRF cell lies in a swing phase in {int(swing.sum())} of them, where the data carry no "
-                   f"load and the model's foot does). In the torque channels, where a gain and a mass differ, it "
+                   f"load: a heavier model whose swing foot touches the ground would put it there — a hypothesis, "
+                   f"not measured here). In the torque channels, where a gain and a mass differ, it "
                    f"leaves {tq[ls].median():.1f} less (median), more than its GRF excess in "
                    f"{int((tq[ls] > bm[ls]).sum())} of {int(ls.sum())} cases. The library has no effect that scales "
                    "the data's loads as a normalising mass does, so the choice between a mass and a plate gain rests "
@@ -1629,7 +1630,7 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
              valv: gval.Validation | None = None, diag_m: diagnose.Diagnosis | None = None,
              profile_m: pd.DataFrame | None = None, valn: gval.Validation | None = None, tv_muscle=None,
              valr: gval.Validation | None = None, valr_reps: dict | None = None,
-             load_confusion: dict | None = None) -> list[str]:
+             load_confusion: dict | None = None, valr5_reps: dict | None = None) -> list[str]:
     """The chapter's findings as Markdown paragraphs, every number and verdict from the
     results: the twin checks (``tv`` on the coarse mesh, :func:`twin_validation`;
     ``tv_full`` on 20 × 5, :func:`twin_validation_full_mesh`), the SK diagnoses of Schwartz
@@ -1645,8 +1646,9 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     rules on its cases, :func:`rule_table`), ``valr_reps`` an earlier revision's replicates on
     other draws (label → validation, :func:`replicate_lines`, with what a fixed threshold
     gives on them, :func:`threshold_lines`); ``load_confusion``: why the load family holds
-    that ceiling (:func:`load_confusion_lines`); ``tv_muscle``: the muscle-level twins
-    (:func:`muscle_twin_validation`)."""
+    that ceiling (:func:`load_confusion_lines`); ``valr5_reps``: the current revision's
+    replicates (pooled rates and the same ceiling on them); ``tv_muscle``: the muscle-level
+    twins (:func:`muscle_twin_validation`)."""
     s, sf = tv.summary(), tv_full.summary()
     acc = tv.accuracy()
     sS, sU = summary(diag_s), summary(diag_u)
@@ -1714,6 +1716,10 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
                    + " " + " ".join(threshold_lines(valr_reps)))
     if load_confusion is not None:
         out.append(" ".join(load_confusion_lines(load_confusion)))
+    if valr5_reps is not None and len(valr5_reps) > 1:
+        rev = next(iter(valr5_reps.values())).settings["relative_method"]["revision"]
+        out.append(f"**Revision {rev}, both replicates.** " + " ".join(replicate_lines(valr5_reps)[:-1])
+                   + " " + " ".join(threshold_lines(valr5_reps)))
     if valv is not None:
         out.append(" ".join(validation_lines(valv)[:-1]))
     if tv_muscle is not None:
