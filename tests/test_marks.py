@@ -366,3 +366,35 @@ def test_a_legend_of_long_marked_run_labels_never_widens_a_tracking_figure(tmp_p
     fig.savefig(tmp_path / "f.png", bbox_inches="tight")
     plt.close(fig)
     assert Image.open(tmp_path / "f.png").size[0] <= 1.1 * 8 * 50
+
+
+def test_a_marked_one_row_tracking_figure_keeps_its_axes_and_its_width(tracked, tmp_path):
+    """Ch 4's GRF figure: one row of four panels, a run marked with three failed gates (a
+    title of three lines and a legend label of two) — at its nominal 2.1 in the decorations
+    left the axes no height and constrained layout gave up ("axes sizes collapsed to zero").
+    The figure grows to fit them: saving raises no layout warning, every panel keeps at least
+    1.4 in of the figure, and the width is not exceeded."""
+    import warnings
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from PIL import Image
+
+    from gaitlib import plots
+
+    label = ("INVALID: swing load 47.4 N > 8.12 N (2 % BW); residual force 331 N > 24.5 N (5 % of peak external "
+             "force); residual moment 29.3 N·m > 4.11 N·m (1 % of COM height × peak external force)")
+    sims = {"(a) trajectory optimisation": tracked.mean, "(b) optimal control": tracked.mean,
+            "(c) optimal control + body parameters": tracked.mean}
+    fig = plots.tracking_figure(tracked, sims, channels=("grf_x_r", "grf_y_r", "grf_x_l", "grf_y_l"), ncols=4,
+                                title="Figs 4.9 / 4.15", marks={"(a) trajectory optimisation": label})
+    assert fig.get_size_inches()[1] >= 1.4 + 0.35
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fig.savefig(tmp_path / "f.png", bbox_inches="tight", dpi=50)
+    h_ax = min(ax.get_position().height for ax in fig.axes if ax.get_visible()) * fig.get_size_inches()[1]
+    plt.close(fig)
+    assert h_ax > 0.5
+    assert Image.open(tmp_path / "f.png").size[0] <= 1.1 * 12 * 50

@@ -188,9 +188,9 @@ def mark_figure(fig, label: str | None):
     old = fig._suptitle.get_text() if getattr(fig, "_suptitle", None) is not None else ""
     size = fig._suptitle.get_fontsize() if old else 10
     sep = "\n" if len(label) + len(old) > 70 else " — "
-    # wrapped to the figure's width (≈ 0.55 em per character): a long label (many marked
-    # runs) must not widen the saved figure beyond its axes
-    width = max(40, int(fig.get_size_inches()[0] * 72.0 / (0.55 * size)))
+    # wrapped to the figure's width (bold: ≈ 0.65 em per character): a long label (many
+    # marked runs) must not widen the saved figure beyond its axes
+    width = max(40, int(fig.get_size_inches()[0] * 72.0 / (0.65 * size)))
     label = textwrap.fill(label, width=width)
     t = fig.suptitle(f"{label}{sep}{old}" if old else label, color=MARK_COLOR, fontsize=size,
                      fontweight="bold")

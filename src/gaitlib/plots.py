@@ -80,6 +80,32 @@ def _legend_layout(fig, labels, fontsize: float = 8.0, max_cols: int = 5):
     return wrapped, ncols
 
 
+def fit_decorations(fig, nrows: int, min_panel: float = 1.4):
+    """Make ``fig`` tall enough for its title and legends beside ``nrows`` rows of panels at
+    least ``min_panel`` inches high (≈ 1.35 × font size per text line): a marked title and a
+    wrapped legend on a one-row figure must not squeeze its axes to nothing (constrained
+    layout then gives up and the panels overlap)."""
+    deco = 0.0
+    st = getattr(fig, "_suptitle", None)
+    if st is not None and st.get_text():
+        deco += len(st.get_text().splitlines()) * st.get_fontsize() * 1.35 + 6.0
+    for leg in fig.legends:
+        texts = leg.get_texts()
+        if not texts:
+            continue
+        ncols = max(1, int(getattr(leg, "_ncols", 1)))
+        lines = [len(t.get_text().splitlines()) or 1 for t in texts]
+        rows = int(np.ceil(len(lines) / ncols))
+        # column-major: column c holds labels c*rows … (c+1)*rows − 1; a row is as tall as its tallest label
+        per_row = [max(lines[c * rows + r] for c in range(ncols) if c * rows + r < len(lines)) for r in range(rows)]
+        deco += sum(per_row) * texts[0].get_fontsize() * 1.35 + 10.0
+    w, h = fig.get_size_inches()
+    need = nrows * min_panel + deco / 72.0 + 0.35  # + the x labels
+    if h < need:
+        fig.set_size_inches(w, need)
+    return fig
+
+
 def _finish_panels(fig, axes, n: int, title=None):
     """Hide unused panels, label the x axes (% gait cycle), one legend, a title."""
     for ax in axes.flat[n:]:
@@ -517,7 +543,7 @@ def tracking_figure(gait, sims: dict, channels=GAIT_CHANNELS, ncols: int = 4, co
         mk.mark_axes(ax, mk.joint_label({k: marks.get(k) for k in shown}, named=len(sims) > 1))
     fig = _finish_panels(fig, axes, len(channels), title)
     mk.mark_figure(fig, mk.joint_label(marks, named=len(sims) > 1))
-    return fig
+    return fit_decorations(fig, axes.shape[0])
 
 
 def animate_jump(jump_model, t, Q, p_contact=None, grf=None, cop=None, fps: float = 12,
