@@ -654,9 +654,16 @@ def test_load_confusion_lines_by_hand():
     assert "torque channels carry 30–30 %" in a and "GRF channels: body_mass 6.0, grf_scale 2.5" in a
     assert "Ranked first: grf_scale 1×, body_mass 1×" in a and "+0.090 for +0.100" in a
     assert "identifies the injected magnitude (within 10 %)" in b
-    assert "leaves 3.5 more GRF RSS than `grf_scale` (median; more in 2 of 2 cases; its largest GRF cell lies in a " \
-           "swing phase in 1 of them" in b
-    assert "it leaves 24.0 less (median), more than its GRF excess in 2 of 2 cases" in b
+    assert "leaves 3.5 more GRF RSS than `grf_scale` (median; more in 2 of 2 cases)." in b
+    assert "body_mass leaves 24.0 less (median), more than its GRF excess in 2 of 2 cases" in b
+    for x in res["cases"]:  # the swing measurements of the experiment's second version
+        x["body_mass"].update(grf_swing=4.0, swing_load_N={"r": 70.0, "l": 120.0})
+        x["grf_scale"].update(grf_swing=1.0, swing_load_N={"r": 70.0, "l": 100.0})
+        x["baseline"]["swing_load_N"] = {"r": 70.0, "l": 105.0}
+    b = G.load_confusion_lines(res)[1]
+    # excess GRF 8 − 2 = 6 and 4 − 3 = 1; in swing 4 − 1 = 3 of each: 50 % and 300 %, median 175 %
+    assert "175 % of that excess (median) lies in the swing phases, where body_mass leaves 4.0 and grf_scale 1.0" in b
+    assert "peak vertical GRF 105 N in the baseline's fit, 120 N in body_mass's, 100 N in grf_scale's" in b
 
 
 def test_threshold_draw_lines_name_the_draw_that_sets_the_lowest_statistic():
