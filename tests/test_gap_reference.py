@@ -85,6 +85,61 @@ def test_the_hat_tilt_is_located_only_relative_to_a_reference(ref):
     assert "pelvis_tilt" not in R.background(ref, sim, tilt=False).columns
 
 
+def test_quiet_points_are_left_out_of_a_relative_location(ref):
+    """Revision 6: where neither the data nor the reference have variance (both SDs below the
+    floor: each foot's GRF in its swing) a fit's change is not located — a swing-foot load
+    that appears only in the fit of the data adds nothing; the same load in stance does
+    (by hand: z = load / SD*). The points left out are exactly those with SD < floor in
+    both; the angle channels keep all 50; absolute, nothing is left out."""
+    sim = _fake_fit(CHANNELS, n=L.N_GRID)  # on locate's grid: a change at a grid point stays there
+    rel = R.relative_data(ref, ref, sim)
+    assert rel.reference_sd is not None and list(rel.reference_sd.columns) == list(rel.background.columns)
+    grid = np.arange(L.N_GRID) / L.N_GRID
+    loc0 = L.locate(sim, rel)
+    pts0 = loc0.points
+    kept = pts0.loc[pts0["channel"] == "grf:grf_y_r", "tau"].to_numpy()
+    quiet = ~np.isin(np.round(grid, 9), np.round(kept, 9))
+    t_data = np.asarray(ref.gait.time, float) / float(ref.gait.cycle_time)
+    sd = np.interp(grid, t_data, ref.gait.sd["grf_y_r"].to_numpy())
+    assert np.array_equal(quiet, sd < L.SD_FLOOR * np.sqrt(np.mean(sd**2))) and quiet.sum() >= 5  # the swing
+    assert (pts0[pts0["kind"] == "angle"].groupby("channel").size() == L.N_GRID).all()
+    assert loc0.channels.set_index("channel").loc["grf:grf_y_r", "n"] == L.N_GRID - quiet.sum()
+    # a 40 N load added to the fit on the quiet points only: not located
+    loaded = sim.copy()
+    loaded["grf_y_r"] = sim["grf_y_r"].to_numpy() + 40.0 * quiet
+    assert L.locate(loaded, rel).rss == pytest.approx(loc0.rss, abs=1e-9)
+    # on stance points it is: z = 40 / SD* there, by hand
+    stance = sim.copy()
+    k = int(np.flatnonzero(~quiet)[0])
+    stance.iloc[k, stance.columns.get_loc("grf_y_r")] += 40.0
+    p = L.locate(stance, rel).points
+    zk = p.loc[(p["channel"] == "grf:grf_y_r") & np.isclose(p["tau"], grid[k]), ["z", "sd_eff"]].iloc[0]
+    assert zk["z"] == pytest.approx(40.0 / zk["sd_eff"], rel=1e-9)
+    # the same fit located absolutely sees it
+    assert L.locate(loaded, ref).rss > L.locate(sim, ref).rss
+    # without the reference's SD (quiet_points off): every point counts
+    import dataclasses as dc
+    assert L.locate(sim, dc.replace(rel, reference_sd=None)).channels["n"].eq(L.N_GRID).all()
+
+
+def test_resels_with_points_left_out():
+    """Kept points only: a curve whose kept half is a smooth sine keeps that half's
+    roughness (the pairs across the gap do not count) and scales with the points kept."""
+    tau = np.arange(50) / 50
+    z = np.sin(2 * np.pi * tau)
+    keep = np.ones(50, bool)
+    assert L.resels(z, keep) == pytest.approx(L.resels(z), rel=1e-12)
+    noisy = z.copy()
+    noisy[25:] = np.where(np.arange(25) % 2 == 0, 5.0, -5.0)  # a rough half, left out
+    keep[25:] = False
+    r_half = L.resels(noisy, keep)
+    # by hand: λ = mean of the 24 kept pairs' squared steps × 25 / Σ(z − z̄)² over the 25 kept points
+    zk = z[:25]
+    lam = np.mean(np.diff(zk) ** 2) * 25 / np.sum((zk - zk.mean()) ** 2)
+    assert r_half == pytest.approx(25 / np.sqrt(4 * np.log(2) / lam), rel=1e-12)
+    assert r_half < L.resels(noisy)
+
+
 def test_background_is_the_fits_residual_by_hand(ref):
     """S_R − R on the data grid: the hip as the thigh in the laboratory (data hip + pelvic
     tilt), the rest as the data."""
@@ -164,10 +219,11 @@ def test_a_null_draw_is_the_reference_plus_its_sampling_error(ref):
 def test_the_relative_method_names_itself_and_the_absolute_one():
     from gaitlib.gap import method as M
 
-    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 5 and M.RELATIVE.tilt_channel and M.RELATIVE.reference_rounds >= 1
+    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 6 and M.RELATIVE.tilt_channel and M.RELATIVE.reference_rounds >= 1
     h = M.RELATIVE.hash()
     assert len(h) == 16 and h != M.METHOD.hash()
     assert M.RelativeMethod(null_draws=3).hash() != h and M.RelativeMethod(null_rank=1).hash() != h
+    assert M.RelativeMethod(quiet_points=False).hash() != h and M.RELATIVE.quiet_points
     with pytest.raises(dataclasses.FrozenInstanceError):
         M.RELATIVE.null_draws = 1
 

@@ -99,6 +99,10 @@ class DataSet:
         the reference fit's residual S_R − R per channel on the data's time grid (model units,
         tracked representation), which :func:`gaitlib.gap.locate.locate` adds to these data
         (after any data-model effect) before standardising; the fits never see it.
+    reference_sd : None, or (relative, :data:`gaitlib.gap.method.RELATIVE` ``quiet_points``)
+        the reference's SD per channel on the data's time grid: :func:`gaitlib.gap.locate.locate`
+        leaves out the points where neither these data nor the reference have variance (both
+        SDs below the locate floor: the GRFs in swing), where nothing in the data can change.
     """
 
     gait: object
@@ -110,6 +114,7 @@ class DataSet:
     notes: tuple = field(default_factory=tuple)
     n_source: str = ""
     background: object | None = None  # DataFrame: a reference fit's residual (gaitlib.gap.reference)
+    reference_sd: object | None = None  # DataFrame: the reference's SD (relative; gaitlib.gap.reference)
 
     @property
     def signature(self) -> str:

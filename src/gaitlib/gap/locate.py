@@ -149,9 +149,26 @@ def periodic(tau_src, y, tau):
     return np.interp(np.mod(tau, 1.0), ts, np.tile(y, 3))
 
 
-def resels(z: np.ndarray) -> float:
-    """Resels of a periodic 1-D residual curve (module docstring), in [1, len(z)]."""
+def resels(z: np.ndarray, keep: np.ndarray | None = None) -> float:
+    """Resels of a periodic 1-D residual curve (module docstring), in [1, len(z)]; ``keep``
+    (bool, same length): only those points count — the roughness from the pairs of
+    neighbours both kept, the variance over the kept points, resels = kept / FWHM."""
     z = np.asarray(z, float)
+    if keep is not None:
+        keep = np.asarray(keep, bool)
+        n = int(keep.sum())
+        if n < 2:
+            return float(max(n, 1))
+        zk = z[keep]
+        v = float(np.sum((zk - zk.mean()) ** 2))
+        pair = keep & np.roll(keep, -1)
+        d2 = ((np.roll(z, -1) - z) ** 2)[pair]
+        if v <= 1e-300 or not d2.size:
+            return 1.0
+        lam = float(np.mean(d2)) * n / v
+        if lam <= 0:
+            return 1.0
+        return float(np.clip(n / np.sqrt(4 * np.log(2) / lam), 1.0, n))
     n = z.size
     zc = z - z.mean()
     v = float(np.sum(zc**2))
@@ -249,11 +266,12 @@ def locate(sim, ds, thetas: dict | None = None, exclude=(), background=None) -> 
     DataSet's own): per channel, a curve on the data's time grid added to the data (after
     the data-model effects) — a reference fit's residual (:mod:`gaitlib.gap.reference`).
     """
-    n = 1
+    n, ref_sd = 1, None
     if isinstance(ds, DataSet):
         exclude = set(exclude) | filled_channels(ds)
         n, gait = ds.n, ds.gait
         background = ds.background if background is None else background
+        ref_sd = ds.reference_sd
     else:
         gait = ds
     if not isinstance(sim, pd.DataFrame):
@@ -285,12 +303,21 @@ def locate(sim, ds, thetas: dict | None = None, exclude=(), background=None) -> 
         p = np.minimum(1.0, norm.sf(Z) * N_GRID)
         shift = float(gait.left_shift) if ch["side"] == "l" else 0.0
         ph = phase_of(tau, gait.events, shift)
+        keep = np.ones(N_GRID, bool)
+        if ref_sd is not None and col in ref_sd.columns:  # relative: points where neither set has variance
+            sd_r = np.interp(tau, t_data, ref_sd[col].to_numpy())
+            keep = ~((sd < floor) & (sd_r < SD_FLOOR * float(np.sqrt(np.mean(sd_r**2)))))
+            if not keep.any():
+                exc.append({**ch, "reason": "no variance in the data or the reference"})
+                continue
         rows.append(pd.DataFrame({"channel": ch["id"], "kind": ch["kind"], "name": ch["name"], "side": ch["side"],
                                   "tau": tau, "phase": ph, "sim": s, "mean": m, "sd": sd, "sd_eff": sde, "z": z,
-                                  "p_bonf": p, "out_of_band": np.abs(z) > 1}))
+                                  "p_bonf": p, "out_of_band": np.abs(z) > 1})[keep])
+        zk = z[keep]
         chans.append({"channel": ch["id"], "kind": ch["kind"], "name": ch["name"], "side": ch["side"],
-                      "rss": float(np.sum(z**2)), "n": N_GRID, "resels": resels(z),
-                      "rms_z": float(np.sqrt(np.mean(z**2))), "significant": bool(np.any(p < ALPHA))})
+                      "rss": float(np.sum(zk**2)), "n": int(keep.sum()),
+                      "resels": resels(z) if keep.all() else resels(z, keep),
+                      "rms_z": float(np.sqrt(np.mean(zk**2))), "significant": bool(np.any(p[keep] < ALPHA))})
     points = pd.concat(rows, ignore_index=True) if rows else pd.DataFrame()
     table = _aggregate(points)
     res = residual_table(sim, gait) if all(f"res_{r}" in sim.columns for r in cv.RESIDUALS) else None

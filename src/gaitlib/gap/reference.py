@@ -67,8 +67,20 @@ the K statistics (:func:`gaitlib.gap.diagnose.null_calibration`,
 :func:`gaitlib.gap.method.null_threshold`): a rank test at level r/(K + 1) (revision 5:
 r = 2 of K = 19; revisions 1–4: the lowest of 9).
 
+Quiet points
+------------
+Where neither data set has variance — both SDs below :func:`gaitlib.gap.locate.locate`'s floor:
+the GRFs in each foot's swing, zero in every child — nothing in the data can change, and a
+located change there is the model's own misfit changing with a candidate (revision 4's
+replicates: a heavier model presses its swing foot's load, 70–76 N where the data carry none,
+harder; ``benchmarks/gap_load_confusion.py``). From revision 6 (RELATIVE ``quiet_points``) those
+points are not located: the reference's SD travels with the relative data set
+(``DataSet.reference_sd``) and :func:`gaitlib.gap.locate.locate` leaves out the points where
+both SDs are below the floor (their RSS and resels).
+
 Assumptions, stated: the model's own misfit F_k(R) − R does not change with the effect (first
-order: an effect that changes the gait changes the misfit too); both data sets have the same
+order: an effect that changes the gait changes the misfit too; the quiet points above are
+where it fails most visibly); both data sets have the same
 time grid, cycle time and speed (a change of cadence is not a curve offset: refused with a
 one-line error). Channels the reference fit does not simulate (EMG for SK) get no background.
 """
@@ -151,7 +163,9 @@ def relative_data(ds: gio.DataSet, ref: gio.DataSet, ref_fit, tilt: bool | None 
     bg = background(ref, ref_fit, tilt=tilt)
     note = (f"located relative to {ref.label}: {bg.shape[1]} channels carry the reference fit's residual "
             f"(N' = N + S_R - R, gaitlib.gap.reference)")
-    return dataclasses.replace(ds, background=bg, label=f"{ds.label} − {ref.label}", n=relative_n(ds.n, ref.n),
+    ref_sd = gait_ocp.tracking_data(ref.gait).sd[list(bg.columns)] if RELATIVE.quiet_points else None
+    return dataclasses.replace(ds, background=bg, reference_sd=ref_sd, label=f"{ds.label} − {ref.label}",
+                               n=relative_n(ds.n, ref.n),
                                notes=tuple(ds.notes) + (note,),
                                n_source=f"1/(1/{ds.n} + 1/{ref.n}) (difference of two group means)")
 
