@@ -675,3 +675,29 @@ def test_threshold_draw_lines_name_the_draw_that_sets_the_lowest_statistic():
     (line,) = G.threshold_draw_lines(V.Validation(V.pd.DataFrame(), {"null_calibration": calib}, {}), "rep")
     assert line.startswith("The draw that sets rep's lowest statistic (null1): a at ΔBIC -80; 2 of its 3 ranked")
     assert "from -50 to -80" in line and "objective 0.700, against a median of 0.750 in the other 1 draws" in line
+
+
+def test_quiet_pair_lines_by_hand():
+    """Two validations of the same draws: counts per group before → after, thresholds, the
+    ranked-right ceiling and the verdicts that changed, all from the rows."""
+    from gaitlib.studies import gap as G
+
+    def rows(named, rank1, contenders):
+        return V.pd.DataFrame({
+            "case": ["load_scale_middle_0", "knee_offset_large_0", "knee_rom_middle_0"],
+            "set": ["independent", "independent", "out-of-library"], "band": ["middle", "large", "middle"],
+            "expected": ["body_mass", "knee_offset", "unexplained"], "named": named, "rank1": rank1,
+            "rank1_dBIC": [-200.0, -300.0, -20.0], "rank2": ["body_mass", "hip_offset", "friction"],
+            "rank2_dBIC": [-150.0, -10.0, -5.0], "contenders": contenders, "expected_rank": [2, 1, None],
+            "magnitude": [0.1, 5.0, 0.1], "verdict": ["explained"] * 3,
+            "correct": [n == e for n, e in zip(named, ["body_mass", "knee_offset", "unexplained"])]})
+
+    cal = lambda t: {"null_calibration": {"lowest_dBIC": t}}  # noqa: E731
+    before = V.Validation(rows(["grf_scale", "knee_offset", "unexplained"], ["grf_scale", "knee_offset", "foot_contact"],
+                               [["grf_scale"], ["knee_offset"], ["foot_contact"]]), cal(-30.0), {"relative": True})
+    after = V.Validation(rows(["body_mass", "knee_offset", "unexplained"], ["body_mass", "knee_offset", "foot_contact"],
+                              [["body_mass"], ["knee_offset"], ["foot_contact"]]), cal(-25.0), {"relative": True})
+    (line,) = G.quiet_pair_lines(before, after)
+    assert "independent, middle + large: 1/2 → 2/2; out-of-library: 1/1 → 1/1" in line
+    assert "(thresholds ΔBIC ≤ -30 → -25)" in line and ": 1 → 2 of 2." in line
+    assert "Verdicts changed: load_scale_middle_0 grf_scale → body_mass (expected body_mass)." in line

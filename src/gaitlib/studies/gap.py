@@ -57,7 +57,8 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
            "VALIDATION_RUNS", "stored_validation", "calibration_threshold", "wilson", "TARGET_GROUPS",
            "replicate_table", "replicate_lines", "named_at", "rule_table", "threshold_sweep", "ranking_misses", "threshold_lines",
-           "threshold_draw_lines", "stored_load_confusion", "load_confusion_lines", "LOAD_CONFUSION_FILE", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
+           "threshold_draw_lines", "stored_quiet_points", "quiet_pair_lines", "QUIET_POINTS_DIR",
+           "stored_load_confusion", "load_confusion_lines", "LOAD_CONFUSION_FILE", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
            "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines",
            "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines", "consistency_lines", "tie_lines",
            "stored_reference_basin", "reference_basin_lines", "REFERENCE_BASIN_FILE", "stored_baseline_basin",
@@ -395,7 +396,7 @@ def stored_validation(name: str = "real") -> gval.Validation:
 #: A validation made by an earlier method, kept as the "before" of a method change:
 #: folder under ``gap_validation`` → the method revision that made it.
 SUPERSEDED_VALIDATIONS = {"real_rev1": 1, "relative_rev0": 0, "relative_rev1": 1, "relative_rev2": 2,
-                          "relative_rev3": 3, "relative_rev4": 4, "relative_rev4_r1": 4}
+                          "relative_rev3": 3, "relative_rev4": 4, "relative_rev4_r1": 4, "relative_rev5": 5}
 
 
 def superseded_validation(name: str = "real_rev1") -> gval.Validation:
@@ -924,6 +925,47 @@ def load_confusion_lines(res: dict) -> list[str]:
                    "between a mass and a plate gain rests on that balance: with the runner-up margin, this family is "
                    "the ceiling of the threshold sweep.")
     return out
+
+
+#: ``benchmarks/gap_quiet_points.py``'s result: revision 5's draws with the quiet points left out.
+QUIET_POINTS_DIR = "quiet_points_rev5"
+
+
+def stored_quiet_points() -> gval.Validation | None:
+    """``benchmarks/gap_quiet_points.py``'s validation (revision 5's draws, located with the
+    quiet points left out), or None if not run; refused if made with another method or on
+    other draws than the stored revision-5 validation it pairs with."""
+    folder = perf.results_dir() / "gap_validation" / QUIET_POINTS_DIR
+    if not (folder / "validation.json").is_file():
+        return None
+    v = gval.Validation.load(folder)
+    pair = superseded_validation(v.settings["pairs_with"])
+    for k in ("method_hash", "relative_method_hash"):
+        if v.settings.get(k) != pair.settings.get(k):
+            raise RuntimeError(f"{folder}: its {k} {v.settings.get(k)} is not {v.settings['pairs_with']}'s "
+                               f"{pair.settings.get(k)}: rerun benchmarks/gap_quiet_points.py")
+    return v
+
+
+def quiet_pair_lines(before: gval.Validation, after: gval.Validation) -> list[str]:
+    """The same draws located with and without the quiet points (:func:`stored_quiet_points`)
+    in words, every number from the two results: each target group's count in both, each
+    calibration's threshold, the cases ranked right with no runner-up within the margin (what
+    a threshold can reach), and the cases whose verdict changed."""
+    cb, ca = _group_counts(before.rows), _group_counts(after.rows)
+    tb, ta = calibration_threshold(before), calibration_threshold(after)
+    parts = [f"{g}: {cb[g][0]}/{cb[g][1]} → {ca[g][0]}/{ca[g][1]}" for g in TARGET_GROUPS if cb[g][1]]
+    nb, na = (len(ranking_misses({"x": v})) for v in (before, after))
+    n_ind = int(((before.rows["set"] == "independent") & before.rows["band"].isin(("middle", "large"))).sum())
+    b, a = before.rows.set_index("case"), after.rows.set_index("case")
+    changed = [c for c in b.index if c in a.index and b.loc[c, "named"] != a.loc[c, "named"]]
+    line = (f"The same draws, the same fits, located with the quiet points left out: " + "; ".join(parts)
+            + f" (thresholds ΔBIC ≤ {tb:.0f} → {ta:.0f}). Independent middle+large injections ranked right with no "
+            f"runner-up within the margin — the most any threshold can name: {n_ind - nb} → {n_ind - na} of {n_ind}. ")
+    line += ("Verdicts changed: " + "; ".join(f"{c} {b.loc[c, 'named']} → {a.loc[c, 'named']} (expected "
+                                              f"{b.loc[c, 'expected']})" for c in changed) + "."
+             if changed else "No verdict changed.")
+    return [line]
 
 
 def replicate_lines(reps: dict, target: float = 90.0) -> list[str]:
@@ -1639,7 +1681,7 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
              valv: gval.Validation | None = None, diag_m: diagnose.Diagnosis | None = None,
              profile_m: pd.DataFrame | None = None, valn: gval.Validation | None = None, tv_muscle=None,
              valr: gval.Validation | None = None, valr_reps: dict | None = None,
-             load_confusion: dict | None = None, valr5_reps: dict | None = None) -> list[str]:
+             load_confusion: dict | None = None, quiet_pair: tuple | None = None) -> list[str]:
     """The chapter's findings as Markdown paragraphs, every number and verdict from the
     results: the twin checks (``tv`` on the coarse mesh, :func:`twin_validation`;
     ``tv_full`` on 20 × 5, :func:`twin_validation_full_mesh`), the SK diagnoses of Schwartz
@@ -1655,9 +1697,9 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     rules on its cases, :func:`rule_table`), ``valr_reps`` an earlier revision's replicates on
     other draws (label → validation, :func:`replicate_lines`, with what a fixed threshold
     gives on them, :func:`threshold_lines`); ``load_confusion``: why the load family holds
-    that ceiling (:func:`load_confusion_lines`); ``valr5_reps``: the current revision's
-    replicates (pooled rates and the same ceiling on them); ``tv_muscle``: the muscle-level
-    twins (:func:`muscle_twin_validation`)."""
+    that ceiling (:func:`load_confusion_lines`); ``quiet_pair``: (revision 5's validation, the
+    same draws with the quiet points left out or None, :func:`quiet_pair_lines`);
+    ``tv_muscle``: the muscle-level twins (:func:`muscle_twin_validation`)."""
     s, sf = tv.summary(), tv_full.summary()
     acc = tv.accuracy()
     sS, sU = summary(diag_s), summary(diag_u)
@@ -1725,10 +1767,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
                    + " " + " ".join(threshold_lines(valr_reps)))
     if load_confusion is not None:
         out.append(" ".join(load_confusion_lines(load_confusion)))
-    if valr5_reps is not None and len(valr5_reps) > 1:
-        rev = next(iter(valr5_reps.values())).settings["relative_method"]["revision"]
-        out.append(f"**Revision {rev}, both replicates.** " + " ".join(replicate_lines(valr5_reps)[:-1])
-                   + " " + " ".join(threshold_lines(valr5_reps)))
+    if quiet_pair is not None and quiet_pair[1] is not None:
+        out.append("**The quiet points, paired on revision 5's draws.** " + " ".join(quiet_pair_lines(*quiet_pair)))
     if valv is not None:
         out.append(" ".join(validation_lines(valv)[:-1]))
     if tv_muscle is not None:
