@@ -701,3 +701,24 @@ def test_quiet_pair_lines_by_hand():
     assert "independent, middle + large: 1/2 → 2/2; out-of-library: 1/1 → 1/1" in line
     assert "(thresholds ΔBIC ≤ -30 → -25)" in line and ": 1 → 2 of 2." in line
     assert "Verdicts changed: load_scale_middle_0 grf_scale → body_mass (expected body_mass)." in line
+
+
+def test_null_tail_by_hand():
+    """Calibration draws and null cases of two made-up validations: counts at or below the
+    cut, the pooled sentence with both rates and the lowest values."""
+    from gaitlib.studies import gap as G
+
+    def val(per, null_dbic, named):
+        rows = V.pd.DataFrame({"set": ["null"] * len(null_dbic), "rank1_dBIC": null_dbic, "named": named})
+        return V.Validation(rows, {"null_calibration": {"dBIC": per, "lowest_dBIC": min(min(p.values()) for p in per if p)}},
+                            {"relative": True})
+
+    a = val([{"x": -60.0, "y": -5.0}, {"x": -10.0}, {}], [-70.0, -3.0], ["hip_offset", "unexplained"])
+    b = val([{"x": -2.0}], [float("nan"), -55.0], ["unexplained", "unexplained"])
+    t = G.null_tail_table({"a": a, "b": b})
+    assert t.loc["a", "calibration draws"] == 2 and t.loc["a", "draws ≤ -50"] == 1 and t.loc["a", "their lowest"] == -60
+    assert t.loc["b", "null cases' first-ranked ΔBIC"] == "—, -55" and t.loc["b", "null cases ≤ -50"] == 1
+    (line,) = G.null_tail_lines({"a": a, "b": b})
+    assert line.startswith("Over a, b the null reached ΔBIC ≤ -50 in 1 of 3 calibration draws")
+    assert "and in 2 of 4 null cases" in line and "calibration draws -60, null cases -70" in line
+    assert "(1 of 4 null cases named an effect)" in line

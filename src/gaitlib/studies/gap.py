@@ -57,7 +57,7 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
            "VALIDATION_RUNS", "stored_validation", "calibration_threshold", "wilson", "TARGET_GROUPS",
            "replicate_table", "replicate_lines", "named_at", "rule_table", "threshold_sweep", "ranking_misses", "threshold_lines",
-           "threshold_draw_lines", "stored_quiet_points", "quiet_pair_lines", "QUIET_POINTS_DIR",
+           "threshold_draw_lines", "null_tail_table", "null_tail_lines", "stored_quiet_points", "quiet_pair_lines", "QUIET_POINTS_DIR",
            "stored_load_confusion", "load_confusion_lines", "LOAD_CONFUSION_FILE", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
            "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines",
            "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines", "consistency_lines", "tie_lines",
@@ -968,6 +968,45 @@ def quiet_pair_lines(before: gval.Validation, after: gval.Validation) -> list[st
     return [line]
 
 
+def null_tail_table(vals: dict, cut: float = -50.0) -> pd.DataFrame:
+    """The null side of every relative validation (label → Validation): its calibration's
+    draws (each draw's lowest ΔBIC over the candidates: how many, their median and lowest, how
+    many at or below ``cut``), the threshold it set, and its ``null`` cases' first-ranked ΔBIC
+    (the unedited data resampled, nothing changed: named beyond the threshold = a false
+    name) — the two kinds of draw of the same null, side by side."""
+    rows = []
+    for lab, v in vals.items():
+        c = (v.unedited or {}).get("null_calibration") or {}
+        st = np.array(sorted(min(p.values()) for p in (c.get("dBIC") or []) if p), float)
+        r = v.rows[v.rows["set"] == "null"]
+        d = r["rank1_dBIC"].astype(float)
+        rows.append({"validation": lab, "calibration draws": len(st),
+                     "their median": float(np.median(st)) if len(st) else np.nan,
+                     "their lowest": float(st[0]) if len(st) else np.nan,
+                     f"draws ≤ {cut:g}": int((st <= cut).sum()), "threshold": calibration_threshold(v),
+                     "null cases": len(r), "null cases' first-ranked ΔBIC": ", ".join(
+                         "—" if not np.isfinite(x) else f"{x:.0f}" for x in d),
+                     f"null cases ≤ {cut:g}": int((d <= cut).sum()),
+                     "named (false)": int((r["named"] != "unexplained").sum())})
+    return pd.DataFrame(rows).set_index("validation")
+
+
+def null_tail_lines(vals: dict, cut: float = -50.0) -> list[str]:
+    """:func:`null_tail_table` pooled in words: how often a draw of the null reached ``cut``
+    among the calibrations' draws and among the validations' null cases."""
+    t = null_tail_table(vals, cut)
+    k_c, n_c = int(t[f"draws ≤ {cut:g}"].sum()), int(t["calibration draws"].sum())
+    k_n, n_n = int(t[f"null cases ≤ {cut:g}"].sum()), int(t["null cases"].sum())
+    lo_c, hi_c = wilson(k_c, n_c)
+    lo_n, hi_n = wilson(k_n, n_n)
+    nulls = [float(x) for cell in t["null cases' first-ranked ΔBIC"] for x in cell.split(", ") if x != "—"]
+    return [f"Over {', '.join(t.index)} the null reached ΔBIC ≤ {cut:g} in {k_c} of {n_c} calibration draws "
+            f"({lo_c:.0f}–{hi_c:.0f} %) and in {k_n} of {n_n} null cases ({lo_n:.0f}–{hi_n:.0f} %); the lowest values: "
+            f"calibration draws {t['their lowest'].min():.0f}, null cases {min(nulls):.0f}. The null's tail is long: a "
+            f"calibration of 9 or 19 draws sees such a draw or not by chance, and a threshold set above it names the "
+            f"null cases that reach it ({int(t['named (false)'].sum())} of {n_n} null cases named an effect)."]
+
+
 def replicate_lines(reps: dict, target: float = 90.0) -> list[str]:
     """The replicates of a validation in words, every number from their stored results: the
     threshold each null calibration set, the pooled rate of each target group against the
@@ -1681,7 +1720,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
              valv: gval.Validation | None = None, diag_m: diagnose.Diagnosis | None = None,
              profile_m: pd.DataFrame | None = None, valn: gval.Validation | None = None, tv_muscle=None,
              valr: gval.Validation | None = None, valr_reps: dict | None = None,
-             load_confusion: dict | None = None, quiet_pair: tuple | None = None) -> list[str]:
+             load_confusion: dict | None = None, quiet_pair: tuple | None = None,
+             null_tail: dict | None = None) -> list[str]:
     """The chapter's findings as Markdown paragraphs, every number and verdict from the
     results: the twin checks (``tv`` on the coarse mesh, :func:`twin_validation`;
     ``tv_full`` on 20 × 5, :func:`twin_validation_full_mesh`), the SK diagnoses of Schwartz
@@ -1698,7 +1738,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     other draws (label → validation, :func:`replicate_lines`, with what a fixed threshold
     gives on them, :func:`threshold_lines`); ``load_confusion``: why the load family holds
     that ceiling (:func:`load_confusion_lines`); ``quiet_pair``: (revision 5's validation, the
-    same draws with the quiet points left out or None, :func:`quiet_pair_lines`);
+    same draws with the quiet points left out or None, :func:`quiet_pair_lines`); ``null_tail``:
+    relative validations of the same fits and ranking (:func:`null_tail_lines`);
     ``tv_muscle``: the muscle-level twins (:func:`muscle_twin_validation`)."""
     s, sf = tv.summary(), tv_full.summary()
     acc = tv.accuracy()
@@ -1767,6 +1808,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
                    + " " + " ".join(threshold_lines(valr_reps)))
     if load_confusion is not None:
         out.append(" ".join(load_confusion_lines(load_confusion)))
+    if null_tail:
+        out.append("**The null's tail.** " + " ".join(null_tail_lines(null_tail)))
     if quiet_pair is not None and quiet_pair[1] is not None:
         out.append("**The quiet points, paired on revision 5's draws.** " + " ".join(quiet_pair_lines(*quiet_pair)))
     if valv is not None:
