@@ -606,8 +606,8 @@ display(Markdown("\n\n".join(gap_study.threshold_lines({"revision 5": valr5}))))
 
 # %% [markdown]
 # **Revision 6: the quiet points.** The load family's misses trace largely to the GRFs in
-# swing (the experiment above): there every child's force is zero — no variance in the data or the reference —
-# yet the model's feet carry load, and a candidate that makes the model heavier changes that
+# swing (the experiment above): there every child's force is zero — no variance in the data
+# or the reference — yet the model's feet carry load, and a candidate that makes the model heavier changes that
 # load. Nothing in the data can change at such a point, so a located change there is the
 # model's own misfit changing, which the relative method assumes away. Revision 6
 # (`RELATIVE.quiet_points`, `gaitlib.gap.reference`, "Quiet points") leaves out the points
@@ -643,13 +643,13 @@ display(Markdown("\n\n".join(gap_study.threshold_lines({"revision 6": valr}))))
 
 # %% [markdown]
 # **The null's tail.** Revision 5's null cases named an effect beyond its threshold, and
-# revision 6's calibration set a threshold beyond most of its injections (the draw behind
-# its lowest statistic is described under its tables above).
+# revision 6's calibration set a threshold that held back injections its ranking had right
+# (its rule table above; the draw behind its lowest statistic is described there too).
 # Every relative validation has two kinds of draw of the same null — its calibration's
 # draws and its `null` cases (the unedited data resampled, nothing changed) — side by side
 # (revisions 1–3 fitted and ranked differently; the first pooled sentence counts revision
 # 4's replicates and revision 5, whose fits and rankings are made the same way, the second
-# revision 6, which locates without the quiet points):
+# revision 6, which leaves the quiet points out of the location):
 
 # %%
 null_all = {"revision 1": valr1, "revision 2": valr2, "revision 3": valr3, "revision 4": valr4,
