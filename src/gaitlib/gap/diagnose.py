@@ -806,8 +806,7 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
                 raise BaselineFailed({f"reference {st}": s.stats["status"] for st, s in rb["reference"].items()
                                       if st != "best" and s is not None})
             ref_info = {"label": ref.label, "n_subjects": ref.n, "signature": ref.signature,
-                        "fit": _stats(ref_fit), "rss_reference": locate.locate(ref_fit, ref).rss,
-                        "data_label": ds.label, "data_n_subjects": ds.n}
+                        "fit": _stats(ref_fit), "data_label": ds.label, "data_n_subjects": ds.n}
         names, skipped = candidates(spec0, ds.gait, effects)
         if ref is None:
             b = baseline_fits(spec0, {"data": ds}, warm, objective=objective, root=root, use_cache=use_cache,
@@ -826,6 +825,19 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
             ref_fits = candidate_fits(spec0, {"reference": ref}, {"reference": ref_fit}, names, objective=objective,
                                       root=root, use_cache=use_cache, alternates=alternates_of(rb),
                                       scheduler=scheduler, **kw)["reference"]
+            if RELATIVE.reference_from_candidates:
+                # the baseline's fit of the reference from every nested candidate's: its
+                # multistart can stop in a worse optimum than they reach (RELATIVE)
+                mv = baseline_from_candidates(spec0, {"reference": ref.gait}, {"reference": ref_fit},
+                                              {"reference": ref_fits}, _nlp_names(names), RELATIVE.consistency_margin,
+                                              "reference-baseline-from", objective=objective, root=root,
+                                              use_cache=use_cache, scheduler=scheduler, **kw)
+                if "reference" in mv:
+                    best, n = mv["reference"]
+                    ref_info["fit_from_candidates"] = {"objective": [float(ref_fit.stats["objective"]),
+                                                                     float(best.stats["objective"])], "from": n}
+                    ref_fit = best
+            ref_info["rss_reference"] = locate.locate(ref_fit, ref).rss
             # … and the data as its continuation: the baseline from the reference's fit only,
             # each candidate from its own fit of the reference (the same basin, so the fits
             # differ by the change, not by the local optimum a multistart lands in)
@@ -942,6 +954,35 @@ def _better(new, old, margin: float) -> bool:
     return float(new.stats["objective"]) < f0 - margin * abs(f0)
 
 
+def _nlp_names(names) -> list:
+    """The candidates among ``names`` whose parameters the NLP identifies (a profile or
+    comparison-only effect has no fit of its own to start from)."""
+    return [n for n in names if effects_mod.EFFECTS[n].resolve and effects_mod.EFFECTS[n].identify == "nlp"]
+
+
+def baseline_from_candidates(spec0, gaits: dict, bases: dict, fits: dict, names, margin: float, label: str,
+                             **kw) -> dict:
+    """The baseline re-solved from its nested candidates' fits (:func:`_nested`: the baseline
+    is a member of each, so a candidate's optimum with its parameter at the null value is a
+    start the baseline can reach). For each key of ``gaits`` (key → gait data, with the
+    baseline's fit ``bases[key]`` and the candidates' fits ``fits[key]``, name → :class:`Fit`),
+    the baseline is solved on the gait from every converged fit of ``names`` and the lowest
+    kept where it is below ``bases[key]``'s objective by more than ``margin`` (relative,
+    :func:`_better`). Returns key → (solution, the candidate it started from), only for the
+    keys that moved. ``label``: the sweep group's name."""
+    jobs = [(f"{k}|{n}", g, fits[k][n].solution) for k, g in gaits.items() if bases.get(k) is not None
+            for n in names if _nested(effects_mod.EFFECTS[n]) and (fits.get(k) or {}).get(n) is not None
+            and fits[k][n].solution is not None and _status(fits[k][n].solution)[1]]
+    res = solve_many({label: (spec0, jobs)}, **kw) if jobs else {}
+    out = {}
+    for k in gaits:
+        tried = {n: res[f"{k}|{n}"] for n in names if res.get(f"{k}|{n}") is not None}
+        best = pick_best(list(tried.values()))
+        if _better(best, bases.get(k), margin):
+            out[k] = (best, next(n for n, s in tried.items() if s is best))
+    return out
+
+
 def consistent_fits(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, datasets: dict, bases: dict, fits: dict,
                     names, *, method=None, **kw) -> dict:
     """The self-consistent reference fit of a relative diagnosis
@@ -967,7 +1008,7 @@ def consistent_fits(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, datasets: 
     a later move of its data fit: ``"data_again"``)."""
     method = method or RELATIVE
     margin = method.consistency_margin
-    nlp = [n for n in names if effects_mod.EFFECTS[n].resolve and effects_mod.EFFECTS[n].identify == "nlp"]
+    nlp = _nlp_names(names)
     out = {k: {"ref_fit": ref_fit, "ref_fits": dict(ref_fits), "base": bases.get(k), "fits": dict(fits.get(k) or {}),
                "moved": {}} for k in datasets}
 
@@ -984,17 +1025,14 @@ def consistent_fits(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, datasets: 
     if method.baseline_from_candidates:
         # the baseline's fit of the data from every nested candidate's (a member of each):
         # the continuation from the reference's fit can stop in a worse optimum than they reach
-        jobs = [(f"{k}|{n}", datasets[k].gait, o["fits"][n].solution) for k, o in out.items() if o["base"] is not None
-                for n in nlp if _nested(effects_mod.EFFECTS[n]) and o["fits"].get(n) is not None
-                and _status(o["fits"][n].solution)[1]]
-        res = solve_many({"consistency-N-baseline-from": (spec0, jobs)}, **kw) if jobs else {}
-        for k, o in out.items():
-            tried = {n: res[f"{k}|{n}"] for n in nlp if res.get(f"{k}|{n}") is not None}
-            best = pick_best(list(tried.values()))
-            if _better(best, o["base"], margin):
-                o["moved"]["baseline"] = {"data": [float(o["base"].stats["objective"]), float(best.stats["objective"])],
-                                          "data_from": next(n for n, s in tried.items() if s is best)}
-                o["base"] = best
+        moved = baseline_from_candidates(spec0, {k: datasets[k].gait for k in out}, {k: o["base"] for k, o in out.items()},
+                                         {k: o["fits"] for k, o in out.items()}, nlp, margin,
+                                         "consistency-N-baseline-from", **kw)
+        for k, (best, n) in moved.items():
+            o = out[k]
+            o["moved"]["baseline"] = {"data": [float(o["base"].stats["objective"]), float(best.stats["objective"])],
+                                      "data_from": n}
+            o["base"] = best
     todo = {(k, m) for k in datasets for m in ["baseline", *nlp]}
     for _ in range(method.reference_rounds):
         groups: dict = {}

@@ -1,0 +1,97 @@
+"""A relative-method change on a stored validation's own draws: the paired side of a change
+(issue 25). A new revision of the relative method is validated on fresh draws (its hash seeds
+them); this runs the whole stored relative validation again on *its* draws — the same
+reference, null draws, manipulations and resampling seeds, so mostly the same fits, from the
+cache — with only the named fields of the method changed (its null threshold rule kept,
+recomputed on its null draws), so the two can be paired case by case.
+
+    GAITLIB_SOLUTIONS=<cache> .venv/bin/python benchmarks/gap_paired.py reference_fit_rev6
+    GAITLIB_SOLUTIONS=<cache> .venv/bin/python benchmarks/gap_paired.py quiet_points_rev5
+
+Each experiment (:data:`EXPERIMENTS`) writes ``results/gap_validation/<name>/`` (the four
+files of ``gaitlib gap-validate``), its settings naming the validation it pairs with and the
+fields it changed. A field the stored validation's method did not have yet (added by a later
+revision) must be set by the experiment: it was off then.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+RESULTS = HERE / "results" / "gap_validation"
+
+#: name → (the stored validation whose draws are diagnosed again, the fields changed).
+EXPERIMENTS = {
+    # revision 6: the quiet points left out, on revision 5's draws
+    "quiet_points_rev5": ("relative_rev5", {"quiet_points": True, "reference_from_candidates": False}),
+    # revision 7: the baseline's fit of the reference from the candidates', on revision 6's draws
+    "reference_fit_rev6": ("relative_rev6", {"reference_from_candidates": True}),
+}
+
+
+def stored(name: str):
+    """A stored relative validation by folder name: the current one (``relative``) or a
+    superseded one."""
+    from gaitlib.studies import gap as gap_study
+
+    if name in gap_study.SUPERSEDED_VALIDATIONS:
+        return gap_study.superseded_validation(name)
+    return gap_study.stored_validation(name)
+
+
+def run(name: str):
+    """Run experiment ``name`` and save it; returns the Validation."""
+    from gaitlib.gap import diagnose as D
+    from gaitlib.gap import method as M
+    from gaitlib.gap import reference as R
+    from gaitlib.gap import validate as V
+
+    validation, changes = EXPERIMENTS[name]
+    val = stored(validation)
+    h = val.settings["relative_method_hash"]
+    fields = {k: v for k, v in val.settings["relative_method"].items() if k in M.RelativeMethod.__dataclass_fields__}
+    unset = sorted(set(M.RelativeMethod.__dataclass_fields__) - set(fields) - set(changes))
+    if unset:
+        raise ValueError(f"{name}: {validation}'s method has no {', '.join(unset)}: the experiment must set it")
+
+    @dataclasses.dataclass(frozen=True)
+    class StoredDraws(M.RelativeMethod):
+        """The stored method's fields with ``changes``, seeded as the stored method (its
+        hash): the same draws, the same null draws, so the same fits where nothing changed."""
+
+        def hash(self) -> str:
+            return h
+
+    method = StoredDraws(**{**fields, **changes})
+    saved = {m: m.RELATIVE for m in (D, R, V)}
+    try:
+        for m in saved:
+            m.RELATIVE = method
+        v = V.run(tuple(val.settings["sets"]), per_band=int(val.settings["per_band"]),
+                  speed_class=val.settings["speed_class"], base=dict(val.settings["base"]), relative=True,
+                  replicate=int(val.settings.get("replicate", 0)), progress=True)
+    finally:
+        for m, r in saved.items():
+            m.RELATIVE = r
+    v.settings.update(pairs_with=validation, changed=changes, experiment=f"benchmarks/gap_paired.py {name}")
+    v.save(RESULTS / name)
+    print(v.scores().to_string(index=False))
+    return v
+
+
+def main(argv: list[str]) -> int:
+    names = argv or list(EXPERIMENTS)
+    bad = [n for n in names if n not in EXPERIMENTS]
+    if bad:
+        print(f"unknown experiment {', '.join(bad)}; known: {', '.join(EXPERIMENTS)}", file=sys.stderr)
+        return 2
+    for n in names:
+        run(n)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
