@@ -219,11 +219,12 @@ def test_a_null_draw_is_the_reference_plus_its_sampling_error(ref):
 def test_the_relative_method_names_itself_and_the_absolute_one():
     from gaitlib.gap import method as M
 
-    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 6 and M.RELATIVE.tilt_channel and M.RELATIVE.reference_rounds >= 1
+    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 7 and M.RELATIVE.tilt_channel and M.RELATIVE.reference_rounds >= 1
     h = M.RELATIVE.hash()
     assert len(h) == 16 and h != M.METHOD.hash()
     assert M.RelativeMethod(null_draws=3).hash() != h and M.RelativeMethod(null_rank=1).hash() != h
     assert M.RelativeMethod(quiet_points=False).hash() != h and M.RELATIVE.quiet_points
+    assert M.RelativeMethod(reference_from_candidates=False).hash() != h and M.RELATIVE.reference_from_candidates
     with pytest.raises(dataclasses.FrozenInstanceError):
         M.RELATIVE.null_draws = 1
 
@@ -355,3 +356,51 @@ def test_the_baseline_is_refitted_from_the_nested_candidates_fits(ref, monkeypat
     assert out["data"]["base"].tag == "data|hip_offset"
     assert out["data"]["moved"] == {"baseline": {"data": [2.0, 1.2], "data_from": "hip_offset"}}
     assert out["other"]["base"] is bases["other"] and out["other"]["moved"] == {}  # within the margin
+
+
+def test_the_baseline_fit_of_the_reference_is_refitted_from_the_candidates_fits(ref, monkeypatch):
+    """reference_from_candidates (revision 7): in a relative diagnosis the baseline's fit of
+    the reference is re-solved (baseline spec) from each nested NLP candidate's converged fit
+    of the reference, the lowest replaces the multistart's only if lower, and that fit — not
+    the multistart's — is what the data are continued from and made consistent with."""
+    from gaitlib.gap import method as M
+
+    class Stop(Exception):
+        pass
+
+    multistart = _Sol(1.0, "R0")
+    fit = lambda n, s: D.Fit(n, s, {}, None, 1, "nlp", "Solve_Succeeded", True)  # noqa: E731
+    ref_fits = {"knee_offset": fit("knee_offset", _Sol(0.9, "k")), "hip_offset": fit("hip_offset", _Sol(0.8, "h")),
+                "ankle_offset": fit("ankle_offset", _Sol(0.7, "a", "Maximum_Iterations_Exceeded"))}
+    warm_of_data = []
+
+    def fake_baseline_fits(spec0, datasets, warm, **kw):
+        if "data" in datasets:
+            warm_of_data.append(warm)
+        return {k: {"best": multistart if k == "reference" else _Sol(2.0, "N0")} for k in datasets}
+
+    def fake_solve_many(groups, **kw):
+        ((g, (spec, jobs)),) = groups.items()
+        assert g == "reference-baseline-from" and spec.effects == ()
+        obj = {"reference|knee_offset": 0.95, "reference|hip_offset": 0.85}  # not the unconverged ankle fit
+        assert sorted(k for k, _, _ in jobs) == sorted(obj)
+        return {key: _Sol(obj[key], key) for key, _, _ in jobs}
+
+    def fake_consistent(spec0, ref_, ref_fit, *a, **kw):
+        raise Stop(ref_fit)
+
+    monkeypatch.setattr(D, "baseline_fits", fake_baseline_fits)
+    monkeypatch.setattr(D, "candidate_fits", lambda spec0, datasets, *a, **kw: {
+        k: (ref_fits if k == "reference" else {}) for k in datasets})
+    monkeypatch.setattr(D, "solve_many", fake_solve_many)
+    monkeypatch.setattr(D, "consistent_fits", fake_consistent)
+    monkeypatch.setattr(D.locate, "locate", lambda *a, **k: type("L", (), {"rss": 0.0})())
+    names = ["knee_offset", "hip_offset", "ankle_offset"]
+    base = dict(n_intervals=4, degree=2)
+    for on, want in ((True, "reference|hip_offset"), (False, "R0")):
+        monkeypatch.setattr(D, "RELATIVE", M.RelativeMethod(reference_from_candidates=on))
+        warm_of_data.clear()
+        with pytest.raises(Stop) as got:
+            D.diagnose(ref, reference=ref, effects=names, base=base, serial=True)
+        assert got.value.args[0].tag == want
+        assert warm_of_data[0].tag == want  # the data continued from it
