@@ -677,7 +677,7 @@ def test_threshold_draw_lines_name_the_draw_that_sets_the_lowest_statistic():
     assert "from -50 to -80" in line and "objective 0.700, against a median of 0.750 in the other 1 draws" in line
 
 
-def test_quiet_pair_lines_by_hand():
+def test_paired_lines_by_hand():
     """Two validations of the same draws: counts per group before → after, thresholds, the
     ranked-right ceiling and the verdicts that changed, all from the rows."""
     from gaitlib.studies import gap as G
@@ -697,7 +697,8 @@ def test_quiet_pair_lines_by_hand():
                                [["grf_scale"], ["knee_offset"], ["foot_contact"]]), cal(-30.0), {"relative": True})
     after = V.Validation(rows(["body_mass", "knee_offset", "unexplained"], ["body_mass", "knee_offset", "foot_contact"],
                               [["body_mass"], ["knee_offset"], ["foot_contact"]]), cal(-25.0), {"relative": True})
-    (line,) = G.quiet_pair_lines(before, after)
+    (line,) = G.paired_lines(before, after, G.PAIRED["quiet_points_rev5"])
+    assert "The same draws, located with the quiet points left out: " in line
     assert "independent, middle + large: 1/2 → 2/2; out-of-library: 1/1 → 1/1" in line
     assert "(thresholds ΔBIC ≤ -30 → -25)" in line and ": 1 → 2 of 2." in line
     assert "Verdicts changed: load_scale_middle_0 grf_scale → body_mass (expected body_mass)." in line

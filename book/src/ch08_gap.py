@@ -614,19 +614,19 @@ display(Markdown("\n\n".join(gap_study.threshold_lines({"revision 5": valr5}))))
 # where both SDs are below the locate floor. First, paired: revision 5's own draws — the
 # same reference, null draws, manipulations and seeds, so the same fits — located with the
 # quiet points left out, the rest of revision 5 unchanged, its null threshold recomputed on
-# its null draws so located (`benchmarks/gap_quiet_points.py`):
+# its null draws so located (`benchmarks/gap_paired.py quiet_points_rev5`):
 
 # %%
-valq = gap_study.stored_quiet_points()
+valq = gap_study.stored_paired("quiet_points_rev5")
 if valq is not None:
     pair = {"revision 5": valr5, "revision 5's draws, quiet points left out": valq}
     display(gap_study.replicate_table(pair).drop(columns=["pooled", "pooled %", "95 % interval"]))
     display(gap_study.threshold_sweep({"quiet points left out": valq}))
     display(gap_study.ranking_misses({"quiet points left out": valq}))
-    display(Markdown("\n\n".join(gap_study.quiet_pair_lines(valr5, valq)
+    display(Markdown("\n\n".join(gap_study.paired_lines(valr5, valq, gap_study.PAIRED["quiet_points_rev5"])
                                    + gap_study.threshold_lines({"quiet points left out": valq}))))
 else:
-    print("(benchmarks/gap_quiet_points.py: not run)")
+    print("(benchmarks/gap_paired.py quiet_points_rev5: not run)")
 
 # %% [markdown]
 # Then revision 6 on fresh draws (its hash changed) — the relative method in use:

@@ -154,27 +154,16 @@ def resels(z: np.ndarray, keep: np.ndarray | None = None) -> float:
     (bool, same length): only those points count — the roughness from the pairs of
     neighbours both kept, the variance over the kept points, resels = kept / FWHM."""
     z = np.asarray(z, float)
-    if keep is not None:
-        keep = np.asarray(keep, bool)
-        n = int(keep.sum())
-        if n < 2:
-            return float(max(n, 1))
-        zk = z[keep]
-        v = float(np.sum((zk - zk.mean()) ** 2))
-        pair = keep & np.roll(keep, -1)
-        d2 = ((np.roll(z, -1) - z) ** 2)[pair]
-        if v <= 1e-300 or not d2.size:
-            return 1.0
-        lam = float(np.mean(d2)) * n / v
-        if lam <= 0:
-            return 1.0
-        return float(np.clip(n / np.sqrt(4 * np.log(2) / lam), 1.0, n))
-    n = z.size
-    zc = z - z.mean()
-    v = float(np.sum(zc**2))
-    if v <= 1e-300:
+    keep = np.ones(z.size, bool) if keep is None else np.asarray(keep, bool)
+    n = int(keep.sum())
+    if n < 2:
+        return float(max(n, 1))
+    zk = z[keep]
+    v = float(np.sum((zk - zk.mean()) ** 2))
+    d2 = ((np.roll(z, -1) - z) ** 2)[keep & np.roll(keep, -1)]
+    if v <= 1e-300 or not d2.size:
         return 1.0
-    lam = float(np.sum((np.roll(z, -1) - z) ** 2)) / v
+    lam = float(np.sum(d2)) / v * (n / d2.size)  # the mean squared difference × n
     if lam <= 0:
         return 1.0
     fwhm = np.sqrt(4 * np.log(2) / lam)
@@ -316,7 +305,7 @@ def locate(sim, ds, thetas: dict | None = None, exclude=(), background=None) -> 
         zk = z[keep]
         chans.append({"channel": ch["id"], "kind": ch["kind"], "name": ch["name"], "side": ch["side"],
                       "rss": float(np.sum(zk**2)), "n": int(keep.sum()),
-                      "resels": resels(z) if keep.all() else resels(z, keep),
+                      "resels": resels(z, keep),
                       "rms_z": float(np.sqrt(np.mean(zk**2))), "significant": bool(np.any(p[keep] < ALPHA))})
     points = pd.concat(rows, ignore_index=True) if rows else pd.DataFrame()
     table = _aggregate(points)

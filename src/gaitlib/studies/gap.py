@@ -57,7 +57,7 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
            "VALIDATION_RUNS", "stored_validation", "calibration_threshold", "wilson", "TARGET_GROUPS",
            "replicate_table", "replicate_lines", "named_at", "rule_table", "threshold_sweep", "ranking_misses", "threshold_lines",
-           "threshold_draw_lines", "null_tail_table", "null_tail_lines", "stored_quiet_points", "quiet_pair_lines", "QUIET_POINTS_DIR",
+           "threshold_draw_lines", "null_tail_table", "null_tail_lines", "stored_paired", "paired_lines", "PAIRED",
            "stored_load_confusion", "load_confusion_lines", "LOAD_CONFUSION_FILE", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
            "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines",
            "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines", "consistency_lines", "tie_lines",
@@ -754,20 +754,31 @@ def rule_table(v: gval.Validation) -> pd.DataFrame:
     return pd.DataFrame(rows).set_index("rule")
 
 
-def threshold_sweep(reps: dict, thresholds=(-10, -20, -30, -40, -50, -60, -80, -100, -150)) -> pd.DataFrame:
-    """Named right per target group, pooled over the replicates ``reps`` (label →
-    :class:`~gaitlib.gap.validate.Validation`), had every case been decided at each of
-    ``thresholds`` (ΔBIC ≤) instead of its own calibration's (:func:`named_at`): what the
-    threshold alone can trade between naming an injected effect and saying "unexplained"."""
-    rows = []
+#: The fixed thresholds (ΔBIC ≤) :func:`threshold_sweep` decides every case at.
+SWEEP_THRESHOLDS = (-10, -20, -30, -40, -50, -60, -80, -100, -150)
+
+
+def _sweep_counts(reps: dict, thresholds=SWEEP_THRESHOLDS) -> dict:
+    """threshold → target group → [named right, cases], pooled over ``reps``."""
+    out = {}
     for t in thresholds:
         tot = {g: [0, 0] for g in TARGET_GROUPS}
         for v in reps.values():
             for g, (k, n) in _group_counts(named_at(v, t)).items():
                 tot[g][0] += k
                 tot[g][1] += n
-        rows.append({"threshold (ΔBIC ≤)": t, **{g: (f"{k}/{n} ({100.0 * k / n:.0f} %)" if n else "—")
-                                                  for g, (k, n) in tot.items()}})
+        out[t] = tot
+    return out
+
+
+def threshold_sweep(reps: dict, thresholds=SWEEP_THRESHOLDS) -> pd.DataFrame:
+    """Named right per target group, pooled over the replicates ``reps`` (label →
+    :class:`~gaitlib.gap.validate.Validation`), had every case been decided at each of
+    ``thresholds`` (ΔBIC ≤) instead of its own calibration's (:func:`named_at`): what the
+    threshold alone can trade between naming an injected effect and saying "unexplained"."""
+    rows = [{"threshold (ΔBIC ≤)": t, **{g: (f"{k}/{n} ({100.0 * k / n:.0f} %)" if n else "—")
+                                          for g, (k, n) in tot.items()}}
+            for t, tot in _sweep_counts(reps, thresholds).items()]
     return pd.DataFrame(rows).set_index("threshold (ΔBIC ≤)")
 
 
@@ -795,19 +806,22 @@ def threshold_lines(reps: dict, target: float = 90.0) -> list[str]:
     stored results: the best rate any threshold gives the independent middle+large group,
     the thresholds at which the out-of-library group reaches the target, and the cases no
     threshold names right."""
-    sw = threshold_sweep(reps)
+    sw = _sweep_counts(reps)
     g_in, g_ool = "independent, middle + large", "out-of-library"
 
-    def pct(s):
-        return float(s.split("(")[1].split(" %")[0]) if "(" in s else np.nan
+    def pct(t, g):
+        k, n = sw[t][g]
+        return 100.0 * k / n if n else np.nan
 
-    best_in = max(sw[g_in], key=pct)
-    ool_ok = [t for t in sw.index if pct(sw.loc[t, g_ool]) >= target]
+    k_in = max(sw[t][g_in][0] for t in sw)
+    at_best = [t for t in sw if sw[t][g_in][0] == k_in]
+    n_in = sw[at_best[0]][g_in][1]
+    ool_ok = [t for t in sw if pct(t, g_ool) >= target]
     miss = ranking_misses(reps)
     fams = miss["expected"].value_counts() if len(miss) else pd.Series(dtype=int)
     line = (f"Decided again at fixed thresholds ({len(reps)} replicates pooled, the same rankings): the independent "
-            f"middle+large group reaches at best {best_in} (at any threshold from {max(t for t in sw.index if sw.loc[t, g_in] == best_in):g} "
-            f"to {min(t for t in sw.index if sw.loc[t, g_in] == best_in):g}); the out-of-library group reaches "
+            f"middle+large group reaches at best {k_in}/{n_in} ({pct(at_best[0], g_in):.0f} %) (at any threshold from "
+            f"{max(at_best):g} to {min(at_best):g}); the out-of-library group reaches "
             f"{target:.0f} % " + (f"only at ΔBIC ≤ {max(ool_ok):g} or lower" if ool_ok else "at no threshold tried")
             + f". {len(miss)} cases no threshold names right")
     if len(miss):
@@ -926,15 +940,20 @@ def load_confusion_lines(res: dict) -> list[str]:
     return out
 
 
-#: ``benchmarks/gap_quiet_points.py``'s result: revision 5's draws with the quiet points left out.
-QUIET_POINTS_DIR = "quiet_points_rev5"
+#: ``benchmarks/gap_paired.py``'s experiments: a relative-method change on a stored
+#: validation's own draws, name → what changed (in words).
+PAIRED = {"quiet_points_rev5": "located with the quiet points left out",
+          "reference_fit_rev6": "with the baseline's fit of the reference re-solved from the candidates'"}
 
 
-def stored_quiet_points() -> gval.Validation | None:
-    """``benchmarks/gap_quiet_points.py``'s validation (revision 5's draws, located with the
-    quiet points left out), or None if not run; refused if made with another method or on
-    other draws than the stored revision-5 validation it pairs with."""
-    folder = perf.results_dir() / "gap_validation" / QUIET_POINTS_DIR
+def stored_paired(name: str) -> gval.Validation | None:
+    """``benchmarks/gap_paired.py``'s validation ``name`` (:data:`PAIRED`: a stored
+    validation's draws diagnosed again with a field of the method changed), or None if not
+    run; refused if made with another method or on other draws than the stored validation
+    it pairs with."""
+    folder = perf.results_dir() / "gap_validation" / name
+    if name not in PAIRED:
+        raise ValueError(f"unknown paired experiment {name!r}; known: {', '.join(PAIRED)}")
     if not (folder / "validation.json").is_file():
         return None
     v = gval.Validation.load(folder)
@@ -942,15 +961,16 @@ def stored_quiet_points() -> gval.Validation | None:
     for k in ("method_hash", "relative_method_hash"):
         if v.settings.get(k) != pair.settings.get(k):
             raise RuntimeError(f"{folder}: its {k} {v.settings.get(k)} is not {v.settings['pairs_with']}'s "
-                               f"{pair.settings.get(k)}: rerun benchmarks/gap_quiet_points.py")
+                               f"{pair.settings.get(k)}: rerun benchmarks/gap_paired.py {name}")
     return v
 
 
-def quiet_pair_lines(before: gval.Validation, after: gval.Validation) -> list[str]:
-    """The same draws located with and without the quiet points (:func:`stored_quiet_points`)
-    in words, every number from the two results: each target group's count in both, each
-    calibration's threshold, the cases ranked right with no runner-up within the margin (what
-    a threshold can reach), and the cases whose verdict changed."""
+def paired_lines(before: gval.Validation, after: gval.Validation, what: str) -> list[str]:
+    """The same draws diagnosed before and after a change of the method (:func:`stored_paired`;
+    ``what``: the change in words, :data:`PAIRED`), every number from the two results: each
+    target group's count in both, each calibration's threshold, the cases ranked right with
+    no runner-up within the margin (what a threshold can reach), and the cases whose verdict
+    changed."""
     cb, ca = _group_counts(before.rows), _group_counts(after.rows)
     tb, ta = calibration_threshold(before), calibration_threshold(after)
     parts = [f"{g}: {cb[g][0]}/{cb[g][1]} → {ca[g][0]}/{ca[g][1]}" for g in TARGET_GROUPS if cb[g][1]]
@@ -958,7 +978,7 @@ def quiet_pair_lines(before: gval.Validation, after: gval.Validation) -> list[st
     n_ind = int(((before.rows["set"] == "independent") & before.rows["band"].isin(("middle", "large"))).sum())
     b, a = before.rows.set_index("case"), after.rows.set_index("case")
     changed = [c for c in b.index if c in a.index and b.loc[c, "named"] != a.loc[c, "named"]]
-    line = (f"The same draws, the same fits, located with the quiet points left out: " + "; ".join(parts)
+    line = (f"The same draws, {what}: " + "; ".join(parts)
             + f" (thresholds ΔBIC ≤ {tb:.0f} → {ta:.0f}). Independent middle+large injections ranked right with no "
             f"runner-up within the margin — the most any threshold can name: {n_ind - nb} → {n_ind - na} of {n_ind}. ")
     line += ("Verdicts changed: " + "; ".join(f"{c} {b.loc[c, 'named']} → {a.loc[c, 'named']} (expected "
@@ -1737,7 +1757,7 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     other draws (label → validation, :func:`replicate_lines`, with what a fixed threshold
     gives on them, :func:`threshold_lines`); ``load_confusion``: why the load family holds
     that ceiling (:func:`load_confusion_lines`); ``quiet_pair``: (revision 5's validation, the
-    same draws with the quiet points left out or None, :func:`quiet_pair_lines`); ``null_tail``:
+    same draws with the quiet points left out or None, :func:`paired_lines`); ``null_tail``:
     relative validations of the same fits and ranking (:func:`null_tail_lines`);
     ``tv_muscle``: the muscle-level twins (:func:`muscle_twin_validation`)."""
     s, sf = tv.summary(), tv_full.summary()
@@ -1810,7 +1830,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     if null_tail:
         out.append("**The null's tail.** " + " ".join(null_tail_lines(null_tail)))
     if quiet_pair is not None and quiet_pair[1] is not None:
-        out.append("**The quiet points, paired on revision 5's draws.** " + " ".join(quiet_pair_lines(*quiet_pair)))
+        out.append("**The quiet points, paired on revision 5's draws.** "
+                   + " ".join(paired_lines(*quiet_pair, PAIRED["quiet_points_rev5"])))
     if valv is not None:
         out.append(" ".join(validation_lines(valv)[:-1]))
     if tv_muscle is not None:
