@@ -723,3 +723,23 @@ def test_null_tail_by_hand():
     assert line.startswith("Over a, b the null reached ΔBIC ≤ -50 in 1 of 3 calibration draws")
     assert "and in 2 of 4 null cases" in line and "calibration draws -60, null cases -70" in line
     assert "(1 of 4 null cases named an effect)" in line
+
+
+def test_common_mode_draws_by_hand():
+    """Calibration draws of a made-up validation: a draw is common-mode when its median
+    candidate's ΔBIC is at or below the cut; 'kept' when its baseline's fit of the reference
+    was not re-solved lower (no ``reference`` under the baseline in ``moved``)."""
+    from gaitlib.studies import gap as G
+
+    per = [{"x": -100.0, "y": -90.0, "z": -30.0},   # median -90: common mode, reference kept
+           {"x": -60.0, "y": -25.0, "z": -21.0},    # median -25: common mode, reference re-solved
+           {"x": -40.0, "y": 5.0, "z": 0.0},        # median 0: one effect, reference kept
+           {}]                                       # no ranked candidate: not a draw
+    moved = {"null0": {"baseline": {"data": [2.0, 1.9]}}, "null1": {"baseline": {"reference": [1.0, 0.9]}},
+             "null2": {}}
+    v = V.Validation(V.pd.DataFrame({"set": []}), {"null_calibration": {"dBIC": per, "moved": moved,
+                                                                        "threshold_dBIC": -60.0}}, {"relative": True})
+    r = G.common_mode_table({"v": v}).loc["v"]
+    assert r["draws"] == 3 and r["common-mode (median ≤ -20)"] == 2
+    assert r["of which the reference's baseline fit kept"] == 1 and r["other draws"] == 1 and r["of which kept"] == 1
+    assert r["common-mode lowest"] == -100.0 and r["other draws' lowest"] == -40.0 and r["threshold"] == -60.0

@@ -57,7 +57,7 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
            "VALIDATION_RUNS", "stored_validation", "calibration_threshold", "wilson", "TARGET_GROUPS",
            "replicate_table", "replicate_lines", "named_at", "rule_table", "threshold_sweep", "ranking_misses", "threshold_lines",
-           "threshold_draw_lines", "null_tail_table", "null_tail_lines", "stored_paired", "paired_lines", "PAIRED",
+           "threshold_draw_lines", "common_mode_table", "null_tail_table", "null_tail_lines", "stored_paired", "paired_lines", "PAIRED",
            "stored_load_confusion", "load_confusion_lines", "LOAD_CONFUSION_FILE", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
            "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines",
            "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines", "consistency_lines", "tie_lines",
@@ -865,6 +865,33 @@ def threshold_draw_lines(v: gval.Validation, label: str = "") -> list[str]:
         line += (f"; in it the baseline's fit of the reference reached objective {mine:.3f}, against a median of "
                  f"{float(np.median(others)):.3f} in the other {len(others)} draws where it moved")
     return [line + "."]
+
+
+def common_mode_table(vals: dict, cut: float = -20.0) -> pd.DataFrame:
+    """The calibration draws of relative validations (label → Validation) where the
+    candidates gained *alike*: the median ranked candidate's ΔBIC at or below ``cut`` — a
+    shift of the baseline's relative fit that every candidate is credited with, not one
+    effect absorbing noise. Per validation: its draws; the common-mode ones; of those, how
+    many kept the baseline's starting fit of the reference through the self-consistency
+    rounds (not re-solved lower; ``moved`` has no ``reference`` for the baseline) against
+    the same count in the other draws; the lowest statistic of each kind; the threshold."""
+    rows = []
+    for lab, v in vals.items():
+        c = (v.unedited or {}).get("null_calibration") or {}
+        moved = c.get("moved") or {}
+        cm, other = [], []
+        for j, p in enumerate(c.get("dBIC") or []):
+            if not p:
+                continue
+            kept = not ((moved.get(f"null{j}") or {}).get("baseline") or {}).get("reference")
+            (cm if float(np.median(list(p.values()))) <= cut else other).append((min(p.values()), kept))
+        rows.append({"validation": lab, "draws": len(cm) + len(other), f"common-mode (median ≤ {cut:g})": len(cm),
+                     "of which the reference's baseline fit kept": sum(k for _, k in cm),
+                     "other draws": len(other), "of which kept": sum(k for _, k in other),
+                     "common-mode lowest": min((x for x, _ in cm), default=np.nan),
+                     "other draws' lowest": min((x for x, _ in other), default=np.nan),
+                     "threshold": calibration_threshold(v)})
+    return pd.DataFrame(rows).set_index("validation")
 
 
 #: ``benchmarks/gap_load_confusion.py``'s result, under the validation's folder.
