@@ -743,3 +743,7 @@ def test_common_mode_draws_by_hand():
     assert r["draws"] == 3 and r["common-mode (median ≤ -20)"] == 2
     assert r["of which the reference's baseline fit kept"] == 1 and r["other draws"] == 1 and r["of which kept"] == 1
     assert r["common-mode lowest"] == -100.0 and r["other draws' lowest"] == -40.0 and r["threshold"] == -60.0
+    (line,) = G.common_mode_lines({"v": v})
+    assert line.startswith("Over v: 2 of 3 calibration draws were common-mode")
+    assert "their statistics from -60 to -100; in 1 of the 2 the baseline's fit of the reference kept its start" in line
+    assert "against 1 of the 1 other draws. The other draws' statistics reached at most -40." in line

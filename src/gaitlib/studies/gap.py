@@ -57,7 +57,7 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
            "VALIDATION_RUNS", "stored_validation", "calibration_threshold", "wilson", "TARGET_GROUPS",
            "replicate_table", "replicate_lines", "named_at", "rule_table", "threshold_sweep", "ranking_misses", "threshold_lines",
-           "threshold_draw_lines", "common_mode_table", "null_tail_table", "null_tail_lines", "stored_paired", "paired_lines", "PAIRED",
+           "threshold_draw_lines", "common_mode_table", "common_mode_lines", "null_tail_table", "null_tail_lines", "stored_paired", "paired_lines", "PAIRED",
            "stored_load_confusion", "load_confusion_lines", "LOAD_CONFUSION_FILE", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
            "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines",
            "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines", "consistency_lines", "tie_lines",
@@ -867,6 +867,17 @@ def threshold_draw_lines(v: gval.Validation, label: str = "") -> list[str]:
     return [line + "."]
 
 
+def _draw_modes(v: gval.Validation, cut: float) -> list:
+    """Per ranked calibration draw of ``v``: (its statistic — the lowest ΔBIC over the
+    candidates, common-mode — the median candidate's ΔBIC ≤ ``cut``, kept — the baseline's
+    fit of the reference not re-solved lower in the self-consistency rounds)."""
+    c = (v.unedited or {}).get("null_calibration") or {}
+    moved = c.get("moved") or {}
+    return [(min(p.values()), bool(np.median(list(p.values())) <= cut),
+             not ((moved.get(f"null{j}") or {}).get("baseline") or {}).get("reference"))
+            for j, p in enumerate(c.get("dBIC") or []) if p]
+
+
 def common_mode_table(vals: dict, cut: float = -20.0) -> pd.DataFrame:
     """The calibration draws of relative validations (label → Validation) where the
     candidates gained *alike*: the median ranked candidate's ΔBIC at or below ``cut`` — a
@@ -877,21 +888,31 @@ def common_mode_table(vals: dict, cut: float = -20.0) -> pd.DataFrame:
     the same count in the other draws; the lowest statistic of each kind; the threshold."""
     rows = []
     for lab, v in vals.items():
-        c = (v.unedited or {}).get("null_calibration") or {}
-        moved = c.get("moved") or {}
-        cm, other = [], []
-        for j, p in enumerate(c.get("dBIC") or []):
-            if not p:
-                continue
-            kept = not ((moved.get(f"null{j}") or {}).get("baseline") or {}).get("reference")
-            (cm if float(np.median(list(p.values()))) <= cut else other).append((min(p.values()), kept))
-        rows.append({"validation": lab, "draws": len(cm) + len(other), f"common-mode (median ≤ {cut:g})": len(cm),
-                     "of which the reference's baseline fit kept": sum(k for _, k in cm),
-                     "other draws": len(other), "of which kept": sum(k for _, k in other),
-                     "common-mode lowest": min((x for x, _ in cm), default=np.nan),
-                     "other draws' lowest": min((x for x, _ in other), default=np.nan),
+        d = _draw_modes(v, cut)
+        cm, other = [x for x in d if x[1]], [x for x in d if not x[1]]
+        rows.append({"validation": lab, "draws": len(d), f"common-mode (median ≤ {cut:g})": len(cm),
+                     "of which the reference's baseline fit kept": sum(k for *_, k in cm),
+                     "other draws": len(other), "of which kept": sum(k for *_, k in other),
+                     "common-mode lowest": min((x for x, *_ in cm), default=np.nan),
+                     "other draws' lowest": min((x for x, *_ in other), default=np.nan),
                      "threshold": calibration_threshold(v)})
     return pd.DataFrame(rows).set_index("validation")
+
+
+def common_mode_lines(vals: dict, cut: float = -20.0) -> list[str]:
+    """:func:`common_mode_table` pooled over ``vals`` in words, every number from the draws."""
+    d = [x for v in vals.values() for x in _draw_modes(v, cut)]
+    cm, other = [x for x in d if x[1]], [x for x in d if not x[1]]
+    line = (f"Over {', '.join(vals)}: {len(cm)} of {len(d)} calibration draws were common-mode (the median "
+            f"candidate's ΔBIC ≤ {cut:g}: every candidate credited alike)")
+    if cm:
+        st = sorted(x for x, *_ in cm)
+        line += (f", their statistics from {st[-1]:.0f} to {st[0]:.0f}; in {sum(k for *_, k in cm)} of the {len(cm)} "
+                 "the baseline's fit of the reference kept its start through the self-consistency rounds, against "
+                 f"{sum(k for *_, k in other)} of the {len(other)} other draws")
+    if other:
+        line += f". The other draws' statistics reached at most {min(x for x, *_ in other):.0f}"
+    return [line + "."]
 
 
 #: ``benchmarks/gap_load_confusion.py``'s result, under the validation's folder.
