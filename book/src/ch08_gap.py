@@ -629,35 +629,110 @@ else:
     print("(benchmarks/gap_paired.py quiet_points_rev5: not run)")
 
 # %% [markdown]
-# Then revision 6 on fresh draws (its hash changed) — the relative method in use:
+# Then revision 6 on fresh draws (its hash changed):
+
+# %%
+valr6 = gap_study.superseded_validation("relative_rev6")
+show_relative(valr6)
+display(Markdown("\n\n".join(gap_study.threshold_draw_lines(valr6, "revision 6"))))
+display(gap_study.rule_table(valr6))
+display(gap_study.threshold_sweep({"revision 6": valr6}))
+display(gap_study.ranking_misses({"revision 6": valr6}))
+display(Markdown("\n\n".join(gap_study.threshold_lines({"revision 6": valr6}))))
+
+# %% [markdown]
+# **Revision 6 on a second set of draws** (`--replicate 1`: the reference, its 19 null draws,
+# the magnitudes, signs and resampling seeds drawn afresh, the method unchanged), and both
+# replicates pooled, with a 95 % interval on each pooled rate:
+
+# %%
+valr6_1 = gap_study.superseded_validation("relative_rev6_r1")
+display(Markdown("\n\n".join(gap_study.calibration_lines(valr6_1))))
+display(valr6_1.scores())
+display(gap_study.rule_table(valr6_1))
+reps6 = {"replicate 0": valr6, "replicate 1": valr6_1}
+display(gap_study.replicate_table(reps6))
+display(Markdown("\n\n".join(gap_study.replicate_lines(reps6) + [
+    x for lab, v in reps6.items() for x in gap_study.threshold_draw_lines(v, f"revision 6, {lab}")])))
+display(gap_study.threshold_sweep(reps6))
+display(gap_study.ranking_misses(reps6))
+display(Markdown("\n\n".join(gap_study.threshold_lines(reps6))))
+
+# %% [markdown]
+# **The null's tail.** Revision 5's null cases named an effect beyond its threshold, and
+# revision 6's calibrations set thresholds that held back injections its ranking had right
+# (its rule tables above; the draw behind each lowest statistic is described there too).
+# Every relative validation has two kinds of draw of the same null — its calibration's
+# draws and its `null` cases (the unedited data resampled, nothing changed) — side by side
+# (revisions 1–3 fitted and ranked differently; the first pooled sentence counts revision
+# 4's replicates and revision 5, whose fits and rankings are made the same way, the second
+# revision 6's two replicates, which leave the quiet points out of the location):
+
+# %%
+null_all = {"revision 1": valr1, "revision 2": valr2, "revision 3": valr3, "revision 4": valr4,
+            "revision 4, replicate 1": valr4_1, "revision 5": valr5, "revision 6": valr6,
+            "revision 6, replicate 1": valr6_1}
+display(gap_study.null_tail_table(null_all).round(1))
+null_same = {k: null_all[k] for k in ("revision 4", "revision 4, replicate 1", "revision 5")}
+display(Markdown("\n\n".join(gap_study.null_tail_lines(null_same)
+                               + gap_study.null_tail_lines({k: null_all[k] for k in
+                                                            ("revision 6", "revision 6, replicate 1")}))))
+
+# %% [markdown]
+# **Where the tail comes from: draws in which every candidate gains alike.** A draw's
+# statistic is its best candidate's ΔBIC; in most draws one candidate absorbs some noise and
+# the others gain little or lose, but in some *every* candidate gains — a knee offset, a
+# friction coefficient and a left-right shift alike — which no one effect can do: the
+# baseline's own relative fit carries a difference every candidate is credited with
+# closing. The baseline's relative gap is [F(N) − N] − [F(R) − R]: its fit of the draw and
+# its fit of the reference must sit in the same optimum for the model's own misfit to
+# cancel, and the self-consistency rounds only re-solve the reference from the draw's fit.
+# Per validation, the draws whose median candidate reached ΔBIC ≤ −20, and whether the
+# baseline's fit of the reference kept its start (the reference's multistart) through the
+# rounds:
+
+# %%
+cm_vals = {"revision 4": valr4, "revision 4, replicate 1": valr4_1, "revision 5": valr5,
+           "revision 6": valr6, "revision 6, replicate 1": valr6_1}
+display(gap_study.common_mode_table(cm_vals).round(1))
+display(Markdown("\n\n".join(gap_study.common_mode_lines(cm_vals))))
+
+# %% [markdown]
+# **Revision 7: the baseline's fit of the reference from the candidates'.** The reference's
+# multistart is not the best optimum the baseline reaches on the reference: re-solved from a
+# null draw's fit it went lower in most draws, by different amounts. Revision 7
+# (`RELATIVE.reference_from_candidates`, `gaitlib.gap.reference`) re-solves the baseline's
+# fit of the reference from every nested candidate's fit of it and keeps the lowest, before
+# the data are continued from it — the reference-side twin of revision 4's baseline from the
+# candidates' fits of the data. Paired first: revision 6's own draws with only that changed
+# (`benchmarks/gap_paired.py reference_fit_rev6`):
+
+# %%
+valp7 = gap_study.stored_paired("reference_fit_rev6")
+if valp7 is not None:
+    pair = {"revision 6": valr6, "revision 6's draws, reference fit from the candidates'": valp7}
+    display(gap_study.replicate_table(pair).drop(columns=["pooled", "pooled %", "95 % interval"]))
+    display(gap_study.common_mode_table(pair).round(1))
+    display(gap_study.ranking_misses({"reference fit from the candidates'": valp7}))
+    display(Markdown("\n\n".join(gap_study.paired_lines(valr6, valp7, gap_study.PAIRED["reference_fit_rev6"])
+                                   + gap_study.threshold_draw_lines(valp7, "the paired run"))))
+else:
+    print("(benchmarks/gap_paired.py reference_fit_rev6: not run)")
+
+# %% [markdown]
+# Then revision 7 on fresh draws (its hash changed) — the relative method in use:
 
 # %%
 valr = gap_study.stored_validation("relative")
 print("written by:", gap_study.VALIDATION_RUNS["relative"])
 show_relative(valr)
-display(Markdown("\n\n".join(gap_study.threshold_draw_lines(valr, "revision 6"))))
+display(Markdown("\n\n".join(gap_study.threshold_draw_lines(valr, "revision 7"))))
 display(gap_study.rule_table(valr))
-display(gap_study.threshold_sweep({"revision 6": valr}))
-display(gap_study.ranking_misses({"revision 6": valr}))
-display(Markdown("\n\n".join(gap_study.threshold_lines({"revision 6": valr}))))
-
-# %% [markdown]
-# **The null's tail.** Revision 5's null cases named an effect beyond its threshold, and
-# revision 6's calibration set a threshold that held back injections its ranking had right
-# (its rule table above; the draw behind its lowest statistic is described there too).
-# Every relative validation has two kinds of draw of the same null — its calibration's
-# draws and its `null` cases (the unedited data resampled, nothing changed) — side by side
-# (revisions 1–3 fitted and ranked differently; the first pooled sentence counts revision
-# 4's replicates and revision 5, whose fits and rankings are made the same way, the second
-# revision 6, which leaves the quiet points out of the location):
-
-# %%
-null_all = {"revision 1": valr1, "revision 2": valr2, "revision 3": valr3, "revision 4": valr4,
-            "revision 4, replicate 1": valr4_1, "revision 5": valr5, "revision 6": valr}
-display(gap_study.null_tail_table(null_all).round(1))
-null_same = {k: null_all[k] for k in ("revision 4", "revision 4, replicate 1", "revision 5")}
-display(Markdown("\n\n".join(gap_study.null_tail_lines(null_same)
-                               + gap_study.null_tail_lines({"revision 6": valr}))))
+display(gap_study.common_mode_table({"revision 7": valr}).round(1))
+display(gap_study.threshold_sweep({"revision 7": valr}))
+display(gap_study.ranking_misses({"revision 7": valr}))
+display(Markdown("\n\n".join(gap_study.threshold_lines({"revision 7": valr})
+                               + gap_study.null_tail_lines({"revision 7": valr}))))
 
 # %% [markdown]
 # ## 3c. Muscle-level twins: co-contraction, joint stiffness and activation timing against EMG
@@ -968,5 +1043,7 @@ if prof_js is not None:
 display(Markdown("\n\n".join(gap_study.findings(tv, tvf, dS, dU, dN, chkS, chkU, bg, emg, val=val, valv=valv,
                                                     diag_m=dM, profile_m=prof_js, valn=valn, tv_muscle=tvm,
                                                     valr=valr, valr_reps=reps4, load_confusion=_lc,
-                                                    quiet_pair=(valr5, valq), null_tail=null_same))))
+                                                    quiet_pair=(valr5, valq), null_tail=null_same,
+                                                    valr_now_reps=reps6, common_mode=cm_vals,
+                                                    ref_pair=(valr6, valp7)))))
 print(f"notebook time: {time.perf_counter() - T0:.0f} s")

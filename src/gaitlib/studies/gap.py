@@ -1788,7 +1788,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
              profile_m: pd.DataFrame | None = None, valn: gval.Validation | None = None, tv_muscle=None,
              valr: gval.Validation | None = None, valr_reps: dict | None = None,
              load_confusion: dict | None = None, quiet_pair: tuple | None = None,
-             null_tail: dict | None = None) -> list[str]:
+             null_tail: dict | None = None, valr_now_reps: dict | None = None, common_mode: dict | None = None,
+             ref_pair: tuple | None = None) -> list[str]:
     """The chapter's findings as Markdown paragraphs, every number and verdict from the
     results: the twin checks (``tv`` on the coarse mesh, :func:`twin_validation`;
     ``tv_full`` on 20 × 5, :func:`twin_validation_full_mesh`), the SK diagnoses of Schwartz
@@ -1807,6 +1808,11 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     that ceiling (:func:`load_confusion_lines`); ``quiet_pair``: (revision 5's validation, the
     same draws with the quiet points left out or None, :func:`paired_lines`); ``null_tail``:
     relative validations of the same fits and ranking (:func:`null_tail_lines`);
+    ``valr_now_reps``: the previous revision's replicates (label → validation,
+    :func:`replicate_lines`, :func:`threshold_lines`); ``common_mode``: relative validations
+    whose calibration draws are split by common mode (:func:`common_mode_lines`);
+    ``ref_pair``: (revision 6's validation, its draws with the baseline's fit of the reference
+    from the candidates' or None, :func:`paired_lines`);
     ``tv_muscle``: the muscle-level twins (:func:`muscle_twin_validation`)."""
     s, sf = tv.summary(), tv_full.summary()
     acc = tv.accuracy()
@@ -1880,6 +1886,15 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     if quiet_pair is not None and quiet_pair[1] is not None:
         out.append("**The quiet points, paired on revision 5's draws.** "
                    + " ".join(paired_lines(*quiet_pair, PAIRED["quiet_points_rev5"])))
+    if valr_now_reps is not None and len(valr_now_reps) > 1:
+        rev = next(iter(valr_now_reps.values())).settings["relative_method"]["revision"]
+        out.append(f"**Revision {rev} on two sets of draws.** " + " ".join(replicate_lines(valr_now_reps)[:-1])
+                   + " " + " ".join(threshold_lines(valr_now_reps)))
+    if common_mode:
+        out.append("**Common-mode null draws.** " + " ".join(common_mode_lines(common_mode)))
+    if ref_pair is not None and ref_pair[1] is not None:
+        out.append("**The baseline's fit of the reference from the candidates', paired on revision 6's draws.** "
+                   + " ".join(paired_lines(*ref_pair, PAIRED["reference_fit_rev6"])))
     if valv is not None:
         out.append(" ".join(validation_lines(valv)[:-1]))
     if tv_muscle is not None:
