@@ -86,7 +86,8 @@ def main() -> int:
     method = dataclasses.replace(M.RelativeMethod(**fields), null_draws=0)  # the run's method, ranking only
     saved = {m: m.RELATIVE for m in (D, R)}
     orig = D.consistent_fits
-    res = {"run": RUN, "relative_method_hash": run.settings["relative_method_hash"], "base": base, "draws": []}
+    res = {"method_hash": M.METHOD.hash(), "run": RUN, "relative_method_hash": run.settings["relative_method_hash"],
+           "base": base, "draws": []}
     import tempfile
 
     with tempfile.TemporaryDirectory() as td:
