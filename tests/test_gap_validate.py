@@ -747,3 +747,20 @@ def test_common_mode_draws_by_hand():
     assert line.startswith("Over v: 2 of 3 calibration draws were common-mode")
     assert "their statistics from -60 to -100; in 1 of the 2 the baseline's fit of the reference kept its start" in line
     assert "against 1 of the 1 other draws. The other draws' statistics reached at most -40." in line
+
+
+def test_baseline_pair_lines_by_hand():
+    """A made-up gap_baseline_pair result: one common-mode draw the pair fixes, one it does
+    not (objectives moved by 0.002), one other draw whose first-ranked ΔBIC moved by 1.5."""
+    from gaitlib.studies import gap as G
+
+    def run(rank1, med, n, r):
+        return {"rank1": "x", "rank1_dBIC": rank1, "median_dBIC": med, "objective_N": n, "objective_R": r}
+
+    r = {"draws": [{"draw": "a", "as_run": run(-100.0, -80.0, 0.80, 0.77), "pair": run(-8.0, 1.0, 0.81, 0.77)},
+                   {"draw": "b", "as_run": run(-60.0, -40.0, 0.79, 0.76), "pair": run(-60.0, -40.0, 0.792, 0.76)},
+                   {"draw": "c", "as_run": run(-12.0, -1.0, 0.78, 0.76), "pair": run(-13.5, -1.0, 0.78, 0.76)}]}
+    (line,) = G.baseline_pair_lines(r)
+    assert "of 2 common-mode draws, 1 lost the common mode — a -100 (median -80) → -8 (median 1); b -60" in line
+    assert "the first-ranked ΔBIC of the 1 other draws moved by at most 1.5" in line
+    assert "In b the pair moved the baseline's objectives by at most 0.0020" in line

@@ -720,6 +720,24 @@ else:
     print("(benchmarks/gap_paired.py reference_fit_rev6: not run)")
 
 # %% [markdown]
+# Common-mode draws remain. Is the rest the same mismatch — the baseline's lowest optimum
+# on the draw not the one it takes on the reference? Its four common-mode draws and four
+# others, diagnosed again with the baseline's two fits chosen as a *pair* (of the draw's
+# fit with the reference re-solved from it, and the reference's fit with the draw re-solved
+# from it, the lower sum of objectives):
+
+# %%
+bpair = gap_study.stored_baseline_pair()
+if bpair is not None:
+    display(pd.DataFrame([{"draw": d["draw"], "run": lab, "first ranked": d[lab]["rank1"],
+                           "ΔBIC": d[lab]["rank1_dBIC"], "median candidate ΔBIC": d[lab]["median_dBIC"],
+                           "baseline objective N": d[lab]["objective_N"], "baseline objective R": d[lab]["objective_R"]}
+                          for d in bpair["draws"] for lab in ("as_run", "pair")]).round(4))
+    display(Markdown("\n\n".join(gap_study.baseline_pair_lines(bpair))))
+else:
+    print("(benchmarks/gap_baseline_pair.py: not run)")
+
+# %% [markdown]
 # Then revision 7 on fresh draws (its hash changed) — the relative method in use:
 
 # %%
@@ -1045,5 +1063,5 @@ display(Markdown("\n\n".join(gap_study.findings(tv, tvf, dS, dU, dN, chkS, chkU,
                                                     valr=valr, valr_reps=reps4, load_confusion=_lc,
                                                     quiet_pair=(valr5, valq), null_tail=null_same,
                                                     valr_now_reps=reps6, common_mode=cm_vals,
-                                                    ref_pair=(valr6, valp7)))))
+                                                    ref_pair=(valr6, valp7), baseline_pair=bpair))))
 print(f"notebook time: {time.perf_counter() - T0:.0f} s")

@@ -57,7 +57,7 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
            "VALIDATION_RUNS", "stored_validation", "calibration_threshold", "wilson", "TARGET_GROUPS",
            "replicate_table", "replicate_lines", "named_at", "rule_table", "threshold_sweep", "ranking_misses", "threshold_lines",
-           "threshold_draw_lines", "common_mode_table", "common_mode_lines", "null_tail_table", "null_tail_lines", "stored_paired", "paired_lines", "PAIRED",
+           "threshold_draw_lines", "common_mode_table", "common_mode_lines", "stored_baseline_pair", "baseline_pair_lines", "null_tail_table", "null_tail_lines", "stored_paired", "paired_lines", "PAIRED",
            "stored_load_confusion", "load_confusion_lines", "LOAD_CONFUSION_FILE", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
            "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines",
            "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines", "consistency_lines", "tie_lines",
@@ -1303,6 +1303,41 @@ def stored_experiment(relpath: str, script: str) -> dict | None:
     return r
 
 
+def stored_baseline_pair() -> dict | None:
+    """``benchmarks/gap_baseline_pair.py``'s result (:func:`stored_experiment`), refused if the
+    paired run it re-diagnosed was made under another relative method than the stored one."""
+    r = stored_experiment("gap_validation/baseline_pair.json", "gap_baseline_pair.py")
+    if r is not None and stored_paired(r["run"]).settings.get("relative_method_hash") != r["relative_method_hash"]:
+        raise RuntimeError(f"baseline_pair.json: {r['run']} is no longer the run it re-diagnosed: rerun "
+                           "benchmarks/gap_baseline_pair.py")
+    return r
+
+
+def baseline_pair_lines(r: dict, cut: float = -20.0) -> list[str]:
+    """``benchmarks/gap_baseline_pair.py``'s result in words, every number from it: per
+    common-mode draw (the run's median candidate ΔBIC ≤ ``cut``), its statistic and median
+    with the baseline's two fits as the run chose them and as a pair; the other draws' largest
+    change of the first-ranked ΔBIC."""
+    cm = [d for d in r["draws"] if d["as_run"]["median_dBIC"] <= cut]
+    other = [d for d in r["draws"] if d["as_run"]["median_dBIC"] > cut]
+    fixed = [d for d in cm if d["pair"]["median_dBIC"] > cut]
+    parts = [f"{d['draw']} {d['as_run']['rank1_dBIC']:.0f} (median {d['as_run']['median_dBIC']:.0f}) → "
+             f"{d['pair']['rank1_dBIC']:.0f} (median {d['pair']['median_dBIC']:.0f})" for d in cm]
+    line = (f"The baseline's fits of the draw and of the reference chosen as a pair (the lower sum of the two "
+            f"objectives, each pair reached from one start; `benchmarks/gap_baseline_pair.py`, ranking only): of "
+            f"{len(cm)} common-mode draws, {len(fixed)} lost the common mode — " + "; ".join(parts))
+    if other:
+        ch = max(abs(d["pair"]["rank1_dBIC"] - d["as_run"]["rank1_dBIC"]) for d in other)
+        line += f"; the first-ranked ΔBIC of the {len(other)} other draws moved by at most {ch:.1f}"
+    rest = [d for d in cm if d not in fixed]
+    if rest:
+        dobj = max(abs(d["pair"][f"objective_{x}"] - d["as_run"][f"objective_{x}"]) for d in rest for x in "NR")
+        line += (f". In {', '.join(d['draw'] for d in rest)} the pair moved the baseline's objectives by at most "
+                 f"{dobj:.4f} and every candidate still gained alike: a mismatch of the baseline's two optima explains "
+                 "part of the common mode, not all of it")
+    return [line + "."]
+
+
 #: ``benchmarks/gap_reference_basin.py``'s result, under the validation's folder.
 REFERENCE_BASIN_FILE = "reference_basin.json"
 
@@ -1789,7 +1824,7 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
              valr: gval.Validation | None = None, valr_reps: dict | None = None,
              load_confusion: dict | None = None, quiet_pair: tuple | None = None,
              null_tail: dict | None = None, valr_now_reps: dict | None = None, common_mode: dict | None = None,
-             ref_pair: tuple | None = None) -> list[str]:
+             ref_pair: tuple | None = None, baseline_pair: dict | None = None) -> list[str]:
     """The chapter's findings as Markdown paragraphs, every number and verdict from the
     results: the twin checks (``tv`` on the coarse mesh, :func:`twin_validation`;
     ``tv_full`` on 20 × 5, :func:`twin_validation_full_mesh`), the SK diagnoses of Schwartz
@@ -1812,7 +1847,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     :func:`replicate_lines`, :func:`threshold_lines`); ``common_mode``: relative validations
     whose calibration draws are split by common mode (:func:`common_mode_lines`);
     ``ref_pair``: (revision 6's validation, its draws with the baseline's fit of the reference
-    from the candidates' or None, :func:`paired_lines`);
+    from the candidates' or None, :func:`paired_lines`); ``baseline_pair``:
+    ``benchmarks/gap_baseline_pair.py``'s result (:func:`baseline_pair_lines`);
     ``tv_muscle``: the muscle-level twins (:func:`muscle_twin_validation`)."""
     s, sf = tv.summary(), tv_full.summary()
     acc = tv.accuracy()
@@ -1895,6 +1931,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     if ref_pair is not None and ref_pair[1] is not None:
         out.append("**The baseline's fit of the reference from the candidates', paired on revision 6's draws.** "
                    + " ".join(paired_lines(*ref_pair, PAIRED["reference_fit_rev6"])))
+    if baseline_pair is not None:
+        out.append("**What remains of the common mode.** " + " ".join(baseline_pair_lines(baseline_pair)))
     if valv is not None:
         out.append(" ".join(validation_lines(valv)[:-1]))
     if tv_muscle is not None:
