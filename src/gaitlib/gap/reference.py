@@ -51,7 +51,11 @@ again from it (:func:`gaitlib.gap.diagnose.consistent_fits`, RELATIVE ``referenc
 Before that, the baseline's F(N) is also re-solved from every nested candidate's F_k(N) and
 the lowest kept (RELATIVE ``baseline_from_candidates``): a baseline continuation stopped in
 a worse optimum than its own extensions reach would credit every candidate with the
-difference (Chapter 8, revision 3's null draws).
+difference (Chapter 8, revision 3's null draws). From revision 7 the baseline's F(R) is
+re-solved the same way, from every nested candidate's F_k(R), before N is continued from it
+(RELATIVE ``reference_from_candidates``): the reference's multistart was not the lowest
+optimum the baseline reaches on R, and where the rounds kept it, every candidate was
+credited alike (Chapter 8, "Where the tail comes from").
 
 Null calibration
 ----------------
