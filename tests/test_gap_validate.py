@@ -764,3 +764,19 @@ def test_baseline_pair_lines_by_hand():
     assert "of 2 common-mode draws, 1 lost the common mode — a -100 (median -80) → -8 (median 1); b -60" in line
     assert "the first-ranked ΔBIC of the 1 other draws moved by at most 1.5" in line
     assert "In b the pair moved the baseline's objectives by at most 0.0020" in line
+
+
+def test_candidate_baseline_lines_by_hand():
+    """A made-up gap_candidate_baseline result: medians and first-ranked ΔBIC, both ways."""
+    from gaitlib.studies import gap as G
+
+    def x(first, med, n=3):
+        return {"rank1": "k", "rank1_dBIC": first, "median_dBIC": med, "ranked": n}
+
+    r = {"draws": [{"one_baseline": x(-100.0, -80.0), "own_baseline": x(-150.0, -2.0)},
+                   {"one_baseline": x(-10.0, 3.0), "own_baseline": x(-30.0, -25.0)},
+                   {"one_baseline": x(None, None, 0), "own_baseline": x(None, None, 0)}]}
+    (line,) = G.candidate_baseline_lines(r)
+    assert "(`benchmarks/gap_candidate_baseline.py`, 3 draws, ranking only)" in line
+    assert "fell within -25 to -2 (against the one baseline: -80 to 3; ≤ -20 in 1 draws against 1)" in line
+    assert "the first-ranked ΔBIC spread to -150 to -30 (against -100 to -10)" in line

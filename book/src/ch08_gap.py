@@ -738,6 +738,23 @@ else:
     print("(benchmarks/gap_baseline_pair.py: not run)")
 
 # %% [markdown]
+# And each candidate against a baseline of its own — the baseline re-solved from that
+# candidate's fits of the draw and of the reference — instead of the one baseline; the same
+# draws and two more (one where no candidate was ranked: every candidate's relative gap above
+# the baseline's, the opposite shift):
+
+# %%
+cbase = gap_study.stored_candidate_baseline()
+if cbase is not None:
+    display(pd.DataFrame([{"draw": d["draw"], "run": lab, "first ranked": d[lab]["rank1"],
+                           "ΔBIC": d[lab]["rank1_dBIC"], "median candidate ΔBIC": d[lab]["median_dBIC"],
+                           "compared": d[lab]["ranked"]}
+                          for d in cbase["draws"] for lab in ("as_run", "one_baseline", "own_baseline")]).round(1))
+    display(Markdown("\n\n".join(gap_study.candidate_baseline_lines(cbase))))
+else:
+    print("(benchmarks/gap_candidate_baseline.py: not run)")
+
+# %% [markdown]
 # Then revision 7 on fresh draws (its hash changed) — the relative method in use:
 
 # %%
@@ -1063,5 +1080,6 @@ display(Markdown("\n\n".join(gap_study.findings(tv, tvf, dS, dU, dN, chkS, chkU,
                                                     valr=valr, valr_reps=reps4, load_confusion=_lc,
                                                     quiet_pair=(valr5, valq), null_tail=null_same,
                                                     valr_now_reps=reps6, common_mode=cm_vals,
-                                                    ref_pair=(valr6, valp7), baseline_pair=bpair))))
+                                                    ref_pair=(valr6, valp7), baseline_pair=bpair,
+                                                    candidate_baseline=cbase))))
 print(f"notebook time: {time.perf_counter() - T0:.0f} s")

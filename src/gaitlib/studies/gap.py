@@ -57,7 +57,7 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
            "VALIDATION_RUNS", "stored_validation", "calibration_threshold", "wilson", "TARGET_GROUPS",
            "replicate_table", "replicate_lines", "named_at", "rule_table", "threshold_sweep", "ranking_misses", "threshold_lines",
-           "threshold_draw_lines", "common_mode_table", "common_mode_lines", "stored_baseline_pair", "baseline_pair_lines", "null_tail_table", "null_tail_lines", "stored_paired", "paired_lines", "PAIRED",
+           "threshold_draw_lines", "common_mode_table", "common_mode_lines", "stored_baseline_pair", "baseline_pair_lines", "stored_candidate_baseline", "candidate_baseline_lines", "null_tail_table", "null_tail_lines", "stored_paired", "paired_lines", "PAIRED",
            "stored_load_confusion", "load_confusion_lines", "LOAD_CONFUSION_FILE", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
            "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines",
            "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines", "consistency_lines", "tie_lines",
@@ -1338,6 +1338,34 @@ def baseline_pair_lines(r: dict, cut: float = -20.0) -> list[str]:
     return [line + "."]
 
 
+def stored_candidate_baseline() -> dict | None:
+    """``benchmarks/gap_candidate_baseline.py``'s result (:func:`stored_experiment`), refused
+    if the paired run it re-diagnosed was made under another relative method."""
+    r = stored_experiment("gap_validation/candidate_baseline.json", "gap_candidate_baseline.py")
+    if r is not None and stored_paired(r["run"]).settings.get("relative_method_hash") != r["relative_method_hash"]:
+        raise RuntimeError(f"candidate_baseline.json: {r['run']} is no longer the run it re-diagnosed: rerun "
+                           "benchmarks/gap_candidate_baseline.py")
+    return r
+
+
+def candidate_baseline_lines(r: dict, cut: float = -20.0) -> list[str]:
+    """``benchmarks/gap_candidate_baseline.py``'s result in words, every number from it: the
+    medians and first-ranked ΔBIC of the draws with every candidate against the one baseline
+    and against the baseline re-solved from its own fits."""
+    one = [d["one_baseline"] for d in r["draws"] if d["one_baseline"]["ranked"]]
+    own = [d["own_baseline"] for d in r["draws"] if d["own_baseline"]["ranked"]]
+    med1, med2 = (sorted(x["median_dBIC"] for x in v) for v in (one, own))
+    f1, f2 = (sorted(x["rank1_dBIC"] for x in v) for v in (one, own))
+    return [f"Each candidate against the baseline re-solved from its own fits of the draw and the reference "
+            f"(`benchmarks/gap_candidate_baseline.py`, {len(r['draws'])} draws, ranking only): the median candidate's "
+            f"ΔBIC fell within {med2[0]:.0f} to {med2[-1]:.0f} (against the one baseline: {med1[0]:.0f} to "
+            f"{med1[-1]:.0f}; ≤ {cut:g} in {sum(m <= cut for m in med2)} draws against {sum(m <= cut for m in med1)}), "
+            f"but the first-ranked ΔBIC spread to {f2[0]:.0f} to {f2[-1]:.0f} (against {f1[0]:.0f} to {f1[-1]:.0f}): "
+            "each draw's extreme now comes from one candidate whose own re-solved baseline fits the relative gap "
+            "worse, not from all alike. A per-candidate baseline moves the tail, it does not remove it; it is not "
+            "adopted."]
+
+
 #: ``benchmarks/gap_reference_basin.py``'s result, under the validation's folder.
 REFERENCE_BASIN_FILE = "reference_basin.json"
 
@@ -1824,7 +1852,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
              valr: gval.Validation | None = None, valr_reps: dict | None = None,
              load_confusion: dict | None = None, quiet_pair: tuple | None = None,
              null_tail: dict | None = None, valr_now_reps: dict | None = None, common_mode: dict | None = None,
-             ref_pair: tuple | None = None, baseline_pair: dict | None = None) -> list[str]:
+             ref_pair: tuple | None = None, baseline_pair: dict | None = None,
+             candidate_baseline: dict | None = None) -> list[str]:
     """The chapter's findings as Markdown paragraphs, every number and verdict from the
     results: the twin checks (``tv`` on the coarse mesh, :func:`twin_validation`;
     ``tv_full`` on 20 × 5, :func:`twin_validation_full_mesh`), the SK diagnoses of Schwartz
@@ -1849,6 +1878,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     ``ref_pair``: (revision 6's validation, its draws with the baseline's fit of the reference
     from the candidates' or None, :func:`paired_lines`); ``baseline_pair``:
     ``benchmarks/gap_baseline_pair.py``'s result (:func:`baseline_pair_lines`);
+    ``candidate_baseline``: ``benchmarks/gap_candidate_baseline.py``'s
+    (:func:`candidate_baseline_lines`);
     ``tv_muscle``: the muscle-level twins (:func:`muscle_twin_validation`)."""
     s, sf = tv.summary(), tv_full.summary()
     acc = tv.accuracy()
@@ -1932,7 +1963,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
         out.append("**The baseline's fit of the reference from the candidates', paired on revision 6's draws.** "
                    + " ".join(paired_lines(*ref_pair, PAIRED["reference_fit_rev6"])))
     if baseline_pair is not None:
-        out.append("**What remains of the common mode.** " + " ".join(baseline_pair_lines(baseline_pair)))
+        out.append("**What remains of the common mode.** " + " ".join(baseline_pair_lines(baseline_pair))
+                   + (" " + " ".join(candidate_baseline_lines(candidate_baseline)) if candidate_baseline else ""))
     if valv is not None:
         out.append(" ".join(validation_lines(valv)[:-1]))
     if tv_muscle is not None:
