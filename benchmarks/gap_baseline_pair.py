@@ -22,9 +22,9 @@ Writes ``results/gap_validation/baseline_pair.json`` and ``.md``.
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -73,32 +73,23 @@ def paired_consistent(original):
 
 
 def main() -> int:
+    from gap_paired import calibration_draws, stored_method, using
+
     from gaitlib.gap import diagnose as D
     from gaitlib.gap import method as M
-    from gaitlib.gap import reference as R
-    from gaitlib.gap import validate as V
     from gaitlib.studies import gap as gap_study
 
     run = gap_study.stored_paired(RUN)
     calib = run.unedited["null_calibration"]
     base = run.settings["base"]
-    fields = {k: v for k, v in run.settings["relative_method"].items() if k in M.RelativeMethod.__dataclass_fields__}
-    method = dataclasses.replace(M.RelativeMethod(**fields), null_draws=0)  # the run's method, ranking only
-    saved = {m: m.RELATIVE for m in (D, R)}
     orig = D.consistent_fits
     res = {"method_hash": M.METHOD.hash(), "run": RUN, "relative_method_hash": run.settings["relative_method_hash"],
            "base": base, "draws": []}
-    import tempfile
-
-    with tempfile.TemporaryDirectory() as td:
-        ref, _ = V.relative_null_sets(run, td)
+    with tempfile.TemporaryDirectory() as td, using(stored_method(run, {"null_draws": 0})):  # ranking only
+        ref, draws = calibration_draws(run, DRAWS, td)
         try:
-            for m in saved:
-                m.RELATIVE = method
-            for name in DRAWS:
-                j = int(name[4:])
-                ds = R.null_draw(ref, int(calib["n_subjects"]), int(calib["seeds"][j]))
-                row = {"draw": name, "stored": calib["dBIC"][j]}
+            for name, ds in draws:
+                row = {"draw": name, "stored": calib["dBIC"][int(name[4:])]}
                 for label, fn in (("as_run", orig), ("pair", paired_consistent(orig))):
                     D.consistent_fits = fn
                     d = D.diagnose(ds, base=base, resamples=0, reference=ref, serial=True)
@@ -110,8 +101,6 @@ def main() -> int:
                                   for k, v in row.items() if k != "stored"}), flush=True)
         finally:
             D.consistent_fits = orig
-            for m, r in saved.items():
-                m.RELATIVE = r
     OUT.write_text(json.dumps(res, indent=1))
     lines = ["| draw | run | first ranked (ΔBIC) | median candidate ΔBIC | ranked | baseline objective N / R | pair from |",
              "|---|---|---|---|---|---|---|"]

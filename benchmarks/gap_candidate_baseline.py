@@ -22,7 +22,6 @@ Writes ``results/gap_validation/candidate_baseline.json`` and ``.md``.
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import sys
 import tempfile
@@ -46,19 +45,17 @@ def stats(dbic: dict) -> dict:
 
 
 def main() -> int:
+    from gap_paired import calibration_draws, stored_method, using
+
     from gaitlib.gap import diagnose as D
     from gaitlib.gap import locate as L
     from gaitlib.gap import method as M
     from gaitlib.gap import reference as R
-    from gaitlib.gap import validate as V
     from gaitlib.studies import gap as gap_study
 
     run = gap_study.stored_paired(RUN)
     calib = run.unedited["null_calibration"]
     base = run.settings["base"]
-    fields = {k: v for k, v in run.settings["relative_method"].items() if k in M.RelativeMethod.__dataclass_fields__}
-    method = dataclasses.replace(M.RelativeMethod(**fields), null_draws=0)  # the run's method, ranking only
-    saved = {m: m.RELATIVE for m in (D, R)}
     orig = D.consistent_fits
     captured = {}
 
@@ -69,15 +66,12 @@ def main() -> int:
 
     res = {"method_hash": M.METHOD.hash(), "run": RUN, "relative_method_hash": run.settings["relative_method_hash"],
            "base": base, "draws": []}
-    with tempfile.TemporaryDirectory() as td:
-        ref, _ = V.relative_null_sets(run, td)
+    with tempfile.TemporaryDirectory() as td, using(stored_method(run, {"null_draws": 0})):  # ranking only
+        ref, draws = calibration_draws(run, DRAWS, td)
         try:
-            for m in saved:
-                m.RELATIVE = method
             D.consistent_fits = capture
-            for name in DRAWS:
+            for name, ds in draws:
                 j = int(name[4:])
-                ds = R.null_draw(ref, int(calib["n_subjects"]), int(calib["seeds"][j]))
                 captured.clear()
                 d = D.diagnose(ds, base=base, resamples=0, reference=ref, serial=True, progress=False)
                 r = d.ranking[d.ranking["ok"].astype(bool) & np.isfinite(d.ranking["dBIC"].astype(float))]
@@ -108,8 +102,6 @@ def main() -> int:
                                                    for k in ("as_run", "one_baseline", "own_baseline")}}), flush=True)
         finally:
             D.consistent_fits = orig
-            for m, r in saved.items():
-                m.RELATIVE = r
     OUT.write_text(json.dumps(res, indent=1))
     lines = ["| draw | run | first ranked (ΔBIC) | median candidate ΔBIC | candidates compared |", "|---|---|---|---|---|"]
     for row in res["draws"]:

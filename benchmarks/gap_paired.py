@@ -16,6 +16,7 @@ revision) must be set by the experiment: it was off then.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import sys
 from pathlib import Path
@@ -42,40 +43,68 @@ def stored(name: str):
     return gap_study.stored_validation(name)
 
 
-def run(name: str):
-    """Run experiment ``name`` and save it; returns the Validation."""
-    from gaitlib.gap import diagnose as D
+def stored_method(val, changes: dict):
+    """The relative method ``val`` (a stored relative validation) was made with, its fields
+    ``changes`` changed, hashing as the stored method — so its draws, null draws and seeds,
+    and the fits nothing changed, are the stored ones. A field the stored method did not have
+    yet must be in ``changes``."""
     from gaitlib.gap import method as M
-    from gaitlib.gap import reference as R
-    from gaitlib.gap import validate as V
 
-    validation, changes = EXPERIMENTS[name]
-    val = stored(validation)
     h = val.settings["relative_method_hash"]
     fields = {k: v for k, v in val.settings["relative_method"].items() if k in M.RelativeMethod.__dataclass_fields__}
     unset = sorted(set(M.RelativeMethod.__dataclass_fields__) - set(fields) - set(changes))
     if unset:
-        raise ValueError(f"{name}: {validation}'s method has no {', '.join(unset)}: the experiment must set it")
+        raise ValueError(f"the stored method has no {', '.join(unset)}: the experiment must set it")
 
     @dataclasses.dataclass(frozen=True)
     class StoredDraws(M.RelativeMethod):
-        """The stored method's fields with ``changes``, seeded as the stored method (its
-        hash): the same draws, the same null draws, so the same fits where nothing changed."""
+        """The stored method's fields with ``changes``, seeded as the stored method (its hash)."""
 
         def hash(self) -> str:
             return h
 
-    method = StoredDraws(**{**fields, **changes})
+    return StoredDraws(**{**fields, **changes})
+
+
+@contextlib.contextmanager
+def using(method):
+    """The relative method of :mod:`gaitlib.gap` (diagnose, reference, validate) replaced by
+    ``method`` for the block."""
+    from gaitlib.gap import diagnose as D
+    from gaitlib.gap import reference as R
+    from gaitlib.gap import validate as V
+
     saved = {m: m.RELATIVE for m in (D, R, V)}
     try:
         for m in saved:
             m.RELATIVE = method
-        v = V.run(tuple(val.settings["sets"]), per_band=int(val.settings["per_band"]),
-                  speed_class=val.settings["speed_class"], base=dict(val.settings["base"]), relative=True,
-                  replicate=int(val.settings.get("replicate", 0)), progress=True)
+        yield method
     finally:
         for m, r in saved.items():
             m.RELATIVE = r
+
+
+def calibration_draws(val, names, folder) -> tuple:
+    """A stored relative validation's reference and the named null-calibration draws
+    (``"null<j>"``), regenerated from its stored seeds: ``(reference, [(name, DataSet), …])``."""
+    from gaitlib.gap import reference as R
+    from gaitlib.gap import validate as V
+
+    calib = val.unedited["null_calibration"]
+    ref, _ = V.relative_null_sets(val, folder)
+    return ref, [(n, R.null_draw(ref, int(calib["n_subjects"]), int(calib["seeds"][int(n[4:])]))) for n in names]
+
+
+def run(name: str):
+    """Run experiment ``name`` and save it; returns the Validation."""
+    from gaitlib.gap import validate as V
+
+    validation, changes = EXPERIMENTS[name]
+    val = stored(validation)
+    with using(stored_method(val, changes)):
+        v = V.run(tuple(val.settings["sets"]), per_band=int(val.settings["per_band"]),
+                  speed_class=val.settings["speed_class"], base=dict(val.settings["base"]), relative=True,
+                  replicate=int(val.settings.get("replicate", 0)), progress=True)
     v.settings.update(pairs_with=validation, changed=changes, experiment=f"benchmarks/gap_paired.py {name}")
     v.save(RESULTS / name)
     print(v.scores().to_string(index=False))

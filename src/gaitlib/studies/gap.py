@@ -1303,14 +1303,20 @@ def stored_experiment(relpath: str, script: str) -> dict | None:
     return r
 
 
-def stored_baseline_pair() -> dict | None:
-    """``benchmarks/gap_baseline_pair.py``'s result (:func:`stored_experiment`), refused if the
-    paired run it re-diagnosed was made under another relative method than the stored one."""
-    r = stored_experiment("gap_validation/baseline_pair.json", "gap_baseline_pair.py")
+def _stored_run_experiment(name: str) -> dict | None:
+    """``benchmarks/gap_<name>.py``'s result on a paired run (:func:`stored_experiment`,
+    ``results/gap_validation/<name>.json``), refused if the run it re-diagnosed was made under
+    another relative method than the stored one."""
+    r = stored_experiment(f"gap_validation/{name}.json", f"gap_{name}.py")
     if r is not None and stored_paired(r["run"]).settings.get("relative_method_hash") != r["relative_method_hash"]:
-        raise RuntimeError(f"baseline_pair.json: {r['run']} is no longer the run it re-diagnosed: rerun "
-                           "benchmarks/gap_baseline_pair.py")
+        raise RuntimeError(f"{name}.json: {r['run']} is no longer the run it re-diagnosed: rerun "
+                           f"benchmarks/gap_{name}.py")
     return r
+
+
+def stored_baseline_pair() -> dict | None:
+    """``benchmarks/gap_baseline_pair.py``'s result (:func:`_stored_run_experiment`)."""
+    return _stored_run_experiment("baseline_pair")
 
 
 def baseline_pair_lines(r: dict, cut: float = -20.0) -> list[str]:
@@ -1339,13 +1345,8 @@ def baseline_pair_lines(r: dict, cut: float = -20.0) -> list[str]:
 
 
 def stored_candidate_baseline() -> dict | None:
-    """``benchmarks/gap_candidate_baseline.py``'s result (:func:`stored_experiment`), refused
-    if the paired run it re-diagnosed was made under another relative method."""
-    r = stored_experiment("gap_validation/candidate_baseline.json", "gap_candidate_baseline.py")
-    if r is not None and stored_paired(r["run"]).settings.get("relative_method_hash") != r["relative_method_hash"]:
-        raise RuntimeError(f"candidate_baseline.json: {r['run']} is no longer the run it re-diagnosed: rerun "
-                           "benchmarks/gap_candidate_baseline.py")
-    return r
+    """``benchmarks/gap_candidate_baseline.py``'s result (:func:`_stored_run_experiment`)."""
+    return _stored_run_experiment("candidate_baseline")
 
 
 def candidate_baseline_lines(r: dict, cut: float = -20.0) -> list[str]:
