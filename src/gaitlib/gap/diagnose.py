@@ -858,7 +858,7 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
             base_sol, all_fits["data"], all_fits["reference"] = cons["base"], cons["fits"], cons["ref_fits"]
             ref_info["moved"] = cons["moved"]
             ref_info["consistent_fit"] = _stats(cons["ref_fit"])
-            ref_fit_multistart, ref_fit = ref_fit, cons["ref_fit"]
+            ref_fit_start, ref_fit = ref_fit, cons["ref_fit"]  # the null draws start where the data did
             n_rel = gref.relative_n(ds.n, ref.n)
             if calibration is not None:  # computed before for this reference: checked, not redone
                 want = {"relative_method_hash": RELATIVE.hash(), "reference_signature": ref.signature,
@@ -868,7 +868,7 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
                     raise ValueError(f"calibration= was made for another {', '.join(bad)}: not this diagnosis's")
                 calib = calibration
             else:
-                calib = null_calibration(spec0, ref, ref_fit_multistart, ref_fits, names, n_rel, warms,
+                calib = null_calibration(spec0, ref, ref_fit_start, ref_fits, names, n_rel, warms,
                                          objective=objective,
                                          root=root, use_cache=use_cache, scheduler=scheduler,
                                          **kw) if RELATIVE.null_draws > 0 else None

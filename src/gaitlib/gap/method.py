@@ -38,16 +38,6 @@ class Method:
         diagnosis is "unexplained" and names the contenders. When the data hold a gap no
         library effect represents, several effects each absorb a part of it and none stands
         out; when one effect is the cause, it does.
-    reference_from_candidates : the baseline's fit of the reference is also re-solved from
-        every nested candidate's fit of the reference and the lowest kept, before the data are
-        continued from it. Revision 6's calibrations had draws in which every candidate gained
-        alike (the median candidate's ΔBIC ≤ −20; 5 of 19 and 3 of 19 in its two replicates,
-        statistics to −236, thresholds −206 and −78); in 4 of those 8 the baseline's fit of the
-        reference had kept the reference's multistart through the self-consistency rounds,
-        against 1 of the 30 other draws, where re-solving it from the draw's fit went lower.
-        Paired on revision 6's draws (``benchmarks/gap_paired.py reference_fit_rev6``) the
-        threshold moved from −206 to −101 and the independent middle+large injections named
-        from 17 to 24 of 24, out-of-library and null unchanged (16/16, 4/4).
     revision : bumped when the diagnosis decides differently for a reason outside these
         fields, so that the validation is redrawn. 1: the first frozen method; 2: the
         force-plate gain effect scales the data's SD with its mean (``grf_scale`` version 2,
@@ -138,12 +128,15 @@ class RelativeMethod:
         model's feet carry load the data do not (``benchmarks/gap_load_confusion.py``).
     reference_from_candidates : the baseline's fit of the reference is also re-solved from
         every nested candidate's fit of the reference and the lowest kept, before the data are
-        continued from it. Revision 6's validation: in 5 of its 19 null draws every candidate
-        gained alike (the median candidate's ΔBIC −46 to −219), in the two lowest (−236,
-        −206; they set the threshold) with the baseline's fit of the draw re-solved from a
-        candidate's fit and its fit of the reference still the multistart's (objective 0.800,
-        where re-solved from other draws' fits it reached 0.746–0.773): the two baseline fits
-        stood in different optima, and the relative gap carried that difference.
+        continued from it. Revision 6's calibrations had draws in which every candidate gained
+        alike (the median candidate's ΔBIC ≤ −20; 5 of 19 and 3 of 19 in its two replicates,
+        statistics to −236, thresholds −206 and −78); in 4 of those 8 the baseline's fit of the
+        reference had kept the reference's multistart through the self-consistency rounds,
+        against 1 of the 30 other draws, where re-solving it from the draw's fit went lower.
+        Paired on revision 6's draws (``benchmarks/gap_paired.py reference_fit_rev6``) the
+        threshold moved from −206 to −101 and the independent middle+large injections named
+        from 17 to 24 of 24, out-of-library and null unchanged (16/16, 4/4); on its own fresh
+        draws: threshold −60 (still three common-mode draws), 20 of 24, 16/16, 3/4.
     revision : bumped when the relative diagnosis decides differently for a reason outside
         these fields. 1: the null calibration; 2: the self-consistent reference fit; 3: the
         HAT tilt located; 4: the baseline from the candidates' fits; 5: the threshold the
