@@ -382,7 +382,7 @@ def test_the_baseline_fit_of_the_reference_is_refitted_from_the_candidates_fits(
     def fake_solve_many(groups, **kw):
         ((g, (spec, jobs)),) = groups.items()
         assert g == "reference-baseline-from" and spec.effects == ()
-        obj = {"reference|knee_offset": 0.95, "reference|hip_offset": 0.85}  # not the unconverged ankle fit
+        obj = objectives[0]  # not the unconverged ankle fit
         assert sorted(k for k, _, _ in jobs) == sorted(obj)
         return {key: _Sol(obj[key], key) for key, _, _ in jobs}
 
@@ -397,7 +397,11 @@ def test_the_baseline_fit_of_the_reference_is_refitted_from_the_candidates_fits(
     monkeypatch.setattr(D.locate, "locate", lambda *a, **k: type("L", (), {"rss": 0.0})())
     names = ["knee_offset", "hip_offset", "ankle_offset"]
     base = dict(n_intervals=4, degree=2)
-    for on, want in ((True, "reference|hip_offset"), (False, "R0")):
+    lower = {"reference|knee_offset": 0.95, "reference|hip_offset": 0.85}
+    higher = {"reference|knee_offset": 1.05, "reference|hip_offset": 1.1}
+    objectives = []
+    for on, obj, want in ((True, lower, "reference|hip_offset"), (True, higher, "R0"), (False, lower, "R0")):
+        objectives[:] = [obj]
         monkeypatch.setattr(D, "RELATIVE", M.RelativeMethod(reference_from_candidates=on))
         warm_of_data.clear()
         with pytest.raises(Stop) as got:
