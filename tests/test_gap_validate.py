@@ -780,3 +780,22 @@ def test_candidate_baseline_lines_by_hand():
     assert "(`benchmarks/gap_candidate_baseline.py`, 3 draws, ranking only)" in line
     assert "fell within -25 to -2 (against the one baseline: -80 to 3; ≤ -20 in 1 draws against 1)" in line
     assert "the first-ranked ΔBIC spread to -150 to -30 (against -100 to -10)" in line
+
+
+def test_a_failed_baseline_is_named_so_among_the_ranking_misses():
+    """An independent middle injection whose baseline fit failed (nothing ranked) is listed as
+    that, in the table and in the sentence — not as 'another effect ranked first'."""
+    from gaitlib.studies import gap as G
+
+    nan = float("nan")
+    rows = V.pd.DataFrame({"set": ["independent"] * 2, "band": ["middle", "large"], "case": ["k_m", "k_l"],
+                           "expected": ["knee_offset"] * 2, "magnitude": [3.0, 7.0],
+                           "named": ["knee_offset", "baseline failed"], "rank1": ["knee_offset", nan],
+                           "rank1_dBIC": [-80.0, nan], "rank2": ["hip_offset", nan], "rank2_dBIC": [-5.0, nan],
+                           "expected_rank": [1, nan], "contenders": [["knee_offset"], []],
+                           "correct": [True, False], "verdict": ["explained", "baseline failed"]})
+    v = V.Validation(rows, {"null_calibration": {"lowest_dBIC": -30.0}}, {"relative": True})
+    m = G.ranking_misses({"r": v})
+    assert list(m["case"]) == ["k_l"] and m.iloc[0]["why"] == "baseline fit failed: nothing ranked"
+    (line,) = G.threshold_lines({"r": v})
+    assert "k_l (r): the baseline fit failed, nothing ranked" in line

@@ -729,10 +729,7 @@ else:
 # %%
 bpair = gap_study.stored_baseline_pair()
 if bpair is not None:
-    display(pd.DataFrame([{"draw": d["draw"], "run": lab, "first ranked": d[lab]["rank1"],
-                           "ΔBIC": d[lab]["rank1_dBIC"], "median candidate ΔBIC": d[lab]["median_dBIC"],
-                           "baseline objective N": d[lab]["objective_N"], "baseline objective R": d[lab]["objective_R"]}
-                          for d in bpair["draws"] for lab in ("as_run", "pair")]).round(4))
+    display(gap_study.experiment_draws_table(bpair, ("as_run", "pair")).round(4))
     display(Markdown("\n\n".join(gap_study.baseline_pair_lines(bpair))))
 else:
     print("(benchmarks/gap_baseline_pair.py: not run)")
@@ -746,10 +743,7 @@ else:
 # %%
 cbase = gap_study.stored_candidate_baseline()
 if cbase is not None:
-    display(pd.DataFrame([{"draw": d["draw"], "run": lab, "first ranked": d[lab]["rank1"],
-                           "ΔBIC": d[lab]["rank1_dBIC"], "median candidate ΔBIC": d[lab]["median_dBIC"],
-                           "compared": d[lab]["ranked"]}
-                          for d in cbase["draws"] for lab in ("as_run", "one_baseline", "own_baseline")]).round(1))
+    display(gap_study.experiment_draws_table(cbase, ("as_run", "one_baseline", "own_baseline")).round(1))
     display(Markdown("\n\n".join(gap_study.candidate_baseline_lines(cbase))))
 else:
     print("(benchmarks/gap_candidate_baseline.py: not run)")

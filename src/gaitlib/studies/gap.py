@@ -57,7 +57,7 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
            "VALIDATION_RUNS", "stored_validation", "calibration_threshold", "wilson", "TARGET_GROUPS",
            "replicate_table", "replicate_lines", "named_at", "rule_table", "threshold_sweep", "ranking_misses", "threshold_lines",
-           "threshold_draw_lines", "common_mode_table", "common_mode_lines", "stored_baseline_pair", "baseline_pair_lines", "stored_candidate_baseline", "candidate_baseline_lines", "null_tail_table", "null_tail_lines", "stored_paired", "paired_lines", "PAIRED",
+           "threshold_draw_lines", "common_mode_table", "common_mode_lines", "stored_baseline_pair", "baseline_pair_lines", "experiment_draws_table", "stored_candidate_baseline", "candidate_baseline_lines", "null_tail_table", "null_tail_lines", "stored_paired", "paired_lines", "PAIRED",
            "stored_load_confusion", "load_confusion_lines", "LOAD_CONFUSION_FILE", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
            "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines",
            "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines", "consistency_lines", "tie_lines",
@@ -796,7 +796,8 @@ def ranking_misses(reps: dict, bands=("middle", "large")) -> pd.DataFrame:
             out.append({"replicate": lab, "case": x["case"], "expected": x["expected"], "magnitude": x["magnitude"],
                         "rank1": x["rank1"], "rank1_dBIC": x["rank1_dBIC"], "rank2": x["rank2"],
                         "rank2_dBIC": x["rank2_dBIC"], "expected_rank": x["expected_rank"],
-                        "why": "ranked first, runner-up within the margin" if x["rank1"] == x["expected"]
+                        "why": "baseline fit failed: nothing ranked" if x["named"] == "baseline failed"
+                        else "ranked first, runner-up within the margin" if x["rank1"] == x["expected"]
                         else "another effect ranked first"})
     return pd.DataFrame(out)
 
@@ -826,8 +827,10 @@ def threshold_lines(reps: dict, target: float = 90.0) -> list[str]:
             + f". {len(miss)} cases no threshold names right")
     if len(miss):
         line += (" — " + ", ".join(f"{k} of the {e} injections" for e, k in fams.items()) + ": "
-                 + "; ".join(f"{r['case']} ({r['replicate']}): {r['rank1']} {r['rank1_dBIC']:.0f}, {r['rank2']} "
-                             f"{r['rank2_dBIC']:.0f}" for _, r in miss.iterrows())
+                 + "; ".join(f"{r['case']} ({r['replicate']}): " + (
+                     "the baseline fit failed, nothing ranked" if r["why"].startswith("baseline fit failed")
+                     else f"{r['rank1']} {r['rank1_dBIC']:.0f}, {r['rank2']} {r['rank2_dBIC']:.0f}")
+                             for _, r in miss.iterrows())
                  + ". These are the target's ceiling under this ranking: a threshold cannot move it.")
     else:
         line += "."
@@ -1317,6 +1320,22 @@ def _stored_run_experiment(name: str) -> dict | None:
 def stored_baseline_pair() -> dict | None:
     """``benchmarks/gap_baseline_pair.py``'s result (:func:`_stored_run_experiment`)."""
     return _stored_run_experiment("baseline_pair")
+
+
+def experiment_draws_table(r: dict, runs=("as_run", "pair")) -> pd.DataFrame:
+    """A ranking experiment's draws (``gap_baseline_pair.py``, ``gap_candidate_baseline.py``)
+    as a table: per draw and run, the first-ranked effect and ΔBIC, the median candidate's
+    ΔBIC, how many candidates were compared and, where stored, the baseline's objectives."""
+    rows = []
+    for d in r["draws"]:
+        for lab in runs:
+            x = d[lab]
+            rows.append({"draw": d["draw"], "run": lab, "first ranked": x["rank1"] or "— (none ranked)",
+                         "ΔBIC": x["rank1_dBIC"], "median candidate ΔBIC": x["median_dBIC"],
+                         "compared": x.get("ranked"), **({"baseline objective N": x["objective_N"],
+                                                          "baseline objective R": x["objective_R"]}
+                                                         if "objective_N" in x else {})})
+    return pd.DataFrame(rows)
 
 
 def baseline_pair_lines(r: dict, cut: float = -20.0) -> list[str]:
