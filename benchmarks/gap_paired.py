@@ -27,9 +27,10 @@ RESULTS = HERE / "results" / "gap_validation"
 #: name → (the stored validation whose draws are diagnosed again, the fields changed).
 EXPERIMENTS = {
     # revision 6: the quiet points left out, on revision 5's draws
-    "quiet_points_rev5": ("relative_rev5", {"quiet_points": True, "reference_from_candidates": False}),
+    "quiet_points_rev5": ("relative_rev5", {"quiet_points": True, "reference_from_candidates": False,
+                                            "baseline_fallback": False}),
     # revision 7: the baseline's fit of the reference from the candidates', on revision 6's draws
-    "reference_fit_rev6": ("relative_rev6", {"reference_from_candidates": True}),
+    "reference_fit_rev6": ("relative_rev6", {"reference_from_candidates": True, "baseline_fallback": False}),
 }
 
 

@@ -219,7 +219,7 @@ def test_a_null_draw_is_the_reference_plus_its_sampling_error(ref):
 def test_the_relative_method_names_itself_and_the_absolute_one():
     from gaitlib.gap import method as M
 
-    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 7 and M.RELATIVE.tilt_channel and M.RELATIVE.reference_rounds >= 1
+    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 8 and M.RELATIVE.baseline_fallback and M.RELATIVE.tilt_channel and M.RELATIVE.reference_rounds >= 1
     h = M.RELATIVE.hash()
     assert len(h) == 16 and h != M.METHOD.hash()
     assert M.RelativeMethod(null_draws=3).hash() != h and M.RelativeMethod(null_rank=1).hash() != h
@@ -408,3 +408,80 @@ def test_the_baseline_fit_of_the_reference_is_refitted_from_the_candidates_fits(
             D.diagnose(ref, reference=ref, effects=names, base=base, serial=True)
         assert got.value.args[0].tag == want
         assert warm_of_data[0].tag == want  # the data continued from it
+
+
+def test_a_failed_baseline_continuation_falls_back_to_the_candidates_reference_fits(ref, monkeypatch):
+    """fallback_baselines (revision 8): the baseline is solved on the data from each nested,
+    converged candidate fit of the reference, the lowest converged kept and named; a key none
+    of whose starts converges goes to the multistart without the warm start; a key nothing
+    reaches is left out."""
+    fit = lambda n, s: D.Fit(n, s, {}, None, 1, "nlp", s.stats["status"], True)  # noqa: E731
+    ref_fits = {"knee_offset": fit("knee_offset", _Sol(0.9, "k")), "hip_offset": fit("hip_offset", _Sol(0.8, "h")),
+                "ankle_offset": fit("ankle_offset", _Sol(0.7, "a", "Maximum_Iterations_Exceeded"))}
+    solved, multi = [], []
+
+    def fake_solve_many(groups, **kw):
+        ((g, (spec, jobs)),) = groups.items()
+        assert g == "baseline-fallback" and spec.effects == ()
+        solved.extend((key, start.tag) for key, _, start in jobs)
+        obj = {"A|knee_offset": 1.2, "A|hip_offset": 1.1, "B|knee_offset": None, "B|hip_offset": None,
+               "C|knee_offset": None, "C|hip_offset": None}
+        return {key: _Sol(obj[key], key) if obj[key] is not None else _Sol(9.0, key, "Infeasible_Problem_Detected")
+                for key, _, _ in jobs}
+
+    def fake_baseline_fits(spec0, datasets, warm, *, starts, **kw):
+        assert warm is None and "warm" not in starts and set(starts) == set(D.BASELINE_STARTS) - {"warm"}
+        multi.extend(datasets)
+        return {k: (_Sol(1.5, "cold") if k == "B" else None) for k in datasets}
+
+    monkeypatch.setattr(D, "solve_many", fake_solve_many)
+    monkeypatch.setattr(D, "baseline_fits", lambda *a, **k: {
+        k: (lambda s: (s.stats.update(start="coarse"), s)[1])(v) if v is not None else None
+        for k, v in fake_baseline_fits(*a, **k).items()})
+    names = ["knee_offset", "hip_offset", "ankle_offset", "body_mass"]
+    out = D.fallback_baselines(D.base_spec(dict(n_intervals=4, degree=2)), {"A": ref, "B": ref, "C": ref},
+                               {k: ref_fits for k in "ABC"}, names)
+    # the unconverged ankle fit is no start; body_mass (not nested here) has no fit to start from
+    assert sorted(t for _, t in solved) == sorted(["k", "h"] * 3)
+    assert out["A"].tag == "A|hip_offset" and out["A"].stats["start"] == "reference fit of hip_offset"
+    assert out["B"].stats["start"] == "multistart coarse" and sorted(multi) == ["B", "C"]
+    assert "C" not in out
+
+
+def test_the_relative_diagnosis_continues_from_the_fallback_baseline(ref, monkeypatch):
+    """diagnose: a data baseline whose continuation fails is taken from fallback_baselines
+    (baseline_fallback on) and named in the reference's settings; off, the diagnosis stops
+    with BaselineFailed, as up to revision 7."""
+    from gaitlib.gap import method as M
+
+    class Stop(Exception):
+        pass
+
+    def fake_baseline_fits(spec0, datasets, warm, **kw):
+        return {k: {"best": _Sol(1.0, "R0") if k == "reference" else None,
+                    "warm": _Sol(3.0, "x", "Maximum_Iterations_Exceeded")} for k in datasets}
+
+    def fake_fallback(spec0, datasets, ref_fits, names, **kw):
+        assert list(datasets) == ["data"] and ref_fits["data"] is ref_fits_
+        s = _Sol(2.0, "F")
+        s.stats["start"] = "reference fit of hip_offset"
+        return {"data": s}
+
+    def fake_consistent(spec0, ref_, ref_fit, ref_fits, datasets, bases, *a, **kw):
+        raise Stop(bases["data"])
+
+    ref_fits_ = {}
+    monkeypatch.setattr(D, "baseline_fits", fake_baseline_fits)
+    monkeypatch.setattr(D, "candidate_fits", lambda spec0, datasets, *a, **kw: {
+        k: (ref_fits_ if k == "reference" else {}) for k in datasets})
+    monkeypatch.setattr(D, "fallback_baselines", fake_fallback)
+    monkeypatch.setattr(D, "consistent_fits", fake_consistent)
+    monkeypatch.setattr(D.locate, "locate", lambda *a, **k: type("L", (), {"rss": 0.0})())
+    base = dict(n_intervals=4, degree=2)
+    monkeypatch.setattr(D, "RELATIVE", M.RelativeMethod(reference_from_candidates=False))
+    with pytest.raises(Stop) as got:
+        D.diagnose(ref, reference=ref, effects=["hip_offset"], base=base, serial=True)
+    assert got.value.args[0].tag == "F"
+    monkeypatch.setattr(D, "RELATIVE", M.RelativeMethod(reference_from_candidates=False, baseline_fallback=False))
+    with pytest.raises(D.BaselineFailed):
+        D.diagnose(ref, reference=ref, effects=["hip_offset"], base=base, serial=True)

@@ -844,6 +844,11 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
             b = baseline_fits(spec0, {"data": ds}, ref_fit, objective=objective, root=root, use_cache=use_cache,
                               detail=True, starts=("warm",), scheduler=scheduler, **kw)
             base_sol = b["data"]["best"]
+            if base_sol is None and RELATIVE.baseline_fallback:  # the continuation failed
+                fb = fallback_baselines(spec0, {"data": ds}, {"data": ref_fits}, names, objective=objective,
+                                        root=root, use_cache=use_cache, scheduler=scheduler, **kw)
+                base_sol = fb.get("data")
+                ref_info["baseline_fallback"] = base_sol.stats["start"] if base_sol is not None else "failed"
             if base_sol is None:
                 raise BaselineFailed({st: s.stats["status"] for st, s in b["data"].items()
                                       if st != "best" and s is not None})
@@ -916,6 +921,12 @@ def null_calibration(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, names, n:
     draws = {f"null{j}": gref.null_draw(ref, n, sd) for j, sd in enumerate(seeds)}
     kw = dict(objective=objective, root=root, use_cache=use_cache, **sweep_kw)
     bases = baseline_fits(spec0, draws, ref_fit, starts=("warm",), **kw)
+    failed = {k: draws[k] for k in draws if bases[k] is None}
+    fallback = {}
+    if failed and method.baseline_fallback:  # as the data's (diagnose)
+        fb = fallback_baselines(spec0, failed, {k: ref_fits for k in failed}, names, **kw)
+        bases.update(fb)
+        fallback = {k: s.stats["start"] for k, s in fb.items()}
     ok = {k: v for k, v in draws.items() if bases[k] is not None}
     nf = candidate_fits(spec0, ok, bases, names, warms={k: warms["data"] for k in ok}, **kw) if ok else {}
     cons = consistent_fits(spec0, ref, ref_fit, ref_fits, ok, bases, nf, names, method=method, **kw) if ok else {}
@@ -940,6 +951,7 @@ def null_calibration(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, names, n:
             "lowest_dBIC": min(vals) if vals else None, "rank": method.null_rank,
             "threshold_dBIC": null_threshold(per, method.null_rank),
             "baseline_failed": [b["draw"] for b in best if b["effect"] == "baseline failed"],
+            "baseline_fallback": fallback,
             "moved": {k: c["moved"] for k, c in cons.items()}}
 
 
@@ -980,6 +992,40 @@ def baseline_from_candidates(spec0, gaits: dict, bases: dict, fits: dict, names,
         best = pick_best(list(tried.values()))
         if _better(best, bases.get(k), margin):
             out[k] = (best, next(n for n, s in tried.items() if s is best))
+    return out
+
+
+def fallback_baselines(spec0, datasets: dict, ref_fits: dict, names, **kw) -> dict:
+    """The baseline's fit of data sets whose continuation from the reference's fit did not
+    converge (:class:`gaitlib.gap.method.RelativeMethod` ``baseline_fallback``): for each key
+    of ``datasets`` (key → DataSet, with ``ref_fits[key]``, name → :class:`Fit`, the
+    candidates' fits of the reference) the baseline is solved on the data from every nested
+    candidate's converged fit of the reference (:func:`_nested`: starts in the reference's
+    basin, as the continuation was) and the lowest converged kept; where none converges, from
+    the absolute multistart's starts (:data:`BASELINE_STARTS` but ``warm``). Returns key →
+    solution for the keys a fallback reached, ``stats["start"]`` naming it (``"reference
+    fit of <candidate>"`` or ``"multistart <start>"``); keys with no converged fallback are
+    left out."""
+    nlp = _nlp_names(names)
+    jobs = [(f"{k}|{n}", ds.gait, ref_fits[k][n].solution) for k, ds in datasets.items() for n in nlp
+            if _nested(effects_mod.EFFECTS[n]) and (ref_fits.get(k) or {}).get(n) is not None
+            and ref_fits[k][n].solution is not None and _status(ref_fits[k][n].solution)[1]]
+    res = solve_many({"baseline-fallback": (spec0, jobs)}, **kw) if jobs else {}
+    out, left = {}, {}
+    for k, ds in datasets.items():
+        tried = {n: res[f"{k}|{n}"] for n in nlp if res.get(f"{k}|{n}") is not None}
+        best = pick_best(list(tried.values()))
+        if best is None:
+            left[k] = ds
+            continue
+        best.stats["start"] = "reference fit of " + next(n for n, s in tried.items() if s is best)
+        out[k] = best
+    if left:
+        multi = baseline_fits(spec0, left, None, starts=tuple(s for s in BASELINE_STARTS if s != "warm"), **kw)
+        for k, s in multi.items():
+            if s is not None:
+                s.stats["start"] = "multistart " + s.stats["start"]
+                out[k] = s
     return out
 
 

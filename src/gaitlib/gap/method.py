@@ -137,12 +137,19 @@ class RelativeMethod:
         threshold moved from −206 to −101 and the independent middle+large injections named
         from 17 to 24 of 24, out-of-library and null unchanged (16/16, 4/4); on its own fresh
         draws: threshold −60 (still three common-mode draws), 20 of 24, 16/16, 3/4.
+    baseline_fallback : where the baseline's continuation from the reference's fit does not
+        converge on the data (or on a null draw), the baseline is solved from each nested
+        candidate's fit of the reference, and where none of those converges from the absolute
+        multistart's starts (:func:`gaitlib.gap.diagnose.fallback_baselines`). Up to revision
+        7 such a case had no baseline and nothing was ranked (revision 7's fresh draws: the
+        large knee offset ``knee_offset_large_1``, IPOPT at its iteration limit).
     revision : bumped when the relative diagnosis decides differently for a reason outside
         these fields. 1: the null calibration; 2: the self-consistent reference fit; 3: the
         HAT tilt located; 4: the baseline from the candidates' fits; 5: the threshold the
         second lowest of 19 null draws (``null_rank``) instead of the lowest of 9; 6: the quiet
         points left out (``quiet_points``); 7: the baseline's fit of the reference from the
-        candidates' (``reference_from_candidates``).
+        candidates' (``reference_from_candidates``); 8: a fallback for a failed baseline
+        continuation (``baseline_fallback``).
     """
 
     null_draws: int = 19
@@ -153,7 +160,8 @@ class RelativeMethod:
     baseline_from_candidates: bool = True
     quiet_points: bool = True
     reference_from_candidates: bool = True
-    revision: int = 7
+    baseline_fallback: bool = True
+    revision: int = 8
 
     def to_dict(self) -> dict:
         return json.loads(json.dumps(asdict(self)))

@@ -453,6 +453,8 @@ def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_clas
                     s["reference_moved"] = sorted(m for m, x in mv.items() if "reference" in x)
                     # the baseline's data fit from a candidate's (RELATIVE.baseline_from_candidates)
                     s["baseline_from"] = (mv.get("baseline") or {}).get("data_from")
+                    # the baseline's continuation failed: where it was solved from (RELATIVE.baseline_fallback)
+                    s["baseline_fallback"] = d.settings["reference"].get("baseline_fallback")
                     # on relative data the whole baseline RSS is the change (+ sampling error),
                     # as % of the reference's own gap; unrefit: at the reference's fit
                     added, gap0 = s["rss_baseline"], d.settings["reference"]["rss_reference"]
