@@ -28,9 +28,13 @@ RESULTS = HERE / "results" / "gap_validation"
 EXPERIMENTS = {
     # revision 6: the quiet points left out, on revision 5's draws
     "quiet_points_rev5": ("relative_rev5", {"quiet_points": True, "reference_from_candidates": False,
-                                            "baseline_fallback": False}),
+                                            "baseline_fallback": False, "lowest_pair": False}),
     # revision 7: the baseline's fit of the reference from the candidates', on revision 6's draws
-    "reference_fit_rev6": ("relative_rev6", {"reference_from_candidates": True, "baseline_fallback": False}),
+    "reference_fit_rev6": ("relative_rev6", {"reference_from_candidates": True, "baseline_fallback": False,
+                                            "lowest_pair": False}),
+    # revision 8: the fallback baseline and the lower of two located pairs, on revision 7's draws
+    "lowest_pair_rev7": ("relative_rev7", {"baseline_fallback": True, "lowest_pair": True}),
+    "fallback_rev7": ("relative_rev7", {"baseline_fallback": True, "lowest_pair": False}),
 }
 
 

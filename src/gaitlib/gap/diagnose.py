@@ -85,6 +85,7 @@ __all__ = ["BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "Fit", "Diagnosis", 
            "COARSE_MESH", "GRF_SD_FACTOR", "RETRY_MARGIN", "grf_weighted", "candidate_fits", "needs_retry",
            "alternates_of", "lowest_objective", "BaselineFailed", "nesting", "ABOVE_LOCATED", "FIT_STARTS",
            "with_effects", "contenders_of", "relative_fits", "consistent_fits",
+           "continuation_pairs", "lowest_baseline_pair", "fallback_baselines",
            "null_calibration", "calibration_dBIC"]
 
 
@@ -142,6 +143,9 @@ class Fit:
     start: str = "baseline"  # where the kept fit started (:data:`FIT_STARTS`)
     search: str = "ok"  # "ok" or "failed search" (:func:`candidate_fits`)
     reference_thetas: dict = field(default_factory=dict)  # its fit of a reference (:func:`relative_fits`)
+    # relative: the first solve from its fit of the reference (``warms``), kept when another start won
+    continuation: object | None = None
+    pair: str = "final"  # relative: which (reference fit, data fit) pair is located (:func:`relative_fits`)
 
 
 def _status(sol) -> tuple[str, bool]:
@@ -367,7 +371,7 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
         row = {"effect": name, "title": e.title, "n_params": f.n_params, "identify": f.identify,
                "parameters": th, "parameters_reference": th_r,
                "parameter_change": {k: float(v) - float(th_r[k]) for k, v in th.items() if k in th_r},
-               "status": f.status, "ok": f.ok, "start": f.start,
+               "status": f.status, "ok": f.ok, "start": f.start, "pair": f.pair,
                "nests_baseline": nests, "search": f.search, "rss_before": loc0.rss, "rss_after": np.nan,
                "pct_closed": np.nan, "dAIC": np.nan, "dBIC": np.nan, "residual_ratio": np.nan}
         if f.located is not None and f.located.residuals is not None:
@@ -480,8 +484,11 @@ GRF_SD_FACTOR = 0.1
 #: from that start (the retry); ``"null"`` the null start (:mod:`gaitlib.gap.nullstart`);
 #: ``"baseline (no re-solve)"`` comparison-only effects; in a relative diagnosis
 #: (:func:`consistent_fits`) ``"data"`` a fit of the reference re-solved from the model's fit
-#: of the data, ``"reference (consistent)"`` a fit of the data continued again from it.
-FIT_STARTS = ("baseline", *BASELINE_STARTS, "null", "baseline (no re-solve)", "data", "reference (consistent)")
+#: of the data, ``"reference (consistent)"`` a fit of the data continued again from it,
+#: ``"reference"`` the data's first fit, continued from the model's first fit of the reference
+#: (the continuation pair, :func:`relative_fits` ``alternates``).
+FIT_STARTS = ("baseline", *BASELINE_STARTS, "null", "baseline (no re-solve)", "data", "reference (consistent)",
+              "reference")
 #: A nested candidate (its null parameters are the baseline model) whose fit ends with an
 #: objective above the baseline fit's by more than this relative margin has stopped in a
 #: worse local optimum; :func:`candidate_fits` then re-solves it from the baseline's other
@@ -684,6 +691,8 @@ def candidate_fits(spec0, datasets: dict, bases: dict, names, *, objective="fit"
                     start = "baseline" if key == "best" else key
                 fits[n] = _nlp_fit(n, sol, ds, error=n in recs and bool(recs[n].error))
                 fits[n].start = start
+                if ((warms or {}).get(k) or {}).get(n) is not None:
+                    fits[n].continuation = t["best"]
                 if _nested(e) and bases[k] is not None and needs_retry(n, sol, bases[k]):
                     fits[n].search = "failed search"
             else:
@@ -855,6 +864,7 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
             warms = {"data": {n: f.solution for n, f in ref_fits.items() if f.solution is not None}}
             all_fits = candidate_fits(spec0, {"data": ds}, {"data": base_sol}, names, objective=objective, root=root,
                                       use_cache=use_cache, warms=warms, scheduler=scheduler, **kw)
+            base_cont, fits_cont = base_sol, all_fits["data"]  # the continuations, before the rounds
             # the self-consistent reference fit (RELATIVE.reference_rounds): each model's
             # reference fit re-solved from its data fit, the lower kept, the data continued again
             cons = consistent_fits(spec0, ref, ref_fit, ref_fits, {"data": ds}, {"data": base_sol}, all_fits, names,
@@ -880,8 +890,14 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
     fits = all_fits["data"]
     threshold = None
     if ref is not None:
+        alternates = None
+        if RELATIVE.lowest_pair:  # each model's located pair: the final or the continuation, the lower
+            pair, ref_fit, base_sol = lowest_baseline_pair(ds, ref, [("final", ref_fit, base_sol),
+                                                                     ("continuation", ref_fit_start, base_cont)])
+            ref_info["baseline_pair"] = pair
+            alternates = continuation_pairs(ref_fits, fits_cont)
         ds = gref.relative_data(ds, ref, ref_fit)  # the same data and fits; the gap located relative to R
-        fits = relative_fits(fits, all_fits["reference"], ds, ref, base_sol)
+        fits = relative_fits(fits, all_fits["reference"], ds, ref, base_sol, alternates)
         ref_info["relative_method"] = RELATIVE.to_dict()
         ref_info["relative_method_hash"] = RELATIVE.hash()
         ref_info["null_calibration"] = calib
@@ -937,8 +953,12 @@ def null_calibration(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, names, n:
             per.append({})
             continue
         c = cons[k]
-        rel = gref.relative_data(dk, ref, c["ref_fit"])
-        d = assemble(rel, spec0, c["base"], relative_fits(c["fits"], c["ref_fits"], rel, ref, c["base"]),
+        rf, base, alt = c["ref_fit"], c["base"], None
+        if method.lowest_pair:  # as the data's (diagnose)
+            _, rf, base = lowest_baseline_pair(dk, ref, [("final", rf, base), ("continuation", ref_fit, bases[k])])
+            alt = continuation_pairs(ref_fits, nf[k])
+        rel = gref.relative_data(dk, ref, rf)
+        d = assemble(rel, spec0, base, relative_fits(c["fits"], c["ref_fits"], rel, ref, base, alt),
                      objective=objective, resamples=0)
         r = d.ranking[d.ranking["ok"].astype(bool) & np.isfinite(d.ranking["dBIC"].astype(float))]
         per.append({str(e): float(v) for e, v in zip(r["effect"], r["dBIC"])})
@@ -1120,7 +1140,8 @@ def consistent_fits(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, datasets: 
     return out
 
 
-def relative_fits(fits: dict, ref_fits: dict, ds: gio.DataSet, ref: gio.DataSet, base_sol) -> dict:
+def relative_fits(fits: dict, ref_fits: dict, ds: gio.DataSet, ref: gio.DataSet, base_sol,
+                  alternates: dict | None = None) -> dict:
     """The candidates' fits of the data located relative to the reference, each against its
     *own* fit of the reference (:mod:`gaitlib.gap.reference`): candidate k's located gap is
     [F_k(N) − N_k] − [F_k(R) − R_k] (N_k, R_k: the data as k reads them at its parameters on
@@ -1129,7 +1150,11 @@ def relative_fits(fits: dict, ref_fits: dict, ds: gio.DataSet, ref: gio.DataSet,
     A candidate without a fit of the reference is not located (``located=None``, not ranked).
     ``Fit.reference_thetas``: the candidate's parameters on the reference, so the ranking's
     ``parameter_change`` is the change the candidate identifies between R and N.
-    Comparison-only effects are searched again on the relative data (on ``base_sol``)."""
+    Comparison-only effects are searched again on the relative data (on ``base_sol``).
+    ``alternates`` (name → [(label, its fit of the reference (:class:`Fit`), a converged fit
+    of the data)]; :func:`continuation_pairs`): other pairs of the candidate's fits, each
+    located the same way; the pair with the lowest RSS is kept (``Fit.pair`` names it;
+    :class:`gaitlib.gap.method.RelativeMethod` ``lowest_pair``)."""
     import dataclasses
 
     out = {}
@@ -1151,8 +1176,47 @@ def relative_fits(fits: dict, ref_fits: dict, ds: gio.DataSet, ref: gio.DataSet,
         if not fr.ok:
             f.ok = False
             f.status = f"{f.status}; reference fit {fr.status}"
+        for label, ar, asol in (alternates or {}).get(n, ()):
+            if f.located is None or not (f.ok and ar.ok):
+                break
+            th = asol.stats.get("effects", {})
+            loc = locate.locate(asol, dataclasses.replace(ds, background=gref.background(ref, ar.solution, ar.thetas)),
+                                thetas=th)
+            if loc.rss < f.located.rss:
+                f = dataclasses.replace(f, solution=asol, thetas=th, located=loc, reference_thetas=ar.thetas,
+                                        pair=label, start="reference")
         out[n] = f
     return out
+
+
+def continuation_pairs(ref_fits: dict, fits: dict) -> dict:
+    """The continuation pair of every NLP candidate of a relative diagnosis, for
+    :func:`relative_fits` ``alternates``: its first fit of the reference (``ref_fits``,
+    before the self-consistency rounds) and the data's fit continued from it
+    (``Fit.continuation`` of ``fits``, the data's fits before the rounds) — where that fit
+    converged and is not the one kept anyway. name → [("continuation", Fit, solution)]."""
+    out = {}
+    for n, f in fits.items():
+        c, fr = f.continuation, ref_fits.get(n)
+        if c is None or fr is None or fr.solution is None or c is f.solution or not _status(c)[1]:
+            continue
+        out[n] = [("continuation", fr, c)]
+    return out
+
+
+def lowest_baseline_pair(ds: gio.DataSet, ref: gio.DataSet, pairs: list) -> tuple:
+    """Of the baseline's (label, fit of the reference, fit of the data) ``pairs`` (the first
+    the final pair), the one whose gap located relative to the reference
+    (:func:`gaitlib.gap.reference.relative_data`) has the lowest RSS; pairs with a missing
+    or non-converged fit are skipped. Returns (label, reference fit, data fit)."""
+    best = None
+    for label, rf, bs in pairs:
+        if rf is None or bs is None or not (_status(bs)[1] and _status(rf)[1]):
+            continue
+        rss = locate.locate(bs, gref.relative_data(ds, ref, rf)).rss
+        if best is None or rss < best[0]:
+            best = (rss, label, rf, bs)
+    return best[1:]
 
 
 # ``gaitlib.gap.diagnose(...)`` calls :func:`diagnose` even after this submodule was imported

@@ -143,13 +143,25 @@ class RelativeMethod:
         multistart's starts (:func:`gaitlib.gap.diagnose.fallback_baselines`). Up to revision
         7 such a case had no baseline and nothing was ranked (revision 7's fresh draws: the
         large knee offset ``knee_offset_large_1``, IPOPT at its iteration limit).
+    lowest_pair : each model's gap relative to the reference is located for two pairs of its
+        fits — the final one (after the self-consistency rounds and the other starts) and the
+        continuation (its first fit of the reference and the data's fit continued from it) —
+        and the pair with the lower RSS kept, for the baseline and every NLP candidate alike
+        (:func:`gaitlib.gap.diagnose.relative_fits`, :func:`~gaitlib.gap.diagnose.
+        lowest_baseline_pair`); the null draws the same way. A pair whose two fits sit in
+        different optima carries that difference as a change: in revision 7's
+        ``ankle_offset_middle_1`` the ankle offset's kept fit of the data came from the null
+        start (its continuation ended above the baseline's fit), identified the injected
+        −2.7° as −3.0°, and closed the ankle channels (16.6 → 1.7) but opened the right
+        anterior GRF (0.9 → 18.0): 6 % of the gap closed; its continuation pair closes 56 %.
     revision : bumped when the relative diagnosis decides differently for a reason outside
         these fields. 1: the null calibration; 2: the self-consistent reference fit; 3: the
         HAT tilt located; 4: the baseline from the candidates' fits; 5: the threshold the
         second lowest of 19 null draws (``null_rank``) instead of the lowest of 9; 6: the quiet
         points left out (``quiet_points``); 7: the baseline's fit of the reference from the
         candidates' (``reference_from_candidates``); 8: a fallback for a failed baseline
-        continuation (``baseline_fallback``).
+        continuation (``baseline_fallback``) and the lower of two located pairs
+        (``lowest_pair``).
     """
 
     null_draws: int = 19
@@ -161,6 +173,7 @@ class RelativeMethod:
     quiet_points: bool = True
     reference_from_candidates: bool = True
     baseline_fallback: bool = True
+    lowest_pair: bool = True
     revision: int = 8
 
     def to_dict(self) -> dict:

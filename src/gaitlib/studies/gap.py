@@ -395,7 +395,7 @@ def stored_validation(name: str = "real") -> gval.Validation:
 #: folder under ``gap_validation`` → the method revision that made it.
 SUPERSEDED_VALIDATIONS = {"real_rev1": 1, "relative_rev0": 0, "relative_rev1": 1, "relative_rev2": 2,
                           "relative_rev3": 3, "relative_rev4": 4, "relative_rev4_r1": 4, "relative_rev5": 5,
-                          "relative_rev6": 6, "relative_rev6_r1": 6}
+                          "relative_rev6": 6, "relative_rev6_r1": 6, "relative_rev7": 7}
 
 
 def superseded_validation(name: str = "real_rev1") -> gval.Validation:
