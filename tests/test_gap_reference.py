@@ -219,7 +219,7 @@ def test_a_null_draw_is_the_reference_plus_its_sampling_error(ref):
 def test_the_relative_method_names_itself_and_the_absolute_one():
     from gaitlib.gap import method as M
 
-    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 8 and M.RELATIVE.baseline_fallback and M.RELATIVE.tilt_channel and M.RELATIVE.reference_rounds >= 1
+    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 8 and M.RELATIVE.baseline_fallback and M.RELATIVE.lowest_pair and M.RELATIVE.tilt_channel and M.RELATIVE.reference_rounds >= 1
     h = M.RELATIVE.hash()
     assert len(h) == 16 and h != M.METHOD.hash()
     assert M.RelativeMethod(null_draws=3).hash() != h and M.RelativeMethod(null_rank=1).hash() != h
@@ -485,3 +485,57 @@ def test_the_relative_diagnosis_continues_from_the_fallback_baseline(ref, monkey
     monkeypatch.setattr(D, "RELATIVE", M.RelativeMethod(reference_from_candidates=False, baseline_fallback=False))
     with pytest.raises(D.BaselineFailed):
         D.diagnose(ref, reference=ref, effects=["hip_offset"], base=base, serial=True)
+
+
+def test_the_lower_of_the_final_and_the_continuation_pair_is_located(ref, monkeypatch):
+    """lowest_pair (revision 8): relative_fits locates each candidate's continuation pair
+    beside its final one and keeps the lower RSS, with that pair's fits and reference
+    parameters; continuation_pairs offers only converged continuations that are not the kept
+    fit; lowest_baseline_pair does the same for the baseline."""
+    rss = {("Rk", "Nk"): 5.0, ("Rk0", "Nk0"): 2.0, ("Rh", "Nh"): 1.0, ("Rh0", "Nh0"): 3.0,
+           ("R0", "N0"): 4.0, ("R00", "N00"): 6.0}
+    monkeypatch.setattr(D.gref, "background", lambda ref_, sol, thetas=None, tilt=None: sol.tag)
+    monkeypatch.setattr(D.locate, "locate", lambda sol, ds, thetas=None: type(
+        "L", (), {"rss": rss[(ds.background, sol.tag)]})())
+    monkeypatch.setattr(D.gref, "relative_data", lambda ds, ref_, rf, tilt=None: dataclasses.replace(
+        ds, background=rf.tag))
+
+    def fit(n, tag, th, cont=None, status="Solve_Succeeded"):
+        s = _Sol(1.0, tag, status)
+        s.stats["effects"] = {n: {"c": th}}
+        f = D.Fit(n, s, {n: {"c": th}}, None, 1, "nlp", status, True)
+        f.continuation = cont
+        return f
+
+    def sol(tag, n, th, status="Solve_Succeeded"):
+        s = _Sol(1.0, tag, status)
+        s.stats["effects"] = {n: {"c": th}}
+        return s
+
+    ref_first = {"knee_offset": fit("knee_offset", "Rk0", 0.1), "hip_offset": fit("hip_offset", "Rh0", 0.2),
+                 "ankle_offset": fit("ankle_offset", "Ra0", 0.3)}
+    kept_hip = sol("Nh", "hip_offset", 0.25)
+    data_first = {"knee_offset": fit("knee_offset", "Nk", 0.5, cont=sol("Nk0", "knee_offset", 0.4)),
+                  "hip_offset": fit("hip_offset", "Nh", 0.25, cont=sol("Nh0", "hip_offset", 0.3)),
+                  "ankle_offset": fit("ankle_offset", "Na", 0.3, cont=sol("Na0", "ankle_offset", 0.3,
+                                                                          "Maximum_Iterations_Exceeded"))}
+    alt = D.continuation_pairs(ref_first, data_first)
+    assert sorted(alt) == ["hip_offset", "knee_offset"]  # the ankle's continuation did not converge
+    data_first["knee_offset"].continuation = data_first["knee_offset"].solution
+    assert "knee_offset" not in D.continuation_pairs(ref_first, data_first)  # the kept fit itself
+    final_ref = {"knee_offset": fit("knee_offset", "Rk", 0.45), "hip_offset": fit("hip_offset", "Rh", 0.2)}
+    final = {"knee_offset": fit("knee_offset", "Nk", 0.5), "hip_offset": D.Fit("hip_offset", kept_hip,
+                                                                              kept_hip.stats["effects"], None, 1,
+                                                                              "nlp", "Solve_Succeeded", True)}
+    out = D.relative_fits(final, final_ref, ref, ref, None, alt)
+    k, h = out["knee_offset"], out["hip_offset"]
+    assert (k.pair, k.start, k.located.rss, k.solution.tag) == ("continuation", "reference", 2.0, "Nk0")
+    assert k.reference_thetas == {"knee_offset": {"c": 0.1}} and k.thetas == {"knee_offset": {"c": 0.4}}
+    assert (h.pair, h.located.rss, h.solution.tag) == ("final", 1.0, "Nh")
+    # the baseline: the lower pair, a non-converged data fit skipped
+    pairs = [("final", _Sol(1, "R0"), _Sol(1, "N0")), ("continuation", _Sol(1, "R00"), _Sol(1, "N00"))]
+    assert D.lowest_baseline_pair(ref, ref, pairs)[0] == "final"
+    rss[("R00", "N00")] = 3.0
+    assert D.lowest_baseline_pair(ref, ref, pairs)[0] == "continuation"
+    pairs[1] = ("continuation", _Sol(1, "R00"), _Sol(1, "N00", "Infeasible_Problem_Detected"))
+    assert D.lowest_baseline_pair(ref, ref, pairs)[0] == "final"
