@@ -539,3 +539,48 @@ def test_the_lower_of_the_final_and_the_continuation_pair_is_located(ref, monkey
     assert D.lowest_baseline_pair(ref, ref, pairs)[0] == "continuation"
     pairs[1] = ("continuation", _Sol(1, "R00"), _Sol(1, "N00", "Infeasible_Problem_Detected"))
     assert D.lowest_baseline_pair(ref, ref, pairs)[0] == "final"
+
+
+def test_the_null_draws_are_located_on_the_lower_pair_as_the_data_are(ref, monkeypatch):
+    """null_calibration with lowest_pair: each draw's baseline pair is chosen between its
+    final fits and its continuation (the reference's start fit, the draw's first baseline
+    fit), the candidates get their continuation pairs, and the choice is recorded; off, the
+    final fits are located, as up to revision 7."""
+    from gaitlib.gap import method as M
+
+    seen = {}
+    monkeypatch.setattr(D.gref, "null_draw", lambda ref_, n, seed: ref_)
+    monkeypatch.setattr(D, "baseline_fits", lambda spec0, draws, warm, **kw: {k: _Sol(2.0, f"N0-{k}") for k in draws})
+    monkeypatch.setattr(D, "candidate_fits", lambda spec0, ok, bases, names, **kw: {k: {"first": k} for k in ok})
+    monkeypatch.setattr(D, "consistent_fits", lambda spec0, ref_, rf, rfs, ok, bases, nf, names, **kw: {
+        k: {"ref_fit": _Sol(1.0, "Rfinal"), "ref_fits": {}, "base": _Sol(1.9, "Nfinal"), "fits": {}, "moved": {}}
+        for k in ok})
+
+    def fake_lowest(dk, ref_, pairs):
+        seen.setdefault("pairs", []).append([(lab, r.tag, n.tag) for lab, r, n in pairs])
+        return ("continuation", *pairs[1][1:])
+
+    monkeypatch.setattr(D, "lowest_baseline_pair", fake_lowest)
+    monkeypatch.setattr(D, "continuation_pairs", lambda rfs, nf: {"alt": nf["first"]})
+    monkeypatch.setattr(D.gref, "relative_data", lambda dk, ref_, rf, tilt=None: rf.tag)
+
+    def fake_relative_fits(fits, ref_fits, rel, ref_, base, alt=None):
+        seen.setdefault("located", []).append((rel, base.tag, alt))
+        return {}
+
+    monkeypatch.setattr(D, "relative_fits", fake_relative_fits)
+    ranking = pd.DataFrame({"effect": ["knee_offset"], "dBIC": [-30.0], "ok": [True], "pair": ["continuation"]})
+    monkeypatch.setattr(D, "assemble", lambda *a, **k: type("Dg", (), {"ranking": ranking})())
+    kw = dict(objective="fit", root=None, use_cache=False)
+    out = D.null_calibration(D.base_spec(dict(n_intervals=4, degree=2)), ref, _Sol(1.0, "Rstart"), {}, ["knee_offset"], 10, {"data": {}},
+                             method=M.RelativeMethod(null_draws=2), **kw)
+    assert seen["pairs"] == [[("final", "Rfinal", "Nfinal"), ("continuation", "Rstart", f"N0-null{j}")]
+                             for j in range(2)]
+    assert seen["located"] == [("Rstart", f"N0-null{j}", {"alt": f"null{j}"}) for j in range(2)]
+    assert out["baseline_pair"] == {"null0": "continuation", "null1": "continuation"}
+    assert [b["pair"] for b in out["best"]] == ["continuation", "continuation"]
+    seen.clear()
+    out = D.null_calibration(D.base_spec(dict(n_intervals=4, degree=2)), ref, _Sol(1.0, "Rstart"), {}, ["knee_offset"], 10, {"data": {}},
+                             method=M.RelativeMethod(null_draws=2, lowest_pair=False), **kw)
+    assert "pairs" not in seen and seen["located"] == [("Rfinal", "Nfinal", None)] * 2
+    assert out["baseline_pair"] == {}

@@ -8,6 +8,7 @@ import dataclasses
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from gaitlib import conventions as cv
@@ -799,3 +800,24 @@ def test_a_failed_baseline_is_named_so_among_the_ranking_misses():
     assert list(m["case"]) == ["k_l"] and m.iloc[0]["why"] == "baseline fit failed: nothing ranked"
     (line,) = G.threshold_lines({"r": v})
     assert "k_l (r): the baseline fit failed, nothing ranked" in line
+
+
+def test_pair_counts_reads_the_located_pairs_of_cases_and_null_draws():
+    """studies.gap.pair_counts: per set, the cases whose baseline / first-ranked candidate
+    were located on the continuation pair; the calibration's draws alike; NaN where a
+    validation did not record them."""
+    from gaitlib.gap.validate import Validation
+    from gaitlib.studies import gap as gs
+
+    rows = pd.DataFrame({"set": ["independent", "independent", "independent", "null"],
+                         "baseline_pair": ["final", "continuation", "continuation", "final"],
+                         "rank1_pair": ["continuation", "final", None, "continuation"]})
+    calib = {"best": [{"draw": "null0", "pair": "continuation"}, {"draw": "null1", "pair": "final"},
+                      {"draw": "null2", "effect": "baseline failed"}],
+             "baseline_pair": {"null0": "final", "null1": "continuation"}}
+    t = gs.pair_counts(Validation(rows, {"null_calibration": calib}, {}))
+    assert t.loc["independent"].tolist() == [3, 2, 1]
+    assert t.loc["null"].tolist() == [1, 0, 1]
+    assert t.loc["null calibration draws"].tolist() == [3, 1, 1]
+    old = gs.pair_counts(Validation(rows[["set"]], {}, {}))
+    assert old["baseline on the continuation pair"].isna().all() and "null calibration draws" not in old.index

@@ -928,10 +928,12 @@ def null_calibration(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, names, n:
     each draw fitted and located relative to the reference exactly as the data are (the
     baseline from the reference's fit, each candidate from its own fit of the reference),
     and every ranked candidate's ΔBIC kept. Returns ``{"draws", "seeds", "n_subjects",
-    "best" (per draw: its first-ranked effect and ΔBIC, or its failure), "dBIC" (per draw:
+    "best" (per draw: its first-ranked effect, ΔBIC and located pair, or its failure), "dBIC" (per draw:
     effect → ΔBIC), "lowest_dBIC" (over draws and candidates; None if no draw was ranked),
     "rank" and "threshold_dBIC" (:func:`gaitlib.gap.method.null_threshold`),
-    "baseline_failed" (draws none of whose baseline fits converged)}``."""
+    "baseline_failed" (draws none of whose baseline fits converged), "baseline_fallback" (draw →
+    the fallback start of a failed continuation) and "baseline_pair" (draw → the baseline's
+    located pair, ``method.lowest_pair``)}``."""
     method = method or RELATIVE
     seeds = [gref.null_seed(ref, j, method.hash()) for j in range(method.null_draws)]
     draws = {f"null{j}": gref.null_draw(ref, n, sd) for j, sd in enumerate(seeds)}
@@ -946,7 +948,7 @@ def null_calibration(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, names, n:
     ok = {k: v for k, v in draws.items() if bases[k] is not None}
     nf = candidate_fits(spec0, ok, bases, names, warms={k: warms["data"] for k in ok}, **kw) if ok else {}
     cons = consistent_fits(spec0, ref, ref_fit, ref_fits, ok, bases, nf, names, method=method, **kw) if ok else {}
-    best, per = [], []
+    best, per, pairs = [], [], {}
     for k, dk in draws.items():
         if bases[k] is None:
             best.append({"draw": k, "effect": "baseline failed", "dBIC": None})
@@ -955,7 +957,8 @@ def null_calibration(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, names, n:
         c = cons[k]
         rf, base, alt = c["ref_fit"], c["base"], None
         if method.lowest_pair:  # as the data's (diagnose)
-            _, rf, base = lowest_baseline_pair(dk, ref, [("final", rf, base), ("continuation", ref_fit, bases[k])])
+            pairs[k], rf, base = lowest_baseline_pair(dk, ref, [("final", rf, base),
+                                                                ("continuation", ref_fit, bases[k])])
             alt = continuation_pairs(ref_fits, nf[k])
         rel = gref.relative_data(dk, ref, rf)
         d = assemble(rel, spec0, base, relative_fits(c["fits"], c["ref_fits"], rel, ref, base, alt),
@@ -963,7 +966,8 @@ def null_calibration(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, names, n:
         r = d.ranking[d.ranking["ok"].astype(bool) & np.isfinite(d.ranking["dBIC"].astype(float))]
         per.append({str(e): float(v) for e, v in zip(r["effect"], r["dBIC"])})
         best.append({"draw": k, "effect": str(r.iloc[0]["effect"]) if len(r) else None,
-                     "dBIC": float(r.iloc[0]["dBIC"]) if len(r) else None})
+                     "dBIC": float(r.iloc[0]["dBIC"]) if len(r) else None,
+                     "pair": str(r.iloc[0]["pair"]) if len(r) else None})
     vals = [v for p in per for v in p.values()]
     return {"relative_method_hash": method.hash(), "reference_signature": ref.signature, "spec": spec0.to_dict(),
             "candidates": list(names), "draws": method.null_draws, "seeds": seeds, "n_subjects": n, "best": best,
@@ -972,6 +976,7 @@ def null_calibration(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, names, n:
             "threshold_dBIC": null_threshold(per, method.null_rank),
             "baseline_failed": [b["draw"] for b in best if b["effect"] == "baseline failed"],
             "baseline_fallback": fallback,
+            "baseline_pair": pairs,  # RELATIVE.lowest_pair: per draw, the baseline's located pair
             "moved": {k: c["moved"] for k, c in cons.items()}}
 
 

@@ -354,6 +354,7 @@ def _top2(d: diagnose.Diagnosis) -> dict:
             out[f"rank{i + 1}_pct"] = float(r.iloc[i]["pct_closed"])
             if "parameter_change" in r.columns and r.iloc[i]["parameter_change"]:  # relative: its change
                 out[f"rank{i + 1}_change"] = dict(r.iloc[i]["parameter_change"])
+                out[f"rank{i + 1}_pair"] = str(r.iloc[i].get("pair", "final"))  # relative: its located pair
         else:
             out[f"rank{i + 1}"], out[f"rank{i + 1}_dBIC"], out[f"rank{i + 1}_pct"] = None, np.nan, np.nan
     return out
@@ -455,6 +456,7 @@ def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_clas
                     s["baseline_from"] = (mv.get("baseline") or {}).get("data_from")
                     # the baseline's continuation failed: where it was solved from (RELATIVE.baseline_fallback)
                     s["baseline_fallback"] = d.settings["reference"].get("baseline_fallback")
+                    s["baseline_pair"] = d.settings["reference"].get("baseline_pair")  # RELATIVE.lowest_pair
                     # on relative data the whole baseline RSS is the change (+ sampling error),
                     # as % of the reference's own gap; unrefit: at the reference's fit
                     added, gap0 = s["rss_baseline"], d.settings["reference"]["rss_reference"]

@@ -57,7 +57,7 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
            "VALIDATION_RUNS", "stored_validation", "calibration_threshold", "wilson", "TARGET_GROUPS",
            "replicate_table", "replicate_lines", "named_at", "rule_table", "threshold_sweep", "ranking_misses", "threshold_lines",
-           "threshold_draw_lines", "common_mode_table", "common_mode_lines", "stored_baseline_pair", "baseline_pair_lines", "experiment_draws_table", "stored_candidate_baseline", "candidate_baseline_lines", "null_tail_table", "null_tail_lines", "stored_paired", "paired_lines", "PAIRED",
+           "threshold_draw_lines", "common_mode_table", "common_mode_lines", "stored_baseline_pair", "baseline_pair_lines", "experiment_draws_table", "stored_candidate_baseline", "candidate_baseline_lines", "null_tail_table", "null_tail_lines", "stored_paired", "paired_lines", "PAIRED", "pair_counts",
            "stored_load_confusion", "load_confusion_lines", "LOAD_CONFUSION_FILE", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
            "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines",
            "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines", "consistency_lines", "tie_lines",
@@ -994,7 +994,34 @@ def load_confusion_lines(res: dict) -> list[str]:
 #: ``benchmarks/gap_paired.py``'s experiments: a relative-method change on a stored
 #: validation's own draws, name → what changed (in words).
 PAIRED = {"quiet_points_rev5": "located with the quiet points left out",
-          "reference_fit_rev6": "with the baseline's fit of the reference re-solved from the candidates'"}
+          "reference_fit_rev6": "with the baseline's fit of the reference re-solved from the candidates'",
+          "lowest_pair_rev7": "with a failed baseline continuation's fallback and each model's lower located pair"}
+
+
+def pair_counts(v: gval.Validation) -> pd.DataFrame:
+    """How often a relative validation (:class:`gaitlib.gap.method.RelativeMethod`
+    ``lowest_pair``) located the continuation pair instead of the final one: per set, the
+    cases whose baseline and whose first-ranked candidate were located on it; the same for the
+    null calibration's draws. Columns missing from a validation that did not record them
+    read NaN."""
+    r = v.rows
+    out = []
+
+    def n_cont(col, rows):
+        return int((rows[col] == "continuation").sum()) if col in rows else np.nan
+
+    for st, g in r.groupby("set", sort=False):
+        out.append({"cases": st, "n": len(g), "baseline on the continuation pair": n_cont("baseline_pair", g),
+                    "first-ranked on the continuation pair": n_cont("rank1_pair", g)})
+    calib = v.unedited.get("null_calibration") or {}
+    if calib:
+        bp, best = calib.get("baseline_pair"), calib.get("best") or []
+        out.append({"cases": "null calibration draws", "n": len(best),
+                    "baseline on the continuation pair": (sum(x == "continuation" for x in bp.values())
+                                                          if bp is not None else np.nan),
+                    "first-ranked on the continuation pair": (sum(b.get("pair") == "continuation" for b in best)
+                                                              if any("pair" in b for b in best) else np.nan)})
+    return pd.DataFrame(out).set_index("cases")
 
 
 def stored_paired(name: str) -> gval.Validation | None:
@@ -1873,7 +1900,7 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
              load_confusion: dict | None = None, quiet_pair: tuple | None = None,
              null_tail: dict | None = None, valr_now_reps: dict | None = None, common_mode: dict | None = None,
              ref_pair: tuple | None = None, baseline_pair: dict | None = None,
-             candidate_baseline: dict | None = None) -> list[str]:
+             candidate_baseline: dict | None = None, pair_rev8: tuple | None = None) -> list[str]:
     """The chapter's findings as Markdown paragraphs, every number and verdict from the
     results: the twin checks (``tv`` on the coarse mesh, :func:`twin_validation`;
     ``tv_full`` on 20 × 5, :func:`twin_validation_full_mesh`), the SK diagnoses of Schwartz
@@ -1900,6 +1927,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     ``benchmarks/gap_baseline_pair.py``'s result (:func:`baseline_pair_lines`);
     ``candidate_baseline``: ``benchmarks/gap_candidate_baseline.py``'s
     (:func:`candidate_baseline_lines`);
+    ``pair_rev8``: (revision 7's validation, its draws with revision 8's fallback and lower
+    located pair or None, :func:`paired_lines`);
     ``tv_muscle``: the muscle-level twins (:func:`muscle_twin_validation`)."""
     s, sf = tv.summary(), tv_full.summary()
     acc = tv.accuracy()
@@ -1982,6 +2011,9 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     if ref_pair is not None and ref_pair[1] is not None:
         out.append("**The baseline's fit of the reference from the candidates', paired on revision 6's draws.** "
                    + " ".join(paired_lines(*ref_pair, PAIRED["reference_fit_rev6"])))
+    if pair_rev8 is not None and pair_rev8[1] is not None:
+        out.append("**The fallback and the lower located pair, paired on revision 7's draws.** "
+                   + " ".join(paired_lines(*pair_rev8, PAIRED["lowest_pair_rev7"])))
     if baseline_pair is not None:
         out.append("**What remains of the common mode.** " + " ".join(baseline_pair_lines(baseline_pair))
                    + (" " + " ".join(candidate_baseline_lines(candidate_baseline)) if candidate_baseline else ""))
