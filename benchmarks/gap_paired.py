@@ -7,6 +7,7 @@ recomputed on its null draws), so the two can be paired case by case.
 
     GAITLIB_SOLUTIONS=<cache> .venv/bin/python benchmarks/gap_paired.py reference_fit_rev6
     GAITLIB_SOLUTIONS=<cache> .venv/bin/python benchmarks/gap_paired.py quiet_points_rev5
+    GAITLIB_SOLUTIONS=<cache> .venv/bin/python benchmarks/gap_paired.py lowest_pair_rev7
 
 Each experiment (:data:`EXPERIMENTS`) writes ``results/gap_validation/<name>/`` (the four
 files of ``gaitlib gap-validate``), its settings naming the validation it pairs with and the
@@ -34,7 +35,6 @@ EXPERIMENTS = {
                                             "lowest_pair": False}),
     # revision 8: the fallback baseline and the lower of two located pairs, on revision 7's draws
     "lowest_pair_rev7": ("relative_rev7", {"baseline_fallback": True, "lowest_pair": True}),
-    "fallback_rev7": ("relative_rev7", {"baseline_fallback": True, "lowest_pair": False}),
 }
 
 

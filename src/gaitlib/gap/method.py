@@ -154,6 +154,10 @@ class RelativeMethod:
         start (its continuation ended above the baseline's fit), identified the injected
         −2.7° as −3.0°, and closed the ankle channels (16.6 → 1.7) but opened the right
         anterior GRF (0.9 → 18.0): 6 % of the gap closed; its continuation pair closes 56 %.
+        Paired on revision 7's draws with ``baseline_fallback`` (``benchmarks/gap_paired.py
+        lowest_pair_rev7``): independent middle + large injections named 20 → 22 of 24, small
+        4 → 5 of 12, out-of-library and null unchanged (16/16, 3/4); the null draws' lowest
+        statistic −237 → −77, the threshold −60 → −64.
     revision : bumped when the relative diagnosis decides differently for a reason outside
         these fields. 1: the null calibration; 2: the self-consistent reference fit; 3: the
         HAT tilt located; 4: the baseline from the candidates' fits; 5: the threshold the
