@@ -522,7 +522,8 @@ def test_the_lower_of_the_final_and_the_continuation_pair_is_located(ref, monkey
     alt = D.continuation_pairs(ref_first, data_first)
     assert sorted(alt) == ["hip_offset", "knee_offset"]  # the ankle's continuation did not converge
     data_first["knee_offset"].continuation = data_first["knee_offset"].solution
-    assert "knee_offset" not in D.continuation_pairs(ref_first, data_first)  # the kept fit itself
+    assert "knee_offset" in D.continuation_pairs(ref_first, data_first)  # the rounds may have moved only R
+    data_first["knee_offset"].continuation = alt["knee_offset"][0][2]
     final_ref = {"knee_offset": fit("knee_offset", "Rk", 0.45), "hip_offset": fit("hip_offset", "Rh", 0.2)}
     final = {"knee_offset": fit("knee_offset", "Nk", 0.5), "hip_offset": D.Fit("hip_offset", kept_hip,
                                                                               kept_hip.stats["effects"], None, 1,
@@ -532,6 +533,17 @@ def test_the_lower_of_the_final_and_the_continuation_pair_is_located(ref, monkey
     assert (k.pair, k.start, k.located.rss, k.solution.tag) == ("continuation", "reference", 2.0, "Nk0")
     assert k.reference_thetas == {"knee_offset": {"c": 0.1}} and k.thetas == {"knee_offset": {"c": 0.4}}
     assert (h.pair, h.located.rss, h.solution.tag) == ("final", 1.0, "Nh")
+    # the same data fit with the reference's first fit: a pair of its own; the final pair itself is not located again
+    rss[("Rk0", "Nk")] = 0.5
+    same = {"knee_offset": [("continuation", ref_first["knee_offset"], final["knee_offset"].solution)]}
+    k = D.relative_fits(final, final_ref, ref, ref, None, same)["knee_offset"]
+    assert (k.pair, k.located.rss, k.reference_thetas) == ("continuation", 0.5, {"knee_offset": {"c": 0.1}})
+    own = {"knee_offset": [("continuation", final_ref["knee_offset"], final["knee_offset"].solution)]}
+    calls = []
+    monkeypatch.setattr(D.locate, "locate", lambda sol, ds, thetas=None: calls.append(sol.tag) or type(
+        "L", (), {"rss": rss[(ds.background, sol.tag)]})())
+    assert D.relative_fits(final, final_ref, ref, ref, None, own)["knee_offset"].pair == "final"
+    assert calls.count("Nk") == 1
     # the baseline: the lower pair, a non-converged data fit skipped
     pairs = [("final", _Sol(1, "R0"), _Sol(1, "N0")), ("continuation", _Sol(1, "R00"), _Sol(1, "N00"))]
     assert D.lowest_baseline_pair(ref, ref, pairs)[0] == "final"

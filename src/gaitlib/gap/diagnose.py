@@ -1184,6 +1184,8 @@ def relative_fits(fits: dict, ref_fits: dict, ds: gio.DataSet, ref: gio.DataSet,
         for label, ar, asol in (alternates or {}).get(n, ()):
             if f.located is None or not (f.ok and ar.ok):
                 break
+            if asol is f.solution and ar.solution is fr.solution:  # the final pair itself
+                continue
             th = asol.stats.get("effects", {})
             loc = locate.locate(asol, dataclasses.replace(ds, background=gref.background(ref, ar.solution, ar.thetas)),
                                 thetas=th)
@@ -1199,11 +1201,12 @@ def continuation_pairs(ref_fits: dict, fits: dict) -> dict:
     :func:`relative_fits` ``alternates``: its first fit of the reference (``ref_fits``,
     before the self-consistency rounds) and the data's fit continued from it
     (``Fit.continuation`` of ``fits``, the data's fits before the rounds) — where that fit
-    converged and is not the one kept anyway. name → [("continuation", Fit, solution)]."""
+    converged (the same data fit as the final pair's counts: the rounds may have moved only
+    the fit of the reference). name → [("continuation", Fit, solution)]."""
     out = {}
     for n, f in fits.items():
         c, fr = f.continuation, ref_fits.get(n)
-        if c is None or fr is None or fr.solution is None or c is f.solution or not _status(c)[1]:
+        if c is None or fr is None or fr.solution is None or not _status(c)[1]:
             continue
         out[n] = [("continuation", fr, c)]
     return out
