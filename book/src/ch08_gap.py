@@ -788,6 +788,7 @@ if valp8 is not None:
     display(gap_study.replicate_table(pair).drop(columns=["pooled", "pooled %", "95 % interval"]))
     display(gap_study.common_mode_table(pair).round(1))
     display(gap_study.ranking_misses({"fallback and lower pair": valp8}))
+    display(gap_study.pair_counts(valp8))
     display(Markdown("\n\n".join(gap_study.paired_lines(valr7, valp8, gap_study.PAIRED["lowest_pair_rev7"])
                                    + gap_study.threshold_draw_lines(valp8, "the paired run"))))
 else:
