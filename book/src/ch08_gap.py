@@ -528,6 +528,19 @@ def show_relative(v):
     display(Markdown("\n\n".join(gap_study.relative_lines(v, val))))
 
 
+def show_fresh(v, label):
+    """A revision's validation on its own fresh draws: :func:`show_relative`, then what set
+    its threshold, the threshold rules, the common-mode draws, fixed thresholds, the misses
+    and the null's tail."""
+    show_relative(v)
+    display(Markdown("\n\n".join(gap_study.threshold_draw_lines(v, label))))
+    display(gap_study.rule_table(v))
+    display(gap_study.common_mode_table({label: v}).round(1))
+    display(gap_study.threshold_sweep({label: v}))
+    display(gap_study.ranking_misses({label: v}))
+    display(Markdown("\n\n".join(gap_study.threshold_lines({label: v}) + gap_study.null_tail_lines({label: v}))))
+
+
 valr4 = gap_study.superseded_validation("relative_rev4")
 show_relative(valr4)
 
@@ -753,14 +766,7 @@ else:
 
 # %%
 valr7 = gap_study.superseded_validation("relative_rev7")
-show_relative(valr7)
-display(Markdown("\n\n".join(gap_study.threshold_draw_lines(valr7, "revision 7"))))
-display(gap_study.rule_table(valr7))
-display(gap_study.common_mode_table({"revision 7": valr7}).round(1))
-display(gap_study.threshold_sweep({"revision 7": valr7}))
-display(gap_study.ranking_misses({"revision 7": valr7}))
-display(Markdown("\n\n".join(gap_study.threshold_lines({"revision 7": valr7})
-                               + gap_study.null_tail_lines({"revision 7": valr7}))))
+show_fresh(valr7, "revision 7")
 
 # %% [markdown]
 # **Revision 8: a fallback for a failed continuation, and the lower of two located pairs.**
@@ -800,15 +806,8 @@ else:
 # %%
 valr = gap_study.stored_validation("relative")
 print("written by:", gap_study.VALIDATION_RUNS["relative"])
-show_relative(valr)
-display(Markdown("\n\n".join(gap_study.threshold_draw_lines(valr, "revision 8"))))
-display(gap_study.rule_table(valr))
-display(gap_study.common_mode_table({"revision 8": valr}).round(1))
-display(gap_study.threshold_sweep({"revision 8": valr}))
-display(gap_study.ranking_misses({"revision 8": valr}))
+show_fresh(valr, "revision 8")
 display(gap_study.pair_counts(valr))
-display(Markdown("\n\n".join(gap_study.threshold_lines({"revision 8": valr})
-                               + gap_study.null_tail_lines({"revision 8": valr}))))
 
 # %% [markdown]
 # ## 3c. Muscle-level twins: co-contraction, joint stiffness and activation timing against EMG
