@@ -821,3 +821,22 @@ def test_pair_counts_reads_the_located_pairs_of_cases_and_null_draws():
     assert t.loc["null calibration draws"].tolist() == [3, 1, 1]
     old = gs.pair_counts(Validation(rows[["set"]], {}, {}))
     assert old["baseline on the continuation pair"].isna().all() and "null calibration draws" not in old.index
+
+
+def test_case_change_lines_read_both_sides_of_a_paired_case():
+    """studies.gap.case_change_lines: a failed baseline before, the named effect, its change
+    (rad also in °), % closed, ΔBIC, fallback start and located pair after — every number
+    from the two rows."""
+    from gaitlib.gap.validate import Validation
+    from gaitlib.studies import gap as gs
+
+    common = {"case": "ankle_offset_middle_1", "injection": "ankle_offset", "magnitude": -2.73, "unit": "deg"}
+    before = pd.DataFrame([{**common, "named": "baseline failed", "error": "baseline failed: warm X"}])
+    after = pd.DataFrame([{**common, "named": "ankle_offset", "expected_effect": "ankle_offset",
+                           "expected_change": "{'c': -0.05}", "expected_pct": 56.04, "expected_dBIC": -166.2,
+                           "baseline_fallback": "reference fit of grf_scale", "rank1": "ankle_offset",
+                           "rank1_pair": "continuation"}])
+    (line,) = gs.case_change_lines(Validation(before, {}, {}), Validation(after, {}, {}), ["ankle_offset_middle_1"])
+    assert "before, baseline failed (baseline failed: warm X)" in line
+    assert f"c -0.05 rad ({math.degrees(-0.05):+.2f}°), 56 % closed, ΔBIC -166" in line
+    assert "baseline from the reference fit of grf_scale; located on its continuation pair" in line

@@ -772,15 +772,15 @@ show_fresh(valr7, "revision 7")
 # **Revision 8: a fallback for a failed continuation, and the lower of two located pairs.**
 # Two of revision 7's four misses among the middle and large injections had a cause in the
 # fits, not in the criterion. In `knee_offset_large_1` the baseline's continuation from the
-# reference's fit stopped at IPOPT's iteration limit and nothing was ranked; revision 8 then
-# solves the baseline from each nested candidate's fit of the reference, and failing those
-# from the absolute multistart's starts (`RELATIVE.baseline_fallback`). In
-# `ankle_offset_middle_1` the ankle-offset candidate identified the injected −2.7° as −3.0°,
-# yet closed 6 % of the gap: its continuation from its own fit of the reference had ended
-# above the baseline's fit of the data, so the null start (from the baseline's fit) was kept
-# — a fit in another optimum, which closed the ankle channels but opened the right
-# anterior GRF, 0.9 → 18.0. A relative gap compares two fits; when they sit in different
-# optima, the difference of the optima is read as a change of the data. Revision 8 locates
+# reference's fit did not converge and nothing was ranked; revision 8 then solves the
+# baseline from each nested candidate's fit of the reference, and failing those from the
+# absolute multistart's starts (`RELATIVE.baseline_fallback`). In `ankle_offset_middle_1`
+# the ankle-offset candidate identified about the injected change yet closed little of the
+# gap (sentences below): its continuation from its own fit of the reference had ended above
+# the baseline's fit of the data, so the null start (from the baseline's fit) was kept — a
+# fit of the data in another optimum than its fit of the reference. A relative gap compares
+# two fits; when they sit in different optima, the difference of the optima is read as a
+# change of the data. Revision 8 locates
 # each model's gap for two pairs of its fits — the final pair (after the other starts and
 # the self-consistency rounds) and the continuation pair (its first fit of the reference and
 # the data's fit continued from it) — and keeps the lower RSS, for the baseline and every
@@ -795,7 +795,9 @@ if valp8 is not None:
     display(gap_study.common_mode_table(pair).round(1))
     display(gap_study.ranking_misses({"fallback and lower pair": valp8}))
     display(gap_study.pair_counts(valp8))
-    display(Markdown("\n\n".join(gap_study.paired_lines(valr7, valp8, gap_study.PAIRED["lowest_pair_rev7"])
+    display(Markdown("\n\n".join(gap_study.case_change_lines(valr7, valp8, ["knee_offset_large_1",
+                                                                             "ankle_offset_middle_1"])
+                                   + gap_study.paired_lines(valr7, valp8, gap_study.PAIRED["lowest_pair_rev7"])
                                    + gap_study.threshold_draw_lines(valp8, "the paired run"))))
 else:
     print("(benchmarks/gap_paired.py lowest_pair_rev7: not run)")

@@ -57,7 +57,7 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
            "VALIDATION_RUNS", "stored_validation", "calibration_threshold", "wilson", "TARGET_GROUPS",
            "replicate_table", "replicate_lines", "named_at", "rule_table", "threshold_sweep", "ranking_misses", "threshold_lines",
-           "threshold_draw_lines", "common_mode_table", "common_mode_lines", "stored_baseline_pair", "baseline_pair_lines", "experiment_draws_table", "stored_candidate_baseline", "candidate_baseline_lines", "null_tail_table", "null_tail_lines", "stored_paired", "paired_lines", "PAIRED", "pair_counts",
+           "threshold_draw_lines", "common_mode_table", "common_mode_lines", "stored_baseline_pair", "baseline_pair_lines", "experiment_draws_table", "stored_candidate_baseline", "candidate_baseline_lines", "null_tail_table", "null_tail_lines", "stored_paired", "paired_lines", "PAIRED", "pair_counts", "case_change_lines",
            "stored_load_confusion", "load_confusion_lines", "LOAD_CONFUSION_FILE", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
            "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines",
            "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines", "consistency_lines", "tie_lines",
@@ -1041,6 +1041,38 @@ def stored_paired(name: str) -> gval.Validation | None:
             raise RuntimeError(f"{folder}: its {k} {v.settings.get(k)} is not {v.settings['pairs_with']}'s "
                                f"{pair.settings.get(k)}: rerun benchmarks/gap_paired.py {name}")
     return v
+
+
+def case_change_lines(before: gval.Validation, after: gval.Validation, cases) -> list[str]:
+    """One sentence per named case of a paired run (:func:`stored_paired`): the injection,
+    then before and after the change what was named, the expected effect's identified change
+    (:func:`_change_text`), % closed and ΔBIC — or the baseline's failure — and, after, the
+    fallback start and the located pair where recorded."""
+    import ast
+
+    b, a = before.rows.set_index("case"), after.rows.set_index("case")
+
+    def side(r) -> str:
+        if r["named"] == "baseline failed":
+            return f"baseline failed ({r.get('error')})"
+        ch = r.get("expected_change")
+        ch = ast.literal_eval(ch) if isinstance(ch, str) else ch
+        txt = (f"named {r['named']}; {r['expected_effect']}"
+               + (f" identified {_change_text(r['expected_effect'], ch)}" if isinstance(ch, dict) and ch else "")
+               + f", {float(r['expected_pct']):.0f} % closed, ΔBIC {float(r['expected_dBIC']):.0f}")
+        extra = []
+        if isinstance(r.get("baseline_fallback"), str):
+            extra.append(f"baseline from the {r['baseline_fallback']}")
+        if r.get("rank1") == r["expected_effect"] and isinstance(r.get("rank1_pair"), str):
+            extra.append(f"located on its {r['rank1_pair']} pair")
+        return txt + (f" ({'; '.join(extra)})" if extra else "")
+
+    out = []
+    for c in cases:
+        rb, ra = b.loc[c], a.loc[c]
+        out.append(f"{c} ({rb['injection']} {float(rb['magnitude']):+.3g} {rb['unit']}): before, {side(rb)}; "
+                   f"after, {side(ra)}.")
+    return out
 
 
 def paired_lines(before: gval.Validation, after: gval.Validation, what: str) -> list[str]:
