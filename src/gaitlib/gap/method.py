@@ -152,16 +152,16 @@ class RelativeMethod:
         different optima carries that difference as a change: in revision 7's
         ``ankle_offset_middle_1`` the ankle offset's kept fit of the data came from the null
         start (its continuation ended above the baseline's fit), identified the injected
-        −2.7° as −3.0°, and closed the ankle channels (16.6 → 1.7) but opened the right
-        anterior GRF (0.9 → 18.0): 6 % of the gap closed; its continuation pair closes 56 %.
+        −2.7° as −3.0°, and closed the ankle channels but opened the right anterior GRF: 6 %
+        of the gap closed; its continuation pair closes 56 %.
         Paired on revision 7's draws with ``baseline_fallback`` (``benchmarks/gap_paired.py
         lowest_pair_rev7``): independent middle + large injections named 20 → 22 of 24, small
         4 → 5 of 12, out-of-library and null unchanged (16/16, 3/4); the null draws' lowest
         statistic −237 → −77, the threshold −60 → −64. On revision 8's own fresh draws: no
         common-mode draw among the 19 (revision 7: 3; revision 6: 5 and 3), threshold −20
-        (revision 7: −60), independent middle + large 21 of 24 (both misses but one a
-        body-mass injection with ``grf_scale`` within the margin), small 8 of 12,
-        out-of-library 15 of 16, null 4 of 4.
+        (revision 7: −60), independent middle + large 21 of 24 (two of the three misses a
+        body-mass injection ranked first with ``grf_scale`` within the margin, the third a hip
+        offset at ΔBIC −18), small 8 of 12, out-of-library 15 of 16, null 4 of 4.
     revision : bumped when the relative diagnosis decides differently for a reason outside
         these fields. 1: the null calibration; 2: the self-consistent reference fit; 3: the
         HAT tilt located; 4: the baseline from the candidates' fits; 5: the threshold the
