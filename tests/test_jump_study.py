@@ -385,3 +385,88 @@ def test_stand_in_is_a_converged_valid_retry_of_the_same_problem():
     assert J.strength_stand_ins(own, retries, lambda s: True) == {"toe": a}
     assert J.strength_stand_ins(own, retries, lambda s: s is b) == {"toe": b}
     assert J.strength_stand_ins(own, retries, lambda s: False) == {}
+
+
+# ------------------------------------------------------------------ take-off and the cost
+def test_apex_cost_spec_keeps_the_keys_and_drops_only_the_takeoff_term():
+    """``start_weights`` (ours) is absent from every existing key while unset; the apex-height
+    variant zeroes Table 3.9's take-off velocity weight only (w1 welded, w3 ellipsoid) and
+    starts from the thesis's cost."""
+    from gaitlib.problems import jump as P
+
+    for n in P.SPECS:
+        assert "start_weights" not in P.SPECS[n].to_dict()
+    assert J.apex_cost_spec(J.SPECS["toeless"]).weights == (0.0, 12.0)
+    assert J.apex_cost_spec(J.SPECS["toe"]).weights == (0.0, 1.0)
+    e = J.apex_cost_spec(J.SPECS["ellipsoid"])
+    assert e.weights == (2.0, 1.0, 0.0, 5.0) and e.start_weights == (2.0, 1.0, 1.0, 5.0)
+    assert replace(e, weights=J.SPECS["ellipsoid"].weights, start_weights=None) == J.SPECS["ellipsoid"]
+    assert P.cache_location(e) != P.cache_location(replace(e, start_weights=None))
+    with pytest.raises(ValueError, match="start_weights"):
+        P.spec("toe", start_weights=(1.0, 1.0))  # its own weights: no other start
+    with pytest.raises(ValueError, match="start_weights"):
+        P.spec("toe", start_weights=(1.0, 1.0, 1.0))
+
+
+def test_start_weights_starts_from_the_same_jump_with_the_other_cost(toe, monkeypatch):
+    """The full mesh starts from the solution of the same spec with ``start_weights`` (no mesh
+    continuation), recorded; the goal of the dropped term carries weight 0."""
+    from gaitlib.problems import jump as P
+
+    calls = []
+
+    def fake_solve(sp, guess=None, **kw):
+        calls.append(sp)
+        return toe
+
+    sp = replace(J.apex_cost_spec(toe.spec), max_iter=20)  # the wiring, not the optimum
+    monkeypatch.setattr(P, "solve", fake_solve)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ocp.SolveFailedWarning)
+        sol = P._solve_continued(sp, None)
+    assert calls == [replace(sp, weights=toe.spec.weights, start_weights=None)]
+    rec = sol.info["continuation"]
+    assert len(rec) == 1 and rec[0]["start_weights"] == list(toe.spec.weights)
+    goals = pd.DataFrame(sol.goals)
+    assert (goals.loc[goals["goal"] == J.TAKEOFF_GOAL, "weight"] == 0.0).all()
+    assert (goals.loc[goals["goal"] == "apex_height", "weight"] == 1.0).all()
+
+
+def _fake_jump(label, com_y, hip, knee, vy, rise, apex, goals, ok=True):
+    """A stand-in for a JumpSolution: standing at com_y[0], take-off at the last node before flight."""
+    tr = pd.DataFrame({"phase": ["crouch", "thrust", "thrust", "flight"], "com_y": com_y,
+                       "hip": np.radians(hip), "knee": np.radians(knee), "ankle": np.zeros(4)})
+    g = pd.DataFrame(goals, columns=["phase", "goal", "weight", "value", "weighted"])
+    return SimpleNamespace(trajectory=tr, jump_height={"takeoff_vy": vy, "com_rise_flight": rise, "com_rise_standing": apex},
+                           solution=SimpleNamespace(goals=g, objective=float(g["weighted"].sum())), success=ok,
+                           status="Solve_Succeeded" if ok else "Maximum_Iterations_Exceeded",
+                           spec=SimpleNamespace(label=label), stats={"iterations": 10})
+
+
+def test_takeoff_state_by_hand():
+    s = _fake_jump("toe", [1.10, 1.00, 1.02, 1.20], [0, 40, 70, 10], [0, -60, -45, 0], 2.0, 0.20, 0.10,
+                   [("thrust", "v_takeoff", 1.0, 25.0, 25.0), ("flight", "apex_height", 1.0, 0.8, 0.8),
+                    ("thrust", "reg_taud", 0.1, 0.2, 0.02)])
+    t = J.takeoff_state(s)
+    assert t["com_takeoff"] == pytest.approx(1.02 - 1.10)
+    assert t["hip"] == pytest.approx(70.0) and t["knee"] == pytest.approx(-45.0)
+    assert t["takeoff_share"] == pytest.approx(100 * 25.0 / 25.82)
+    assert (t["takeoff_vy"], t["rise_flight"], t["apex"]) == (2.0, 0.20, 0.10)
+
+
+def test_takeoff_findings_read_apex_runs_that_converged_and_pass_only():
+    th = [("thrust", "v_takeoff", 1.0, 40.0, 40.0), ("flight", "apex_height", 12.0, 0.8, 9.6)]
+    ap = [("thrust", "v_takeoff", 0.0, 50.0, 0.0), ("flight", "apex_height", 12.0, 0.7, 8.4)]
+    read = {"toeless": _fake_jump("toeless", [1.1, 1.0, 0.99, 1.1], [0, 60, 70, 0], [0, -80, -46, 0], 1.5, 0.12, 0.01, th),
+            "toe": _fake_jump("toe", [1.1, 1.0, 1.03, 1.3], [0, 60, 60, 0], [0, -80, -50, 0], 2.2, 0.26, 0.19, th)}
+    apex = {"toeless": _fake_jump("toeless", [1.1, 1.0, 1.06, 1.1], [0, 30, 20, 0], [0, -60, -10, 0], 1.3, 0.09, 0.05, ap),
+            "toe": _fake_jump("toe", [1.1, 1.0, 1.1, 1.3], [0, 30, 5, 0], [0, -60, -5, 0], 2.0, 0.2, 0.2, ap, ok=False)}
+    text = " ".join(J.takeoff_findings(read, apex, {"toeless, apex": True, "toe, apex": True}))
+    assert "the COM 7 to 11 cm below its standing height" in text
+    assert "hips flexed 60 to 70°" in text and "the knees -50 to -46°" in text
+    assert "term is 81 % of the objective" in text  # 40 / 49.6, both jumps
+    assert "toe, apex height alone: did NOT converge (Maximum_Iterations_Exceeded) — not read" in text
+    assert "COM at take-off -11 → -4 cm from standing, hip 70 → 20°, knee -46 → -10°" in text
+    assert "apex +1 → +5 cm" in text and "COM rise in flight 12 → 9 cm" in text
+    assert "higher in 1 of 1 jumps, the take-off less crouched in 1 of 1, and the COM rise in flight lower in 1 of 1" in text
+    assert "not the strength envelope" in text

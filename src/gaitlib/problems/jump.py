@@ -236,6 +236,11 @@ class JumpSpec:
         continuation — its states and controls per phase, the coordinates it lacks (the
         toeless jump has no metatarsal joint) at 0, the static parameters at their defaults.
         Recorded in ``solution.info["continuation"]``.
+    start_weights : ``None`` or cost weights like ``weights`` (ours, a procedure): start the
+        full mesh from this same spec's solution with ``start_weights`` as its weights
+        (reloaded from the cache, or solved by its own procedure) instead of the mesh
+        continuation — e.g. a change of the cost (:func:`gaitlib.studies.jump.apex_cost_spec`)
+        solved from the optimum of the thesis's cost. Recorded in ``solution.info["continuation"]``.
     """
 
     name: str = "toe"
@@ -269,6 +274,7 @@ class JumpSpec:
     torque_limits: str = "table3.5"
     friction_max: float | None = None
     start_from: str | None = None
+    start_weights: tuple | None = None
 
     def __post_init__(self):
         if self.start_from is not None and (self.start_from not in SPECS or self.start_from == self.name):
@@ -284,6 +290,9 @@ class JumpSpec:
         n_w = 4 if self.name == "ellipsoid" else 2
         if len(self.weights) != n_w:
             raise ValueError(f"{self.name}: {n_w} weights expected (Table 3.10)")
+        if self.start_weights is not None and (len(self.start_weights) != n_w
+                                               or tuple(self.start_weights) == tuple(self.weights)):
+            raise ValueError(f"start_weights: {n_w} weights other than the spec's own, got {self.start_weights!r}")
         if len(self.durations) != len(self.phases):
             raise ValueError(f"{self.name}: one duration range per phase {self.phases}")
 
@@ -305,12 +314,12 @@ class JumpSpec:
 
     def to_dict(self) -> dict:
         """The spec as a dict; ``torque_limits`` at its default (the thesis's bounds) and
-        ``friction_max`` and ``start_from`` while unset are left out, so the keys of the jumps
-        stored before they existed stay."""
+        ``friction_max``, ``start_from`` and ``start_weights`` while unset are left out, so the
+        keys of the jumps stored before they existed stay."""
         d = asdict(self)
         if d["torque_limits"] == "table3.5":
             d.pop("torque_limits")
-        for k in ("friction_max", "start_from"):
+        for k in ("friction_max", "start_from", "start_weights"):
             if d[k] is None:
                 d.pop(k)
         return d
@@ -1031,8 +1040,17 @@ def _solve_continued(sp: JumpSpec, guess, root=None) -> ocp.Solution:
     """Solve ``sp`` from ``guess``, or, without one, through its mesh continuation
     (:attr:`JumpSpec.continuation`: each coarser mesh warm-starts the next)."""
     record, start = [], None
-    steps = [n for n in sp.continuation if n < sp.n_intervals] if guess is None and sp.start_from is None else []
-    if sp.start_from is not None and guess is None:  # from another jump's solution (see JumpSpec)
+    own_start = guess is None and sp.start_from is None and sp.start_weights is None
+    steps = [n for n in sp.continuation if n < sp.n_intervals] if own_start else []
+    if sp.start_weights is not None and guess is None:  # from this jump's solution with other weights (see JumpSpec)
+        src = solve(replace(sp, weights=tuple(sp.start_weights), start_weights=None), use_cache=True, root=root)
+        record.append({"start_weights": list(sp.start_weights), "n_intervals": src.spec.n_intervals,
+                       "torque_limits": sp.torque_limits, "status": src.status, "iterations": src.solution.iterations,
+                       "solve_time": src.solution.solve_time, "build_time": src.solution.build_time,
+                       "objective": src.solution.objective,
+                       **src.jump_height, "required_friction": src.required_friction})
+        guess = src.solution
+    elif sp.start_from is not None and guess is None:  # from another jump's solution (see JumpSpec)
         src = solve(replace(SPECS[sp.start_from], torque_limits=sp.torque_limits), use_cache=True, root=root)
         record.append({"start_from": sp.start_from, "n_intervals": src.spec.n_intervals,
                        "torque_limits": sp.torque_limits, "status": src.status, "iterations": src.solution.iterations,
