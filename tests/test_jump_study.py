@@ -390,16 +390,16 @@ def test_stand_in_is_a_converged_valid_retry_of_the_same_problem():
 # ------------------------------------------------------------------ take-off and the cost
 def test_apex_cost_spec_keeps_the_keys_and_drops_only_the_takeoff_term():
     """``start_weights`` (ours) is absent from every existing key while unset; the apex-height
-    variant zeroes Table 3.9's take-off velocity weight only (w1 welded, w3 ellipsoid) and
+    variant scales Table 3.9's take-off velocity weight only (w1 welded, w3 ellipsoid) and
     starts from the thesis's cost."""
     from gaitlib.problems import jump as P
 
     for n in P.SPECS:
         assert "start_weights" not in P.SPECS[n].to_dict()
-    assert J.apex_cost_spec(J.SPECS["toeless"]).weights == (0.0, 12.0)
-    assert J.apex_cost_spec(J.SPECS["toe"]).weights == (0.0, 1.0)
+    assert J.apex_cost_spec(J.SPECS["toeless"], 0.0).weights == (0.0, 12.0)
+    assert J.apex_cost_spec(J.SPECS["toe"]).weights == (J.TAKEOFF_FACTOR, 1.0)
     e = J.apex_cost_spec(J.SPECS["ellipsoid"])
-    assert e.weights == (2.0, 1.0, 0.0, 5.0) and e.start_weights == (2.0, 1.0, 1.0, 5.0)
+    assert e.weights == (2.0, 1.0, J.TAKEOFF_FACTOR, 5.0) and e.start_weights == (2.0, 1.0, 1.0, 5.0)
     assert replace(e, weights=J.SPECS["ellipsoid"].weights, start_weights=None) == J.SPECS["ellipsoid"]
     assert P.cache_location(e) != P.cache_location(replace(e, start_weights=None))
     with pytest.raises(ValueError, match="start_weights"):
@@ -428,7 +428,7 @@ def test_start_weights_starts_from_the_same_jump_with_the_other_cost(toe, monkey
     rec = sol.info["continuation"]
     assert len(rec) == 1 and rec[0]["start_weights"] == list(toe.spec.weights)
     goals = pd.DataFrame(sol.goals)
-    assert (goals.loc[goals["goal"] == J.TAKEOFF_GOAL, "weight"] == 0.0).all()
+    assert (goals.loc[goals["goal"] == J.TAKEOFF_GOAL, "weight"] == J.TAKEOFF_FACTOR).all()
     assert (goals.loc[goals["goal"] == "apex_height", "weight"] == 1.0).all()
 
 
@@ -465,8 +465,20 @@ def test_takeoff_findings_read_apex_runs_that_converged_and_pass_only():
     assert "the COM 7 to 11 cm below its standing height" in text
     assert "hips flexed 60 to 70°" in text and "the knees -50 to -46°" in text
     assert "term is 81 % of the objective" in text  # 40 / 49.6, both jumps
-    assert "toe, apex height alone: did NOT converge (Maximum_Iterations_Exceeded) — not read" in text
+    assert f"toe, take-off term × {J.TAKEOFF_FACTOR:g}: did NOT converge (Maximum_Iterations_Exceeded) — not read" in text
     assert "COM at take-off -11 → -4 cm from standing, hip 70 → 20°, knee -46 → -10°" in text
     assert "apex +1 → +5 cm" in text and "COM rise in flight 12 → 9 cm" in text
-    assert "higher in 1 of 1 jumps, the take-off less crouched in 1 of 1, and the COM rise in flight lower in 1 of 1" in text
+    assert f"term × {J.TAKEOFF_FACTOR:g} the apex is higher in 1 of 1 jumps and the take-off less crouched in 1 of 1" in text
+    assert "is higher without it in 0 of 1 (toeless 12 → 9 cm)." in text
     assert "not the strength envelope" in text
+
+
+def test_takeoff_clause_for_the_card():
+    th = [("thrust", "v_takeoff", 1.0, 40.0, 40.0), ("flight", "apex_height", 12.0, 0.8, 10.0)]
+    ap = [("thrust", "v_takeoff", 0.01, 50.0, 0.5), ("flight", "apex_height", 12.0, 0.7, 8.4)]
+    read = _fake_jump("toeless", [1.1, 1.0, 0.99, 1.1], [0, 60, 70, 0], [0, -80, -46, 0], 1.5, 0.12, 0.01, th)
+    good = _fake_jump("toeless", [1.1, 1.0, 1.06, 1.1], [0, 30, 20, 0], [0, -60, -10, 0], 1.3, 0.09, 0.05, ap)
+    c = J.takeoff_clause(read, None, False)
+    assert c == "leaves the ground crouched (COM -11 cm from standing, hip 70°, knee -46°), Table 3.9's take-off velocity term 80 % of the objective"
+    assert J.takeoff_clause(read, good, False).endswith(f"with it × {J.TAKEOFF_FACTOR:g}: fails a validity gate")
+    assert J.takeoff_clause(read, good, True).endswith("apex +1 → +5 cm from the standing COM; COM rise in flight 12 → 9 cm")

@@ -319,6 +319,14 @@ def _ch3() -> list[Row]:
                         holds=mu["ellipsoid"] < min(mu["toeless"], mu["toe"])))
     retry_text = {n: re.sub(r"\*\*[^*]*\*\* — ", "", t) for n, t in
                   zip(retries, jump.strength_retry_findings(own, retries))}
+    apex = {}  # each jump read with Table 3.9's take-off term scaled down (stored ones)
+    for n, s in strong.items():
+        sp = jump.apex_cost_spec(s.spec)
+        if cache.find(jump.cache_location(sp), "solution.json", to_solve=False) is not None:
+            apex[n] = jump.solve(sp, use_cache=True)
+    where_cost = _anchor("ch03_jump", "Why the strength-limited jumps leave the ground crouched: the cost")
+    takeoff = {n: f"; {jump.takeoff_clause(s, apex.get(n), n in apex and not _blocked(gate(apex[n], n)))} [{where_cost}]"
+               for n, s in strong.items()}
     for n, s in strong.items():
         rise = s.jump_height["com_rise_flight"]
         name = f"jump/{cache.find(jump.cache_location(s.spec), 'solution.json', to_solve=False).name} ({n}, strength-limited)"
@@ -328,7 +336,8 @@ def _ch3() -> list[Row]:
                            "ours: COM rise in flight)", jump.THESIS[n]["jump_height_cm"], 100 * rise, "cm",
                         stand + f"the MTG strength envelope (Eq 5.8, Eq 5.21): COM rise {100 * rise:.0f} cm, "
                         f"{'inside' if lo <= rise <= hi else 'outside'} the {100 * lo:.0f}–{100 * hi:.0f} cm of human "
-                        f"standing jumps" + (f"; {retry_text[n]}" if n in retry_text else "") + f" [{where_strong}]",
+                        f"standing jumps" + (f"; {retry_text[n]}" if n in retry_text else "") + f" [{where_strong}]"
+                        + takeoff[n],
                         name, strong_valid[n]))
     if len(strong) == len(jump.THESIS):
         rise = {n: s.jump_height["com_rise_flight"] for n, s in strong.items()}
