@@ -470,6 +470,7 @@ def test_takeoff_findings_read_apex_runs_that_converged_and_pass_only():
     assert "apex +1 → +5 cm" in text and "COM rise in flight 12 → 9 cm" in text
     assert f"term × {J.TAKEOFF_FACTOR:g} the apex is higher in 1 of 1 jumps and the take-off less crouched in 1 of 1" in text
     assert "is higher without it in 0 of 1 (toeless 12 → 9 cm)." in text
+    assert f"Thesis: the toes raise the jump — not read: {J.LABELS['toe']} not converged or not valid." in text
     assert "not the strength envelope" in text
 
 

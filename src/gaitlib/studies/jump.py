@@ -19,10 +19,11 @@ from .. import plots
 __all__ = ["solve_all", "results_table", "stats_table", "plot_channels", "animate", "THESIS", "SPECS",
            "JumpSpec", "JumpSolution", "joint_bounds", "spec", "solve", "build", "cache_location",
            "THESIS_HEIGHT_ORDER", "AT_BOUND", "torques_at_bound", "findings", "HUMAN_JUMP_RISE_M", "strength_specs",
-           "solve_strength", "strength_use", "strength_table", "strength_findings",
+           "solve_strength", "strength_use", "strength_table", "strength_findings", "HEIGHT_CLAIMS", "height_claims",
            "STRENGTH_RETRIES", "PIVTOL", "retry_spec", "retry_label", "strength_stand_ins", "strength_retries",
-           "strength_retry_table", "strength_retry_findings", "TAKEOFF_GOAL", "TAKEOFF_FACTOR", "TAKEOFF_COSTS", "apex_cost_spec", "takeoff_change", "takeoff_clause", "solve_apex_cost",
-           "takeoff_state", "takeoff_table", "takeoff_findings"]
+           "strength_retry_table", "strength_retry_findings", "TAKEOFF_GOAL", "TAKEOFF_FACTOR", "TAKEOFF_COSTS",
+           "apex_cost_spec", "solve_apex_cost", "takeoff_state", "takeoff_table", "takeoff_change", "takeoff_clause",
+           "takeoff_findings"]
 
 
 def solve_all(names=("toeless", "toe", "ellipsoid"), use_cache: bool = False,
@@ -283,6 +284,27 @@ def strength_table(sols: dict[str, JumpSolution], gates: dict[str, str] | None =
     return pd.DataFrame(rows).T
 
 
+#: The thesis's claims on the jump heights (Sec 3.4.4): (lower jump, higher jump, claim).
+HEIGHT_CLAIMS = (("toeless", "toe", "the toes raise the jump"), ("toe", "ellipsoid", "the compliant contact raises it further"),
+                 ("toeless", "ellipsoid", "toes and compliant contact together raise it"))
+
+
+def height_claims(heights: dict[str, float], where: str) -> list[str]:
+    """One sentence per claim of :data:`HEIGHT_CLAIMS`, read on ``heights`` (name → m, only
+    the jumps that converged and pass the gates); a claim with a jump missing is not read.
+    ``where``: the words naming the jumps (e.g. "with strength limits")."""
+    out = []
+    for a, b, claim in HEIGHT_CLAIMS:
+        if a in heights and b in heights:
+            ra, rb = heights[a], heights[b]
+            out.append(f"Thesis: {claim} — {where} {LABELS[a]} {100 * ra:.0f} cm, {LABELS[b]} "
+                       f"{100 * rb:.0f} cm: {'holds' if rb > ra else 'does NOT hold'}.")
+        else:
+            out.append(f"Thesis: {claim} — not read: " + ", ".join(
+                LABELS[n] for n in (a, b) if n not in heights) + " not converged or not valid.")
+    return out
+
+
 def strength_findings(sols: dict[str, JumpSolution], valid: dict[str, bool],
                       stand_ins: dict[str, JumpSolution] | None = None) -> list[str]:
     """The strength-limited jumps' sentences, computed: per jump convergence, validity and COM
@@ -307,16 +329,7 @@ def strength_findings(sols: dict[str, JumpSolution], valid: dict[str, bool],
                    + ("inside" if lo <= r <= hi else "outside")
                    + f" the {100 * lo:.0f}–{100 * hi:.0f} cm of human standing jumps; take-off v_y "
                    f"{s.jump_height['takeoff_vy']:.2f} m/s; required μ_s {s.required_friction:.2f}.")
-    claims = [("toeless", "toe", "the toes raise the jump"), ("toe", "ellipsoid", "the compliant contact raises it further"),
-              ("toeless", "ellipsoid", "toes and compliant contact together raise it")]
-    for a, b, claim in claims:
-        if a in ok and b in ok:
-            ra, rb = ok[a].jump_height["com_rise_flight"], ok[b].jump_height["com_rise_flight"]
-            out.append(f"Thesis: {claim} — with strength limits {LABELS[a]} {100 * ra:.0f} cm, {LABELS[b]} "
-                       f"{100 * rb:.0f} cm: {'holds' if rb > ra else 'does NOT hold'}.")
-        else:
-            out.append(f"Thesis: {claim} — not read: " + ", ".join(
-                LABELS[n] for n in (a, b) if n not in ok) + " not converged or not valid.")
+    out += height_claims({n: s.jump_height["com_rise_flight"] for n, s in ok.items()}, "with strength limits")
     if "ellipsoid" in ok and ({"toeless", "toe"} & set(ok)):
         mu_e = ok["ellipsoid"].required_friction
         welded = {n: ok[n].required_friction for n in ("toeless", "toe") if n in ok}
@@ -583,4 +596,6 @@ def takeoff_findings(read: dict[str, JumpSolution], apex: dict[str, JumpSolution
                    f"{len(higher_flight)} of {len(ok)} ("
                    + ", ".join(f"{ok[n].spec.label} {100 * t[n]['rise_flight']:.0f} → "
                                f"{100 * takeoff_state(ok[n])['rise_flight']:.0f} cm" for n in ok) + ").")
+        out += height_claims({n: takeoff_state(x)["apex"] for n, x in ok.items()},
+                             f"with the take-off term × {TAKEOFF_FACTOR:g}, apex above the standing COM:")
     return out
