@@ -463,13 +463,13 @@ def test_takeoff_findings_read_apex_runs_that_converged_and_pass_only():
             "toe": _fake_jump("toe", [1.1, 1.0, 1.1, 1.3], [0, 30, 5, 0], [0, -60, -5, 0], 2.0, 0.2, 0.2, ap, ok=False)}
     text = " ".join(J.takeoff_findings(read, apex, {"toeless, apex": True, "toe, apex": True}))
     assert "the COM 7 to 11 cm below its standing height" in text
-    assert "hips flexed 60 to 70°" in text and "the knees -50 to -46°" in text
+    assert "hips flexed 60 to 70°" in text and "the knees at -50 to -46°" in text
     assert "term is 81 % of the objective" in text  # 40 / 49.6, both jumps
     assert f"toe, take-off term × {J.TAKEOFF_FACTOR:g}: did NOT converge (Maximum_Iterations_Exceeded) — not read" in text
     assert "COM at take-off -11 → -4 cm from standing, hip 70 → 20°, knee -46 → -10°" in text
     assert "apex +1 → +5 cm" in text and "COM rise in flight 12 → 9 cm" in text
     assert f"term × {J.TAKEOFF_FACTOR:g} the apex is higher in 1 of 1 jumps and the take-off less crouched in 1 of 1" in text
-    assert "is higher without it in 0 of 1 (toeless 12 → 9 cm)." in text
+    assert "is higher with it scaled down in 0 of 1 (toeless 12 → 9 cm)." in text
     assert f"Thesis: the toes raise the jump — not read: {J.LABELS['toe']} not converged or not valid." in text
     assert "not the strength envelope" in text
 

@@ -572,7 +572,7 @@ def takeoff_findings(read: dict[str, JumpSolution], apex: dict[str, JumpSolution
         return fmt.format(v[0]) if len(v) == 1 or fmt.format(v[0]) == fmt.format(v[-1]) else \
             f"{fmt.format(v[0])} to {fmt.format(v[-1])}"
     out = [f"With Table 3.9's cost the strength-limited jumps leave the ground crouched: the COM "
-           f"{rng('com_takeoff', -100)} cm below its standing height, the hips flexed {rng('hip')}°, the knees "
+           f"{rng('com_takeoff', -100)} cm below its standing height, the hips flexed {rng('hip')}°, the knees at "
            f"{rng('knee')}° (a human vertical jump leaves the ground with hips and knees nearly straight, e.g. Bobbert & "
            f"van Ingen Schenau 1988); the take-off velocity term is {rng('takeoff_share')} % of the objective."]
     ok = {n: s for n, s in apex.items() if s.success and valid.get(f"{n}, apex", False)}
@@ -592,7 +592,7 @@ def takeoff_findings(read: dict[str, JumpSolution], apex: dict[str, JumpSolution
                    + (": the term, not the strength envelope, puts the take-off in a crouch — it rewards the vertical "
                       "speed at take-off whatever the posture, and the apex the thesis says its cost maximises is lower "
                       "with it" if len(higher) == len(straighter) == len(ok) else "")
-                   + f". The COM rise in flight (our reading of the thesis's jump height) is higher without it in "
+                   + f". The COM rise in flight (our reading of the thesis's jump height) is higher with it scaled down in "
                    f"{len(higher_flight)} of {len(ok)} ("
                    + ", ".join(f"{ok[n].spec.label} {100 * t[n]['rise_flight']:.0f} → "
                                f"{100 * takeoff_state(ok[n])['rise_flight']:.0f} cm" for n in ok) + ").")
