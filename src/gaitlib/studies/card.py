@@ -325,7 +325,12 @@ def _ch3() -> list[Row]:
         if cache.find(jump.cache_location(sp), "solution.json", to_solve=False) is not None:
             apex[n] = jump.solve(sp, use_cache=True)
     where_cost = _anchor("ch03_jump", "Why the strength-limited jumps leave the ground crouched: the cost")
-    takeoff = {n: f"; {jump.takeoff_clause(s, apex.get(n), n in apex and not _blocked(gate(apex[n], n)))} [{where_cost}]"
+    apex_ok = {n: a for n, a in apex.items() if not _blocked(gate(a, n))}
+    apex_order = ("; the apex above the standing COM with Table 3.9's take-off velocity term × "
+                  f"{jump.TAKEOFF_FACTOR:g}: " + ", ".join(f"{n} {100 * jump.takeoff_state(a)['apex']:.0f} cm"
+                                                           for n, a in apex_ok.items()) + f" [{where_cost}]"
+                  if len(apex_ok) == len(jump.THESIS) else "")
+    takeoff = {n: f"; {jump.takeoff_clause(s, apex.get(n), n in apex_ok)} [{where_cost}]"
                for n, s in strong.items()}
     for n, s in strong.items():
         rise = s.jump_height["com_rise_flight"]
@@ -346,7 +351,7 @@ def _ch3() -> list[Row]:
                         "toeless < toe < ellipsoid", " < ".join(order), "",
                         f"COM rises {', '.join(f'{n} {100 * r:.0f} cm' for n, r in rise.items())}"
                         + "".join(f"; {n}: its stand-in, {jump.retry_label(x)}" for n, x in stand_ins.items())
-                        + f" [{where_strong}]", "jump (3 strength-limited solutions)", _joint(strong_valid),
+                        + f" [{where_strong}]" + apex_order, "jump (3 strength-limited solutions)", _joint(strong_valid),
                         holds=order == ["toeless", "toe", "ellipsoid"]))
     return rows
 
