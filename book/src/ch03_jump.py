@@ -408,7 +408,7 @@ plt.show()
 apex = jump.solve_apex_cost(shown)
 apex_gates = {**{n: validity.label(s, name=n) for n, s in shown.items()},
               **{f"{n}, apex": validity.label(s, name=f"{n}, apex") for n, s in apex.items()}}
-display(marks.mark_table(jump.takeoff_table(shown, apex, apex_gates),
+display(marks.mark_table(jump.takeoff_table(shown, apex, apex_gates).round(1),
                          {(s.spec.label, cost): marks.failure_label(s) for n in shown
                           for cost, s in zip(jump.TAKEOFF_COSTS, (shown[n], apex[n]))}))
 display(Markdown("\n\n".join(jump.takeoff_findings(

@@ -530,7 +530,7 @@ def takeoff_table(read: dict[str, JumpSolution], apex: dict[str, JumpSolution],
                 "take-off velocity term (% of the objective)": t["takeoff_share"],
                 "gates": (gates or {}).get(g, ""),
             }
-    out = pd.DataFrame(rows).T
+    out = pd.DataFrame(rows).T.infer_objects()
     out.index.names = ["jump", "cost"]
     return out
 
