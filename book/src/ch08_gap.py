@@ -812,6 +812,23 @@ show_fresh(valr, "revision 8")
 display(gap_study.pair_counts(valr))
 
 # %% [markdown]
+# **Revision 8 on a second set of draws** (`--replicate 1`: the reference, its 19 null draws,
+# the magnitudes, signs and resampling seeds drawn afresh, the method unchanged), and both
+# replicates pooled, with a 95 % interval on each pooled rate:
+
+# %%
+valr_1 = gap_study.stored_validation("relative_r1")
+print("written by:", gap_study.VALIDATION_RUNS["relative_r1"])
+show_fresh(valr_1, "revision 8, replicate 1")
+display(gap_study.pair_counts(valr_1))
+reps8 = {"replicate 0": valr, "replicate 1": valr_1}
+display(gap_study.replicate_table(reps8))
+display(Markdown("\n\n".join(gap_study.replicate_lines(reps8))))
+display(gap_study.threshold_sweep(reps8))
+display(gap_study.ranking_misses(reps8))
+display(Markdown("\n\n".join(gap_study.threshold_lines(reps8))))
+
+# %% [markdown]
 # ## 3c. Muscle-level twins: co-contraction, joint stiffness and activation timing against EMG
 #
 # The effects of Section 5 show only in the muscles: co-contraction and joint stiffness
@@ -1123,5 +1140,6 @@ display(Markdown("\n\n".join(gap_study.findings(tv, tvf, dS, dU, dN, chkS, chkU,
                                                     quiet_pair=(valr5, valq), null_tail=null_same,
                                                     valr_now_reps=reps6, common_mode=cm_vals,
                                                     ref_pair=(valr6, valp7), baseline_pair=bpair,
-                                                    candidate_baseline=cbase, pair_rev8=(valr7, valp8)))))
+                                                    candidate_baseline=cbase, pair_rev8=(valr7, valp8),
+                                                    current_reps=reps8))))
 print(f"notebook time: {time.perf_counter() - T0:.0f} s")

@@ -371,6 +371,8 @@ VALIDATION_RUNS = {
     "null": "gaitlib gap-validate --set null --derivatives nodes --out benchmarks/results/gap_validation/null",
     "relative": "gaitlib gap-validate --relative --set independent,out-of-library,null --per-band 2 --derivatives nodes "
                 "--out benchmarks/results/gap_validation/relative",
+    "relative_r1": "gaitlib gap-validate --relative --set independent,out-of-library,null --per-band 2 --replicate 1 "
+                   "--derivatives nodes --out benchmarks/results/gap_validation/relative_r1",
 }
 
 
@@ -1932,7 +1934,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
              load_confusion: dict | None = None, quiet_pair: tuple | None = None,
              null_tail: dict | None = None, valr_now_reps: dict | None = None, common_mode: dict | None = None,
              ref_pair: tuple | None = None, baseline_pair: dict | None = None,
-             candidate_baseline: dict | None = None, pair_rev8: tuple | None = None) -> list[str]:
+             candidate_baseline: dict | None = None, pair_rev8: tuple | None = None,
+             current_reps: dict | None = None) -> list[str]:
     """The chapter's findings as Markdown paragraphs, every number and verdict from the
     results: the twin checks (``tv`` on the coarse mesh, :func:`twin_validation`;
     ``tv_full`` on 20 × 5, :func:`twin_validation_full_mesh`), the SK diagnoses of Schwartz
@@ -1961,6 +1964,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     (:func:`candidate_baseline_lines`);
     ``pair_rev8``: (revision 7's validation, its draws with revision 8's fallback and lower
     located pair or None, :func:`paired_lines`);
+    ``current_reps``: the current revision's replicates (label → validation,
+    :func:`replicate_lines`, :func:`threshold_lines`);
     ``tv_muscle``: the muscle-level twins (:func:`muscle_twin_validation`)."""
     s, sf = tv.summary(), tv_full.summary()
     acc = tv.accuracy()
@@ -2046,6 +2051,10 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     if pair_rev8 is not None and pair_rev8[1] is not None:
         out.append("**The fallback and the lower located pair, paired on revision 7's draws.** "
                    + " ".join(paired_lines(*pair_rev8, PAIRED["lowest_pair_rev7"])))
+    if current_reps is not None and len(current_reps) > 1:
+        rev = next(iter(current_reps.values())).settings["relative_method"]["revision"]
+        out.append(f"**Revision {rev}, the method in use, on two sets of draws.** " + " ".join(replicate_lines(current_reps))
+                   + " " + " ".join(threshold_lines(current_reps)))
     if baseline_pair is not None:
         out.append("**What remains of the common mode.** " + " ".join(baseline_pair_lines(baseline_pair))
                    + (" " + " ".join(candidate_baseline_lines(candidate_baseline)) if candidate_baseline else ""))
