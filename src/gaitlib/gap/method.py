@@ -161,7 +161,10 @@ class RelativeMethod:
         common-mode draw among the 19 (revision 7: 3; revision 6: 5 and 3), threshold −20
         (revision 7: −60), independent middle + large 21 of 24 (two of the three misses a
         body-mass injection ranked first with ``grf_scale`` within the margin, the third a hip
-        offset at ΔBIC −18), small 8 of 12, out-of-library 15 of 16, null 4 of 4.
+        offset at ΔBIC −18), small 8 of 12, out-of-library 15 of 16, null 4 of 4. On a second
+        set of draws (``--replicate 1``): threshold −24, middle + large 23 of 24 (the miss again
+        a body-mass injection with ``grf_scale`` within the margin), small 9 of 12,
+        out-of-library 13 of 16, null 4 of 4 — pooled, middle + large 44 of 48.
     revision : bumped when the relative diagnosis decides differently for a reason outside
         these fields. 1: the null calibration; 2: the self-consistent reference fit; 3: the
         HAT tilt located; 4: the baseline from the candidates' fits; 5: the threshold the
