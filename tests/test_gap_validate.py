@@ -840,3 +840,27 @@ def test_case_change_lines_read_both_sides_of_a_paired_case():
     assert "before, baseline failed (baseline failed: warm X)" in line
     assert f"c -0.05 rad ({math.degrees(-0.05):+.2f}°), 56 % closed, ΔBIC -166" in line
     assert "baseline from the reference fit of grf_scale; located on its continuation pair" in line
+
+
+def test_share_floor_replay_by_hand():
+    """A named effect below the floor on the share it closed is read "unexplained": the
+    out-of-library case named with 15 % turns right at a 20 % floor, the injection named
+    right with 40 % stays, the one named right with 12 % turns wrong; 0 is the method as is."""
+    from gaitlib.studies import gap as G
+
+    rows = V.pd.DataFrame({
+        "case": ["a_middle_0", "b_large_0", "c_middle_0"], "set": ["independent", "independent", "out-of-library"],
+        "band": ["middle", "large", "middle"], "expected": ["knee_offset", "ankle_offset", "unexplained"],
+        "rank1": ["knee_offset", "ankle_offset", "hip_offset"], "rank1_pct": [40.0, 12.0, 15.0],
+        "named": ["knee_offset", "ankle_offset", "hip_offset"], "correct": [True, True, False]})
+    v = V.Validation(rows, {}, {"relative": True})
+    assert G.with_share_floor(v, 0.0)["correct"].tolist() == [True, True, False]
+    r = G.with_share_floor(v, 20.0)
+    assert r["named"].tolist() == ["knee_offset", "unexplained", "unexplained"]
+    assert r["correct"].tolist() == [True, False, True]
+    sw = G.share_floor_sweep({"r0": v}, floors=(0.0, 13.0, 20.0))
+    assert sw.loc[0.0, "independent, middle + large"] == "2/2 (100 %)" and sw.loc[0.0, "out-of-library"] == "0/1 (0 %)"
+    assert sw.loc[13.0, "independent, middle + large"] == "1/2 (50 %)" and sw.loc[20.0, "out-of-library"] == "1/1 (100 %)"
+    (line,) = G.share_floor_lines({"r0": v})
+    assert "closed 15–15 % of their relative gap (c_middle_0 (r0): hip_offset 15 %)" in line
+    assert "named right closed 12 % or more (the least: b_large_0, r0)" in line

@@ -829,6 +829,18 @@ display(gap_study.ranking_misses(reps8))
 display(Markdown("\n\n".join(gap_study.threshold_lines(reps8))))
 
 # %% [markdown]
+# **A lead, not a method: the share of the gap a named effect closes.** Revision 8's wrong
+# names among the out-of-library cases came with little of the relative gap closed. The
+# same rankings decided again with one more test — a named effect must also close at least
+# a given share of the relative gap (`gap_study.with_share_floor`; 0: revision 8 as it is) —
+# pooled over both sets of draws. Read on the draws that suggested it, so it says what such a
+# floor could do, not what it does: a revision with it would be validated on fresh draws.
+
+# %%
+display(gap_study.share_floor_sweep(reps8))
+display(Markdown("\n\n".join(gap_study.share_floor_lines(reps8))))
+
+# %% [markdown]
 # ## 3c. Muscle-level twins: co-contraction, joint stiffness and activation timing against EMG
 #
 # The effects of Section 5 show only in the muscles: co-contraction and joint stiffness
