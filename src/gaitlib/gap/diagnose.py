@@ -348,7 +348,8 @@ def nesting(name: str) -> tuple[bool, str]:
 
 
 def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", resamples: int = 200, seed: int = 0,
-             top: int = 3, skipped=None, settings=None, solution=None, threshold: float | None = None) -> Diagnosis:
+             top: int = 3, skipped=None, settings=None, solution=None, threshold: float | None = None,
+             min_share: float = 0.0) -> Diagnosis:
     """Rank fitted candidates against the baseline fit and build the :class:`Diagnosis`.
 
     Ranked (``rank`` 1, 2, …, by ΔBIC): candidates with a located fit whose ``search`` is
@@ -358,7 +359,9 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
     (``nests_baseline``, :func:`nesting`) closes ≥ −100 :data:`RETRY_MARGIN` % of the RSS;
     only a non-nesting one can show a negative % closed. ``threshold``: the ΔBIC the top
     effect must reach (default :data:`BIC_THRESHOLD`; a relative diagnosis's null
-    calibration lowers it)."""
+    calibration lowers it). ``min_share``: the % of the located RSS the top effect must also
+    close to be named (a relative diagnosis: :attr:`gaitlib.gap.method.RelativeMethod.
+    min_share_closed`; 0: no such test) — below it the diagnosis is "unexplained"."""
     thr = BIC_THRESHOLD if threshold is None else float(threshold)
     loc0 = locate.locate(base_sol, ds)
     n_eff = loc0.n_eff
@@ -400,7 +403,7 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
         ranking.insert(0, "rank", rank)
     elig = ranking[(ranking["ok"]) & (ranking["dBIC"] <= thr)] if not ranking.empty else ranking
     contenders = contenders_of(ranking)
-    if len(elig) and len(contenders) <= 1:
+    if len(elig) and len(contenders) <= 1 and float(elig.iloc[0]["pct_closed"]) >= min_share:
         top_effect = str(elig.iloc[0]["effect"])
         verdict = "explained" if float(elig.iloc[0]["pct_closed"]) >= EXPLAINED_PCT else "partial"
     else:
@@ -888,9 +891,10 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
                                          root=root, use_cache=use_cache, scheduler=scheduler,
                                          **kw) if RELATIVE.null_draws > 0 else None
     fits = all_fits["data"]
-    threshold = None
+    threshold, min_share = None, 0.0
     if ref is not None:
         alternates = None
+        min_share = RELATIVE.min_share_closed
         if RELATIVE.lowest_pair:  # each model's located pair: the final or the continuation, the lower
             pair, ref_fit, base_sol = lowest_baseline_pair(ds, ref, [("final", ref_fit, base_sol),
                                                                      ("continuation", ref_fit_start, base_cont)])
@@ -906,7 +910,7 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
             threshold = min(BIC_THRESHOLD, t)
     settings = {"objective": objective, "candidates": names, "warm": warm is not None, "reference": ref_info}
     d = assemble(ds, spec0, base_sol, fits, objective=objective, resamples=resamples, seed=seed, skipped=skipped,
-                 settings=settings, solution=solution, threshold=threshold)
+                 settings=settings, solution=solution, threshold=threshold, min_share=min_share)
     d.reference_fit = ref_fit
     return d
 

@@ -709,17 +709,21 @@ def named_at(v: gval.Validation, threshold: float) -> pd.DataFrame:
     """The cases of a relative validation decided again at another threshold: a case names
     its first-ranked effect if that effect's ΔBIC is at or below ``threshold`` (and the fixed
     :data:`gaitlib.gap.method.BIC_THRESHOLD`) and no runner-up is within the margin (its
-    stored ``contenders``), else "unexplained" — :func:`gaitlib.gap.diagnose.assemble`'s rule
-    replayed on the stored ranking (the contenders do not depend on the threshold). Returns
+    stored ``contenders``) and, from revision 9, it closes at least the method's
+    ``min_share_closed`` % of the gap, else "unexplained" — :func:`gaitlib.gap.diagnose.
+    assemble`'s rule replayed on the stored ranking (the contenders do not depend on the
+    threshold). Returns
     the rows with ``named`` and ``correct`` replaced; a failed baseline stays as stored."""
     thr = min(diagnose.BIC_THRESHOLD, float(threshold))
+    floor = float(((v.settings or {}).get("relative_method") or {}).get("min_share_closed", 0.0))
     r = v.rows.copy()
 
     def one(row):
         if row["verdict"] == "baseline failed":
             return row["named"]
         c = row["contenders"] if isinstance(row["contenders"], (list, tuple)) else []
-        ok = pd.notna(row["rank1_dBIC"]) and float(row["rank1_dBIC"]) <= thr and len(c) <= 1
+        ok = (pd.notna(row["rank1_dBIC"]) and float(row["rank1_dBIC"]) <= thr and len(c) <= 1
+              and (floor <= 0 or float(row["rank1_pct"]) >= floor))
         return str(row["rank1"]) if ok else "unexplained"
 
     r["named"] = r.apply(one, axis=1)
