@@ -217,3 +217,23 @@ def test_cli_needs_n_subjects_for_a_foreign_csv(tmp_path):
     err = r.stderr.strip()
     assert len(err.splitlines()) == 1 and "--n-subjects" in err and "mylab" in err
     assert not (tmp_path / "o").exists()
+
+
+def test_min_share_holds_a_top_effect_that_closes_too_little(tmp_path, real):
+    """``assemble(min_share=)`` (the relative method's ``min_share_closed``): the top effect,
+    past the threshold and alone, is named only if it closes at least that % of the located
+    RSS; just below its own % closed it is named, just above it the diagnosis is
+    "unexplained"."""
+    spec = gait_ocp.GaitSpec(model="SK", cost="DT", n_intervals=4, degree=3, max_iter=5)
+    root = tmp_path / "sol"
+    rough = D.solve_many({"b": (spec, [("b", real.gait, None)])}, root=root, serial=True, progress=False)["b"]
+    good = D.solve_many({"b": (dataclasses.replace(spec, max_iter=1000), [("b", real.gait, None)])}, root=root,
+                        serial=True, progress=False)["b"]
+    fits = {"hat_com": D.Fit("hat_com", good, {"hat_com": {"d": 0.0}}, L.locate(good, real), 1, "nlp",
+                             "Solve_Succeeded", True)}
+    d0 = D.assemble(real, spec, rough, fits, resamples=0, threshold=1e9)
+    pct = float(d0.ranking.set_index("effect").loc["hat_com", "pct_closed"])
+    assert d0.top_effect == "hat_com" and 0 < pct < 100
+    assert D.assemble(real, spec, rough, fits, resamples=0, threshold=1e9, min_share=pct - 1).top_effect == "hat_com"
+    d2 = D.assemble(real, spec, rough, fits, resamples=0, threshold=1e9, min_share=pct + 1)
+    assert d2.top_effect == "unexplained" and d2.verdict == "unexplained"

@@ -864,3 +864,19 @@ def test_share_floor_replay_by_hand():
     (line,) = G.share_floor_lines({"r0": v})
     assert "closed 15–15 % of their relative gap (c_middle_0 (r0): hip_offset 15 %)" in line
     assert "named right closed 12 % or more (the least: b_large_0, r0)" in line
+
+
+def test_named_at_replays_the_share_floor_of_the_validations_method():
+    """From revision 9 a stored validation's own ``min_share_closed`` is part of the replayed
+    rule: a first-ranked effect below it is "unexplained" at any threshold."""
+    from gaitlib.studies import gap as G
+
+    rows = V.pd.DataFrame({
+        "case": ["a_middle_0", "c_middle_0"], "set": ["independent", "out-of-library"], "band": ["middle", "middle"],
+        "expected": ["knee_offset", "unexplained"], "rank1": ["knee_offset", "hip_offset"],
+        "rank1_dBIC": [-40.0, -35.0], "rank1_pct": [40.0, 15.0], "contenders": [["knee_offset"], ["hip_offset"]],
+        "verdict": ["partial", "unexplained"], "named": ["knee_offset", "unexplained"], "correct": [True, True]})
+    v9 = V.Validation(rows, {}, {"relative": True, "relative_method": {"min_share_closed": 20.0}})
+    v8 = V.Validation(rows, {}, {"relative": True, "relative_method": {}})
+    assert G.named_at(v9, -30)["named"].tolist() == ["knee_offset", "unexplained"]
+    assert G.named_at(v8, -30)["named"].tolist() == ["knee_offset", "hip_offset"]
