@@ -864,6 +864,10 @@ def test_share_floor_replay_by_hand():
     (line,) = G.share_floor_lines({"r0": v})
     assert "closed 15–15 % of their relative gap (c_middle_0 (r0): hip_offset 15 %)" in line
     assert "named right closed 12 % or more (the least: b_large_0, r0)" in line
+    assert "a lead for the next revision" in line
+    (line,) = G.share_floor_lines({"r0": v}, floor=20.0)
+    assert "With a 20 % floor the same rankings give independent, middle + large 1/2 (50 %)" in line
+    assert "out-of-library 1/1 (100 %)" in line and "lead" not in line
 
 
 def test_named_at_replays_the_share_floor_of_the_validations_method():

@@ -844,9 +844,11 @@ def share_floor_sweep(reps: dict, floors=SHARE_FLOORS) -> pd.DataFrame:
     return pd.DataFrame(rows).set_index("share closed ≥ (%)")
 
 
-def share_floor_lines(reps: dict) -> list[str]:
+def share_floor_lines(reps: dict, floor: float | None = None) -> list[str]:
     """What the wrongly named out-of-library cases and the rightly named middle+large
-    injections of ``reps`` closed of their relative gap (stored ``rank1_pct``), in words."""
+    injections of ``reps`` closed of their relative gap (stored ``rank1_pct``), in words; with
+    ``floor`` (a method's ``min_share_closed``), what that floor gives on the same rankings
+    (:func:`share_floor_sweep`) instead of the sentence calling a floor a lead."""
     wrong, right = [], []
     for lab, v in reps.items():
         r = v.rows
@@ -861,8 +863,12 @@ def share_floor_lines(reps: dict) -> list[str]:
             f"{max(float(x['rank1_pct']) for _, x in wrong):.0f} % of their relative gap ("
             + ", ".join(f"{x['case']} ({lab}): {x['named']} {float(x['rank1_pct']):.0f} %" for lab, x in wrong)
             + f"); the middle and large injections named right closed {float(lo[1]['rank1_pct']):.0f} % or more "
-            f"(the least: {lo[1]['case']}, {lo[0]}). A floor on the share closed is a lead for the next revision, "
-            "read here on the draws that suggested it: not adopted, not validated."]
+            f"(the least: {lo[1]['case']}, {lo[0]}). "
+            + ("A floor on the share closed is a lead for the next revision, read here on the draws that suggested "
+               "it: not adopted, not validated." if floor is None else
+               f"With a {floor:g} % floor the same rankings give " + ", ".join(
+                   f"{g} {x}" for g, x in share_floor_sweep(reps, (floor,)).iloc[0].items())
+               + " — on the draws that suggested the floor, so fresh draws are its test.")]
 
 
 def threshold_lines(reps: dict, target: float = 90.0) -> list[str]:
