@@ -765,17 +765,20 @@ def rule_table(v: gval.Validation) -> pd.DataFrame:
 SWEEP_THRESHOLDS = (-10, -20, -30, -40, -50, -60, -80, -100, -150)
 
 
+def _pooled_counts(reps: dict, decide) -> dict:
+    """Target group → [named right, cases] over the validations of ``reps``, each decided again
+    by ``decide(validation)`` (its rows with ``correct`` replaced)."""
+    tot = {g: [0, 0] for g in TARGET_GROUPS}
+    for v in reps.values():
+        for g, (k, n) in _group_counts(decide(v)).items():
+            tot[g][0] += k
+            tot[g][1] += n
+    return tot
+
+
 def _sweep_counts(reps: dict, thresholds=SWEEP_THRESHOLDS) -> dict:
     """threshold → target group → [named right, cases], pooled over ``reps``."""
-    out = {}
-    for t in thresholds:
-        tot = {g: [0, 0] for g in TARGET_GROUPS}
-        for v in reps.values():
-            for g, (k, n) in _group_counts(named_at(v, t)).items():
-                tot[g][0] += k
-                tot[g][1] += n
-        out[t] = tot
-    return out
+    return {t: _pooled_counts(reps, lambda v, t=t: named_at(v, t)) for t in thresholds}
 
 
 def threshold_sweep(reps: dict, thresholds=SWEEP_THRESHOLDS) -> pd.DataFrame:
@@ -834,11 +837,7 @@ def share_floor_sweep(reps: dict, floors=SHARE_FLOORS) -> pd.DataFrame:
     method: a floor chosen here would have to be validated on fresh draws."""
     rows = []
     for f in floors:
-        tot = {g: [0, 0] for g in TARGET_GROUPS}
-        for v in reps.values():
-            for g, (k, n) in _group_counts(with_share_floor(v, f)).items():
-                tot[g][0] += k
-                tot[g][1] += n
+        tot = _pooled_counts(reps, lambda v, f=f: with_share_floor(v, f))
         rows.append({"share closed ≥ (%)": f, **{g: (f"{k}/{n} ({100.0 * k / n:.0f} %)" if n else "—")
                                                   for g, (k, n) in tot.items()}})
     return pd.DataFrame(rows).set_index("share closed ≥ (%)")
