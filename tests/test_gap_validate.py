@@ -884,3 +884,34 @@ def test_named_at_replays_the_share_floor_of_the_validations_method():
     v8 = V.Validation(rows, {}, {"relative": True, "relative_method": {}})
     assert G.named_at(v9, -30)["named"].tolist() == ["knee_offset", "unexplained"]
     assert G.named_at(v8, -30)["named"].tolist() == ["knee_offset", "hip_offset"]
+
+
+def test_share_floor_replay_reads_back_what_the_validations_own_floor_held():
+    """A validation made with a floor (revision 9) stores the held case as "unexplained"; the
+    replay reads it back from the ranking: named again without the floor (0), held again at
+    the floor; a case outside the threshold or with a runner-up in the margin stays
+    "unexplained" at any floor; :func:`floor_held_lines` names the held case and the counts."""
+    from gaitlib.studies import gap as G
+
+    rows = V.pd.DataFrame({
+        "case": ["a_middle_0", "c_middle_0", "d_large_0", "e_large_0"],
+        "set": ["independent", "out-of-library", "out-of-library", "out-of-library"],
+        "band": ["middle", "middle", "large", "large"],
+        "expected": ["knee_offset", "unexplained", "unexplained", "unexplained"],
+        "rank1": ["knee_offset", "hip_offset", "hip_offset", "grf_scale"],
+        "rank1_dBIC": [-60.0, -45.0, -30.0, -80.0], "rank1_pct": [40.0, 15.0, 12.0, 10.0],
+        "threshold_used": [-38.0] * 4,
+        "contenders": [["knee_offset"], ["hip_offset"], ["hip_offset"], ["grf_scale", "body_mass"]],
+        "verdict": ["partial", "unexplained", "unexplained", "unexplained"],
+        "named": ["knee_offset", "unexplained", "unexplained", "unexplained"], "correct": [True, True, True, True]})
+    v9 = V.Validation(rows, {}, {"relative": True, "relative_method": {"min_share_closed": 20.0}})
+    assert G._floor_held(v9).tolist() == [False, True, False, False]
+    assert G.with_share_floor(v9, 0.0)["named"].tolist() == ["knee_offset", "hip_offset", "unexplained", "unexplained"]
+    assert G.with_share_floor(v9, 14.0)["named"].tolist()[1] == "hip_offset"
+    assert G.with_share_floor(v9, 20.0)["named"].tolist() == rows["named"].tolist()
+    sw = G.share_floor_sweep({"r9": v9}, (0.0, 20.0))
+    assert sw.loc[0.0, "out-of-library"] == "2/3 (67 %)" and sw.loc[20.0, "out-of-library"] == "3/3 (100 %)"
+    (line,) = G.floor_held_lines(v9, "revision 9")
+    assert "floor held 1 case" in line and "c_middle_0 (hip_offset, ΔBIC -45, 15 % closed; right answer unexplained)" in line
+    assert "out-of-library 2/3 (67 %) → 3/3 (100 %)" in line
+    assert G.floor_held_lines(V.Validation(rows, {}, {"relative": True, "relative_method": {}}), "r8") == []

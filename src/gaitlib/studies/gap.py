@@ -59,7 +59,7 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "replicate_table", "replicate_lines", "named_at", "rule_table", "threshold_sweep", "ranking_misses", "threshold_lines",
            "threshold_draw_lines", "common_mode_table", "common_mode_lines", "stored_baseline_pair", "baseline_pair_lines", "experiment_draws_table", "stored_candidate_baseline", "candidate_baseline_lines", "null_tail_table", "null_tail_lines", "stored_paired", "paired_lines", "PAIRED", "pair_counts", "case_change_lines",
            "stored_load_confusion", "load_confusion_lines", "LOAD_CONFUSION_FILE", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
-           "SHARE_FLOORS", "with_share_floor", "share_floor_sweep", "share_floor_lines",
+           "SHARE_FLOORS", "with_share_floor", "share_floor_sweep", "floor_held_lines", "share_floor_lines",
            "revision_lines", "stored_experiment", "normative_start_lines", "pair_test_lines",
            "relative_cases", "relative_lines", "relative_magnitudes", "calibration_lines", "consistency_lines", "tie_lines",
            "stored_reference_basin", "reference_basin_lines", "REFERENCE_BASIN_FILE", "stored_baseline_basin",
@@ -372,8 +372,6 @@ VALIDATION_RUNS = {
     "null": "gaitlib gap-validate --set null --derivatives nodes --out benchmarks/results/gap_validation/null",
     "relative": "gaitlib gap-validate --relative --set independent,out-of-library,null --per-band 2 --derivatives nodes "
                 "--out benchmarks/results/gap_validation/relative",
-    "relative_r1": "gaitlib gap-validate --relative --set independent,out-of-library,null --per-band 2 --replicate 1 "
-                   "--derivatives nodes --out benchmarks/results/gap_validation/relative_r1",
 }
 
 
@@ -398,7 +396,8 @@ def stored_validation(name: str = "real") -> gval.Validation:
 #: folder under ``gap_validation`` → the method revision that made it.
 SUPERSEDED_VALIDATIONS = {"real_rev1": 1, "relative_rev0": 0, "relative_rev1": 1, "relative_rev2": 2,
                           "relative_rev3": 3, "relative_rev4": 4, "relative_rev4_r1": 4, "relative_rev5": 5,
-                          "relative_rev6": 6, "relative_rev6_r1": 6, "relative_rev7": 7}
+                          "relative_rev6": 6, "relative_rev6_r1": 6, "relative_rev7": 7, "relative_rev8": 8,
+                          "relative_rev8_r1": 8}
 
 
 def superseded_validation(name: str = "real_rev1") -> gval.Validation:
@@ -817,13 +816,36 @@ def ranking_misses(reps: dict, bands=("middle", "large")) -> pd.DataFrame:
 SHARE_FLOORS = (0.0, 10.0, 15.0, 20.0, 25.0, 30.0)
 
 
+def _floor_held(v: gval.Validation) -> pd.Series:
+    """The cases of ``v`` its own method's share floor (``min_share_closed``, revision 9 on)
+    read "unexplained": the first-ranked effect within the case's threshold (and the fixed
+    :data:`gaitlib.gap.method.BIC_THRESHOLD`), no runner-up within the margin, but closing
+    less than the floor — :func:`gaitlib.gap.diagnose.assemble`'s rule read back from the
+    stored ranking. All False for a validation made without a floor."""
+    r = v.rows
+    floor = float(((v.settings or {}).get("relative_method") or {}).get("min_share_closed", 0.0))
+    if floor <= 0:
+        return pd.Series(False, index=r.index)
+    pct = pd.to_numeric(r["rank1_pct"], errors="coerce")
+    dbic = pd.to_numeric(r["rank1_dBIC"], errors="coerce")
+    thr = pd.to_numeric(r["threshold_used"], errors="coerce").clip(upper=diagnose.BIC_THRESHOLD)
+    lone = r["contenders"].apply(lambda c: len(c) <= 1 if isinstance(c, (list, tuple)) else True)
+    return ((r["named"] == "unexplained") & (r["verdict"] != "baseline failed") & (dbic <= thr) & lone
+            & (pct < floor))
+
+
 def with_share_floor(v: gval.Validation, floor: float) -> pd.DataFrame:
-    """The cases of a relative validation decided again with one more test, post hoc: a named
-    effect that closes less than ``floor`` % of the relative gap (its stored ``rank1_pct``;
-    the named effect is the first-ranked one) is read "unexplained"; everything else as
-    stored. Returns the rows with ``named`` and ``correct`` replaced."""
+    """The cases of a relative validation decided again with another floor on the share of the
+    relative gap the named effect closes, post hoc: a named effect that closes less than
+    ``floor`` % (its stored ``rank1_pct``; the named effect is the first-ranked one) is read
+    "unexplained"; a case the validation's own floor held (:func:`_floor_held`) names its
+    first-ranked effect again if it closes ``floor`` % or more (so 0: the method without a
+    floor); everything else as stored. Returns the rows with ``named`` and ``correct``
+    replaced."""
     r = v.rows.copy()
     pct = pd.to_numeric(r["rank1_pct"], errors="coerce")
+    back = _floor_held(v) & (pct >= floor)
+    r.loc[back, "named"] = r.loc[back, "rank1"]
     held = (r["named"] != "unexplained") & (r["named"] == r["rank1"]) & (pct < floor)
     r.loc[held, "named"] = "unexplained"
     r["correct"] = [n in str(e).split("|") for n, e in zip(r["named"], r["expected"])]
@@ -868,6 +890,26 @@ def share_floor_lines(reps: dict, floor: float | None = None) -> list[str]:
                f"With a {floor:g} % floor the same rankings give " + ", ".join(
                    f"{g} {x}" for g, x in share_floor_sweep(reps, (floor,)).iloc[0].items())
                + " — on the draws that suggested the floor, so fresh draws are its test.")]
+
+
+def floor_held_lines(v: gval.Validation, label: str) -> list[str]:
+    """What ``v``'s own share floor did on its draws, in words: the cases it read
+    "unexplained" (:func:`_floor_held`; first-ranked effect, ΔBIC, % closed, the right
+    answer) and each target group's count without the floor and with it."""
+    floor = float(((v.settings or {}).get("relative_method") or {}).get("min_share_closed", 0.0))
+    if floor <= 0:
+        return []
+    held = v.rows[_floor_held(v)]
+    sw = share_floor_sweep({label: v}, (0.0, floor))
+    counts = "; ".join(f"{g} {sw.iloc[0][g]} → {sw.iloc[1][g]}" for g in sw.columns)
+    if held.empty:
+        return [f"On {label}'s draws the {floor:g} % floor held no case: every named effect closed more."]
+    return [f"On {label}'s draws the {floor:g} % floor held {len(held)} case{'s' if len(held) > 1 else ''} "
+            "(read \"unexplained\" though ranked first within the threshold): "
+            + "; ".join(f"{x['case']} ({x['rank1']}, ΔBIC {float(x['rank1_dBIC']):.0f}, "
+                        f"{float(x['rank1_pct']):.0f} % closed; right answer {x['expected']})"
+                        for _, x in held.iterrows())
+            + f". Without the floor → with it: {counts}."]
 
 
 def threshold_lines(reps: dict, target: float = 90.0) -> list[str]:
@@ -2001,7 +2043,7 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
              null_tail: dict | None = None, valr_now_reps: dict | None = None, common_mode: dict | None = None,
              ref_pair: tuple | None = None, baseline_pair: dict | None = None,
              candidate_baseline: dict | None = None, pair_rev8: tuple | None = None,
-             current_reps: dict | None = None) -> list[str]:
+             current_reps: dict | None = None, floor_reps: dict | None = None) -> list[str]:
     """The chapter's findings as Markdown paragraphs, every number and verdict from the
     results: the twin checks (``tv`` on the coarse mesh, :func:`twin_validation`;
     ``tv_full`` on 20 × 5, :func:`twin_validation_full_mesh`), the SK diagnoses of Schwartz
@@ -2030,8 +2072,11 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     (:func:`candidate_baseline_lines`);
     ``pair_rev8``: (revision 7's validation, its draws with revision 8's fallback and lower
     located pair or None, :func:`paired_lines`);
-    ``current_reps``: the current revision's replicates (label → validation,
-    :func:`replicate_lines`, :func:`threshold_lines`);
+    ``current_reps``: the latest revision's replicates (label → validation,
+    :func:`replicate_lines`, :func:`threshold_lines`; "the method in use" when they are
+    :data:`gaitlib.gap.method.RELATIVE`'s); ``floor_reps``: the earlier revision's replicates
+    the share floor :attr:`gaitlib.gap.method.RelativeMethod.min_share_closed` was chosen on
+    (:func:`share_floor_lines` at that floor);
     ``tv_muscle``: the muscle-level twins (:func:`muscle_twin_validation`)."""
     s, sf = tv.summary(), tv_full.summary()
     acc = tv.accuracy()
@@ -2093,7 +2138,9 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
         out.append(f"**The relative method's threshold rule** (revision {valr.settings['relative_method']['revision']}"
                    f"): on its own cases, " + "; ".join(
                        f"{lab}: ΔBIC ≤ {r['threshold (ΔBIC ≤)']:.0f}, {g} {r[g]}, out-of-library {r['out-of-library']}"
-                       for lab, r in rt.iterrows()) + ".")
+                       for lab, r in rt.iterrows()) + "."
+                   + "".join(" " + x for x in floor_held_lines(
+                       valr, f"revision {valr.settings['relative_method']['revision']}")))
     if valr_reps is not None and len(valr_reps) > 1:
         rev = next(iter(valr_reps.values())).settings["relative_method"]["revision"]
         out.append(f"**Revision {rev} on a second set of draws.** " + " ".join(replicate_lines(valr_reps))
@@ -2119,8 +2166,13 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
                    + " ".join(paired_lines(*pair_rev8, PAIRED["lowest_pair_rev7"])))
     if current_reps is not None and len(current_reps) > 1:
         rev = next(iter(current_reps.values())).settings["relative_method"]["revision"]
-        out.append(f"**Revision {rev}, the method in use, on two sets of draws.** " + " ".join(replicate_lines(current_reps))
+        now = ", the method in use," if rev == gap_method.RELATIVE.revision else ""
+        out.append(f"**Revision {rev}{now} on two sets of draws.** " + " ".join(replicate_lines(current_reps))
                    + " " + " ".join(threshold_lines(current_reps)))
+    if floor_reps:
+        rev = next(iter(floor_reps.values())).settings["relative_method"]["revision"]
+        out.append(f"**The share floor, replayed on revision {rev}'s two sets of draws.** "
+                   + " ".join(share_floor_lines(floor_reps, floor=gap_method.RELATIVE.min_share_closed)))
     if baseline_pair is not None:
         out.append("**What remains of the common mode.** " + " ".join(baseline_pair_lines(baseline_pair))
                    + (" " + " ".join(candidate_baseline_lines(candidate_baseline)) if candidate_baseline else ""))
