@@ -219,7 +219,7 @@ def test_a_null_draw_is_the_reference_plus_its_sampling_error(ref):
 def test_the_relative_method_names_itself_and_the_absolute_one():
     from gaitlib.gap import method as M
 
-    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 8 and M.RELATIVE.baseline_fallback and M.RELATIVE.lowest_pair and M.RELATIVE.tilt_channel and M.RELATIVE.reference_rounds >= 1
+    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 9 and M.RELATIVE.min_share_closed > 0 and M.RELATIVE.baseline_fallback and M.RELATIVE.lowest_pair and M.RELATIVE.tilt_channel and M.RELATIVE.reference_rounds >= 1
     h = M.RELATIVE.hash()
     assert len(h) == 16 and h != M.METHOD.hash()
     assert M.RelativeMethod(null_draws=3).hash() != h and M.RelativeMethod(null_rank=1).hash() != h
