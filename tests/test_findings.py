@@ -420,3 +420,17 @@ def test_thesis_guess_runs_beside_the_page_runs():
     assert len(lines) == 4 and lines[3].endswith("not converged: NMSK SP3 (Maximum_Iterations_Exceeded).")
     assert list(tab.index) == ["MSK DT", "MSK SP3", "NMSK DT", "NMSK SP3"]
     assert list(tab.columns) == pr.START_COLUMNS
+
+
+def test_diagnosis_text_says_when_the_share_floor_held_the_top_effect():
+    """A relative diagnosis whose first-ranked effect passed the threshold alone but closed
+    less than the share floor reads "unexplained" with that reason, not "no candidate passes"."""
+    s = {"top": "unexplained", "verdict": "unexplained", "best": "hip_offset", "best_pct": 18.2, "best_dBIC": -41.7,
+         "contenders": ["hip_offset"], "held_by_share_floor": "hip_offset", "min_share_closed": 20.0}
+    t = G._diagnosis_text(s, full=True)
+    assert t.startswith("No candidate explains enough of the change: **unexplained** (best hip_offset, 18 % closed, "
+                        "ΔBIC = -41.7")
+    assert t.endswith("hip_offset passes the threshold but closes less than the 20 % of the gap a named effect must "
+                      "close).")
+    s.update(held_by_share_floor=None)
+    assert G._diagnosis_text(s, full=True).startswith("No candidate passes the criterion")

@@ -234,6 +234,9 @@ def test_min_share_holds_a_top_effect_that_closes_too_little(tmp_path, real):
     d0 = D.assemble(real, spec, rough, fits, resamples=0, threshold=1e9)
     pct = float(d0.ranking.set_index("effect").loc["hat_com", "pct_closed"])
     assert d0.top_effect == "hat_com" and 0 < pct < 100
-    assert D.assemble(real, spec, rough, fits, resamples=0, threshold=1e9, min_share=pct - 1).top_effect == "hat_com"
+    d1 = D.assemble(real, spec, rough, fits, resamples=0, threshold=1e9, min_share=pct - 1)
+    assert d1.top_effect == "hat_com" and d1.settings["held_by_share_floor"] is None
     d2 = D.assemble(real, spec, rough, fits, resamples=0, threshold=1e9, min_share=pct + 1)
     assert d2.top_effect == "unexplained" and d2.verdict == "unexplained"
+    assert d2.settings["held_by_share_floor"] == "hat_com" and d2.settings["min_share_closed"] == pct + 1
+    assert json.loads(json.dumps(d2.to_dict(), default=str))["settings"]["held_by_share_floor"] == "hat_com"

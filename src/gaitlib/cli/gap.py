@@ -88,7 +88,9 @@ def cmd_gap(args) -> int:
     if calib is not None:  # the relative diagnosis's null calibration
         summary.update(null_draws=calib["draws"], null_lowest_dBIC=calib["lowest_dBIC"],
                        null_rank=calib.get("rank", 1),
-                       threshold_used=d.settings.get("threshold_used"))
+                       threshold_used=d.settings.get("threshold_used"),
+                       min_share_closed=d.settings.get("min_share_closed"),
+                       held_by_share_floor=d.settings.get("held_by_share_floor"))
     print(json.dumps(summary, indent=1))
     print(f"wrote {out / 'diagnosis.json'}")
     failed = [(f.effect, f.status) for f in d.fits.values() if not f.ok]

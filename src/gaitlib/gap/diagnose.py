@@ -361,7 +361,8 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
     effect must reach (default :data:`BIC_THRESHOLD`; a relative diagnosis's null
     calibration lowers it). ``min_share``: the % of the located RSS the top effect must also
     close to be named (a relative diagnosis: :attr:`gaitlib.gap.method.RelativeMethod.
-    min_share_closed`; 0: no such test) — below it the diagnosis is "unexplained"."""
+    min_share_closed`; 0: no such test) — below it the diagnosis is "unexplained", and the
+    settings' ``held_by_share_floor`` names the effect it held."""
     thr = BIC_THRESHOLD if threshold is None else float(threshold)
     loc0 = locate.locate(base_sol, ds)
     n_eff = loc0.n_eff
@@ -403,11 +404,14 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
         ranking.insert(0, "rank", rank)
     elig = ranking[(ranking["ok"]) & (ranking["dBIC"] <= thr)] if not ranking.empty else ranking
     contenders = contenders_of(ranking)
+    held = None  # the top effect the share floor held, if it did
     if len(elig) and len(contenders) <= 1 and float(elig.iloc[0]["pct_closed"]) >= min_share:
         top_effect = str(elig.iloc[0]["effect"])
         verdict = "explained" if float(elig.iloc[0]["pct_closed"]) >= EXPLAINED_PCT else "partial"
     else:
         top_effect, verdict = "unexplained", "unexplained"
+        if len(elig) and len(contenders) <= 1:
+            held = str(elig.iloc[0]["effect"])
     # shrink tables and intervals for the top effects
     shrink, intervals = {}, {}
     tops = [r["effect"] for _, r in ranking.iterrows() if r["ok"] and np.isfinite(r["dBIC"])][:top]
@@ -431,6 +435,7 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
     st = dict(settings or {})
     st.update({"resamples": resamples, "seed": seed, "bic_threshold": BIC_THRESHOLD, "threshold_used": thr,
                "runner_up_margin": RUNNER_UP_MARGIN, "contenders": contenders if len(elig) else [],
+               "min_share_closed": float(min_share), "held_by_share_floor": held,
                "method": METHOD.to_dict(), "method_hash": METHOD.hash()})
     return Diagnosis(ds, spec0, objective, base_sol, loc0, fits, ranking, top_effect, verdict, shrink, intervals,
                      dict(skipped or {}), st, sol_loc)

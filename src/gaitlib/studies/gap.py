@@ -340,6 +340,8 @@ def summary(diag: diagnose.Diagnosis) -> dict:
         if len(ok) > 1:
             s.update(second=str(ok.iloc[1]["effect"]), second_dBIC=float(ok.iloc[1]["dBIC"]))
     s["contenders"] = list(diag.settings.get("contenders", []))
+    s["held_by_share_floor"] = diag.settings.get("held_by_share_floor")
+    s["min_share_closed"] = diag.settings.get("min_share_closed", 0.0)
     return s
 
 
@@ -2003,6 +2005,11 @@ def _diagnosis_text(s: dict, full: bool) -> str:
         return (f"the diagnosis names **{s['top']}** ({s['verdict']}, {s['best_pct']:.0f} % closed, "
                 f"interval {s['interval'][0]:.0f}–{s['interval'][1]:.0f} %).")
     what = f"best {s['best']}, {s['best_pct']:.0f} % closed, ΔBIC = {s['best_dBIC']:.1f}; threshold {diagnose.BIC_THRESHOLD:g}"
+    if s.get("held_by_share_floor"):  # a relative diagnosis's share floor (revision 9 on)
+        why = (f"{s['best']} passes the threshold but closes less than the {s['min_share_closed']:g} % of the gap "
+               "a named effect must close")
+        return (f"No candidate explains enough of the change: **unexplained** ({what}; {why})." if full
+                else f"**unexplained** ({what}; {why}).")
     if len(s.get("contenders", [])) > 1:  # passes the threshold, but does not stand out
         others = ", ".join(s["contenders"][1:])
         why = (f"{s['best']} passes the threshold but not the out-of-library test: {others} "
