@@ -708,6 +708,12 @@ def replicate_table(reps: dict) -> pd.DataFrame:
     return pd.DataFrame(rows).set_index("group")
 
 
+def _stored_floor(v: gval.Validation) -> float:
+    """The share floor (%) of the relative method that made ``v`` (``min_share_closed``,
+    revision 9 on); 0 for a validation made without one."""
+    return float(((v.settings or {}).get("relative_method") or {}).get("min_share_closed", 0.0))
+
+
 def named_at(v: gval.Validation, threshold: float) -> pd.DataFrame:
     """The cases of a relative validation decided again at another threshold: a case names
     its first-ranked effect if that effect's ΔBIC is at or below ``threshold`` (and the fixed
@@ -718,7 +724,7 @@ def named_at(v: gval.Validation, threshold: float) -> pd.DataFrame:
     threshold). Returns
     the rows with ``named`` and ``correct`` replaced; a failed baseline stays as stored."""
     thr = min(diagnose.BIC_THRESHOLD, float(threshold))
-    floor = float(((v.settings or {}).get("relative_method") or {}).get("min_share_closed", 0.0))
+    floor = _stored_floor(v)
     r = v.rows.copy()
 
     def one(row):
@@ -827,7 +833,7 @@ def _floor_held(v: gval.Validation) -> pd.Series:
     less than the floor — :func:`gaitlib.gap.diagnose.assemble`'s rule read back from the
     stored ranking. All False for a validation made without a floor."""
     r = v.rows
-    floor = float(((v.settings or {}).get("relative_method") or {}).get("min_share_closed", 0.0))
+    floor = _stored_floor(v)
     if floor <= 0:
         return pd.Series(False, index=r.index)
     pct = pd.to_numeric(r["rank1_pct"], errors="coerce")
@@ -900,7 +906,7 @@ def floor_held_lines(v: gval.Validation, label: str) -> list[str]:
     """What ``v``'s own share floor did on its draws, in words: the cases it read
     "unexplained" (:func:`_floor_held`; first-ranked effect, ΔBIC, % closed, the right
     answer) and each target group's count without the floor and with it."""
-    floor = float(((v.settings or {}).get("relative_method") or {}).get("min_share_closed", 0.0))
+    floor = _stored_floor(v)
     if floor <= 0:
         return []
     held = v.rows[_floor_held(v)]
