@@ -240,3 +240,29 @@ def test_min_share_holds_a_top_effect_that_closes_too_little(tmp_path, real):
     assert d2.top_effect == "unexplained" and d2.verdict == "unexplained"
     assert d2.settings["held_by_share_floor"] == "hat_com" and d2.settings["min_share_closed"] == pct + 1
     assert json.loads(json.dumps(d2.to_dict(), default=str))["settings"]["held_by_share_floor"] == "hat_com"
+
+
+def test_centred_decides_on_the_top_effect_minus_the_median_candidate(tmp_path, real):
+    """``assemble(centred=True)`` (the relative method's ``centred``, revision 10): the top
+    effect must reach :data:`BIC_THRESHOLD` raw and ``threshold`` after the median ranked
+    candidate's ΔBIC is subtracted. Two candidates: the fitted one and one that changes
+    nothing (the baseline itself, ΔBIC = ln n_eff); the median is their mean, so the centred
+    statistic is half their difference, computed here from the ranking."""
+    spec = gait_ocp.GaitSpec(model="SK", cost="DT", n_intervals=4, degree=3, max_iter=5)
+    root = tmp_path / "sol"
+    rough = D.solve_many({"b": (spec, [("b", real.gait, None)])}, root=root, serial=True, progress=False)["b"]
+    good = D.solve_many({"b": (dataclasses.replace(spec, max_iter=1000), [("b", real.gait, None)])}, root=root,
+                        serial=True, progress=False)["b"]
+    fits = {"hat_com": D.Fit("hat_com", good, {"hat_com": {"d": 0.0}}, L.locate(good, real), 1, "nlp",
+                             "Solve_Succeeded", True),
+            "hip_offset": D.Fit("hip_offset", rough, {"hip_offset": {"d": 0.0}}, L.locate(rough, real), 1, "nlp",
+                                "Solve_Succeeded", True)}
+    d0 = D.assemble(real, spec, rough, fits, resamples=0, threshold=-10.0)
+    b = d0.ranking.set_index("effect")["dBIC"].astype(float)
+    assert b["hat_com"] <= D.BIC_THRESHOLD and abs(b["hip_offset"] - np.log(d0.located.n_eff)) < 1e-9
+    half = (b["hat_com"] - b["hip_offset"]) / 2.0
+    assert d0.top_effect == "hat_com" and not d0.settings["centred"] and d0.settings["median_dBIC"] is None
+    d1 = D.assemble(real, spec, rough, fits, resamples=0, threshold=half + 1.0, centred=True)
+    assert d1.top_effect == "hat_com" and abs(d1.settings["median_dBIC"] - (b["hat_com"] + b["hip_offset"]) / 2) < 1e-9
+    d2 = D.assemble(real, spec, rough, fits, resamples=0, threshold=half - 1.0, centred=True)
+    assert d2.top_effect == "unexplained" and d2.settings["centred"]

@@ -219,7 +219,7 @@ def test_a_null_draw_is_the_reference_plus_its_sampling_error(ref):
 def test_the_relative_method_names_itself_and_the_absolute_one():
     from gaitlib.gap import method as M
 
-    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 9 and M.RELATIVE.min_share_closed > 0 and M.RELATIVE.baseline_fallback and M.RELATIVE.lowest_pair and M.RELATIVE.tilt_channel and M.RELATIVE.reference_rounds >= 1
+    assert M.RELATIVE.null_draws >= 1 and M.RELATIVE.revision == 10 and M.RELATIVE.min_share_closed > 0 and M.RELATIVE.baseline_fallback and M.RELATIVE.lowest_pair and M.RELATIVE.tilt_channel and M.RELATIVE.reference_rounds >= 1
     h = M.RELATIVE.hash()
     assert len(h) == 16 and h != M.METHOD.hash()
     assert M.RelativeMethod(null_draws=3).hash() != h and M.RelativeMethod(null_rank=1).hash() != h
@@ -596,3 +596,20 @@ def test_the_null_draws_are_located_on_the_lower_pair_as_the_data_are(ref, monke
                              method=M.RelativeMethod(null_draws=2, lowest_pair=False), **kw)
     assert "pairs" not in seen and seen["located"] == [("Rfinal", "Nfinal", None)] * 2
     assert out["baseline_pair"] == {}
+
+
+def test_the_centred_statistic_cancels_a_shift_shared_by_every_candidate():
+    """Revision 10's statistic by hand: a draw's lowest ΔBIC minus its median candidate's
+    (the mean of the middle two for an even count). A draw where every candidate gained alike
+    (the common mode) has a low raw statistic and a small centred one; the centred threshold
+    is the rank-th lowest centred statistic."""
+    from gaitlib.gap import method as M
+
+    common = {"a": -600.0, "b": -590.0, "c": -585.0, "d": -580.0}  # median -587.5
+    one = {"a": -40.0, "b": -2.0, "c": 1.0}  # median -2
+    assert M.draw_statistic(common) == -600.0 and M.draw_statistic(common, True) == -12.5
+    assert M.draw_statistic(one, True) == -38.0 and M.draw_statistic({}, True) is None
+    per = [common, one, {}, {"a": -5.0, "b": 0.0}]  # centred: -12.5, -38, -2.5
+    assert M.null_threshold(per, 2) == -40.0 and M.null_threshold(per, 2, centred=True) == -12.5
+    assert M.null_threshold(per, 1, centred=True) == -38.0
+    assert M.RELATIVE.centred and M.RelativeMethod(centred=False).hash() != M.RELATIVE.hash()

@@ -349,7 +349,7 @@ def nesting(name: str) -> tuple[bool, str]:
 
 def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", resamples: int = 200, seed: int = 0,
              top: int = 3, skipped=None, settings=None, solution=None, threshold: float | None = None,
-             min_share: float = 0.0) -> Diagnosis:
+             min_share: float = 0.0, centred: bool = False) -> Diagnosis:
     """Rank fitted candidates against the baseline fit and build the :class:`Diagnosis`.
 
     Ranked (``rank`` 1, 2, …, by ΔBIC): candidates with a located fit whose ``search`` is
@@ -362,7 +362,10 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
     calibration lowers it). ``min_share``: the % of the located RSS the top effect must also
     close to be named (a relative diagnosis: :attr:`gaitlib.gap.method.RelativeMethod.
     min_share_closed`; 0: no such test) — below it the diagnosis is "unexplained", and the
-    settings' ``held_by_share_floor`` names the effect it held."""
+    settings' ``held_by_share_floor`` names the effect it held. ``centred`` (a relative
+    diagnosis: :attr:`gaitlib.gap.method.RelativeMethod.centred`): the top effect's ΔBIC must
+    reach :data:`BIC_THRESHOLD`, and its ΔBIC minus the median ranked candidate's (settings
+    ``median_dBIC``) must reach ``threshold``."""
     thr = BIC_THRESHOLD if threshold is None else float(threshold)
     loc0 = locate.locate(base_sol, ds)
     n_eff = loc0.n_eff
@@ -402,7 +405,16 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
         m = int(ranked.sum())
         rank[:m] = np.arange(1, m + 1)
         ranking.insert(0, "rank", rank)
-    elig = ranking[(ranking["ok"]) & (ranking["dBIC"] <= thr)] if not ranking.empty else ranking
+    med = None  # the median ranked candidate's ΔBIC (centred)
+    if ranking.empty:
+        elig = ranking
+    elif centred:
+        dbic = ranking["dBIC"].astype(float)
+        ranked = ranking["ok"].astype(bool) & np.isfinite(dbic)
+        med = float(np.median(dbic[ranked])) if ranked.any() else None
+        elig = ranking[ranked & (dbic <= BIC_THRESHOLD) & (dbic - med <= thr)] if med is not None else ranking[ranked]
+    else:
+        elig = ranking[(ranking["ok"]) & (ranking["dBIC"] <= thr)]
     contenders = contenders_of(ranking)
     held = None  # the top effect the share floor held, if it did
     if len(elig) and len(contenders) <= 1 and float(elig.iloc[0]["pct_closed"]) >= min_share:
@@ -436,6 +448,7 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
     st.update({"resamples": resamples, "seed": seed, "bic_threshold": BIC_THRESHOLD, "threshold_used": thr,
                "runner_up_margin": RUNNER_UP_MARGIN, "contenders": contenders if len(elig) else [],
                "min_share_closed": float(min_share), "held_by_share_floor": held,
+               "centred": bool(centred), "median_dBIC": med,
                "method": METHOD.to_dict(), "method_hash": METHOD.hash()})
     return Diagnosis(ds, spec0, objective, base_sol, loc0, fits, ranking, top_effect, verdict, shrink, intervals,
                      dict(skipped or {}), st, sol_loc)
@@ -896,10 +909,10 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
                                          root=root, use_cache=use_cache, scheduler=scheduler,
                                          **kw) if RELATIVE.null_draws > 0 else None
     fits = all_fits["data"]
-    threshold, min_share = None, 0.0
+    threshold, min_share, centred = None, 0.0, False
     if ref is not None:
         alternates = None
-        min_share = RELATIVE.min_share_closed
+        min_share, centred = RELATIVE.min_share_closed, RELATIVE.centred
         if RELATIVE.lowest_pair:  # each model's located pair: the final or the continuation, the lower
             pair, ref_fit, base_sol = lowest_baseline_pair(ds, ref, [("final", ref_fit, base_sol),
                                                                      ("continuation", ref_fit_start, base_cont)])
@@ -915,7 +928,7 @@ def diagnose(data, *, base=None, effects=None, objective: str = "fit", warm=None
             threshold = min(BIC_THRESHOLD, t)
     settings = {"objective": objective, "candidates": names, "warm": warm is not None, "reference": ref_info}
     d = assemble(ds, spec0, base_sol, fits, objective=objective, resamples=resamples, seed=seed, skipped=skipped,
-                 settings=settings, solution=solution, threshold=threshold, min_share=min_share)
+                 settings=settings, solution=solution, threshold=threshold, min_share=min_share, centred=centred)
     d.reference_fit = ref_fit
     return d
 
@@ -939,7 +952,7 @@ def null_calibration(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, names, n:
     and every ranked candidate's ΔBIC kept. Returns ``{"draws", "seeds", "n_subjects",
     "best" (per draw: its first-ranked effect, ΔBIC and located pair, or its failure), "dBIC" (per draw:
     effect → ΔBIC), "lowest_dBIC" (over draws and candidates; None if no draw was ranked),
-    "rank" and "threshold_dBIC" (:func:`gaitlib.gap.method.null_threshold`),
+    "rank", "centred" and "threshold_dBIC" (:func:`gaitlib.gap.method.null_threshold`),
     "baseline_failed" (draws none of whose baseline fits converged), "baseline_fallback" (draw →
     the fallback start of a failed continuation) and "baseline_pair" (draw → the baseline's
     located pair, ``method.lowest_pair``)}``."""
@@ -982,7 +995,8 @@ def null_calibration(spec0, ref: gio.DataSet, ref_fit, ref_fits: dict, names, n:
             "candidates": list(names), "draws": method.null_draws, "seeds": seeds, "n_subjects": n, "best": best,
             "dBIC": per,
             "lowest_dBIC": min(vals) if vals else None, "rank": method.null_rank,
-            "threshold_dBIC": null_threshold(per, method.null_rank),
+            "threshold_dBIC": null_threshold(per, method.null_rank, method.centred),
+            "centred": method.centred,
             "baseline_failed": [b["draw"] for b in best if b["effect"] == "baseline failed"],
             "baseline_fallback": fallback,
             "baseline_pair": pairs,  # RELATIVE.lowest_pair: per draw, the baseline's located pair
