@@ -915,3 +915,39 @@ def test_share_floor_replay_reads_back_what_the_validations_own_floor_held():
     assert "floor held 1 case" in line and "c_middle_0 (hip_offset, ΔBIC -45, 15 % closed; right answer unexplained)" in line
     assert "out-of-library 2/3 (67 %) → 3/3 (100 %)" in line
     assert G.floor_held_lines(V.Validation(rows, {}, {"relative": True, "relative_method": {}}), "r8") == []
+
+
+def test_the_centred_replay_decides_on_the_top_effect_minus_the_median_candidate():
+    """Revision 10's statistic replayed on stored rankings, by hand: a case whose candidates
+    all gained alike (the common mode) passes a raw threshold but not the centred one; a case
+    where one effect stands out passes both; the runner-up margin is recomputed from the
+    ranking (the stored contenders are empty where nothing passed the case's threshold), and
+    the calibration's thresholds come from its null draws on each statistic."""
+    from gaitlib.studies import gap as G
+
+    common = {"grf_scale": -300.0, "body_mass": -280.0, "hip_offset": -270.0}  # median -280: centred -20
+    alone = {"knee_offset": -60.0, "hip_offset": -5.0, "grf_scale": 0.0}  # median -5: centred -55
+    tied = {"grf_scale": -100.0, "body_mass": -95.0, "hip_offset": 0.0}  # runner-up within 10
+    rows = V.pd.DataFrame({
+        "case": ["a_middle_0", "b_middle_0", "c_large_0"], "set": ["independent", "out-of-library", "independent"],
+        "band": ["middle", "middle", "large"], "expected": ["knee_offset", "unexplained", "body_mass"],
+        "rank1": ["knee_offset", "grf_scale", "grf_scale"], "rank1_dBIC": [-60.0, -300.0, -100.0],
+        "rank1_pct": [40.0, 70.0, 50.0], "dBIC": [alone, common, tied], "contenders": [[], [], []],
+        "verdict": ["unexplained"] * 3, "named": ["unexplained"] * 3, "correct": [False, True, False]})
+    null = [{"a": -50.0, "b": -20.0, "c": -25.0}, {"a": -8.0, "b": 0.0, "c": 1.0}, {"a": -30.0, "b": 2.0, "c": 0.0}]
+    # raw statistics -50, -8, -30 (second lowest -30); centred -25, -8, -30 (second lowest -25)
+    v = V.Validation(rows, {"null_calibration": {"dBIC": null, "rank": 2, "threshold_dBIC": -30.0}},
+                     {"relative": True, "relative_method": {"min_share_closed": 20.0}})
+    assert G.case_statistic(v).tolist() == [-60.0, -300.0, -100.0]
+    assert G.case_statistic(v, centred=True).tolist() == [-55.0, -20.0, -5.0]
+    assert G._lone(v).tolist() == [True, True, False]
+    assert G.centred_threshold(v) == -25.0 and G.calibration_threshold(v) == -30.0
+    assert G.named_at(v, -30.0)["named"].tolist() == ["knee_offset", "grf_scale", "unexplained"]
+    assert G.named_at(v, -30.0, centred=True)["named"].tolist() == ["knee_offset", "unexplained", "unexplained"]
+    assert G.named_at(v, -30.0, centred=True, floor=50.0)["named"].tolist() == ["unexplained"] * 3
+    t = G.centred_replay({"r": v})
+    assert t.loc[("r", "raw ΔBIC"), "out-of-library"] == "0/1" and t.loc[("r", "centred"), "out-of-library"] == "1/1"
+    assert t.loc[("r", "centred"), "threshold"] == -25.0 and t.loc[("r", "raw ΔBIC"), "threshold"] == -30.0
+    assert t.loc[("r", "centred"), "independent, middle + large"] == "1/2"  # c: runner-up within the margin
+    (line,) = G.centred_lines({"r": v})
+    assert "out-of-library 0/1 (0 %) → 1/1 (100 %)" in line and "b_middle_0" not in line.split("to a wrong one")[-1]

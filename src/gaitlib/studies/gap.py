@@ -55,7 +55,8 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "book_gaps", "twin_validation_full_mesh", "twin_full_mesh_lines", "twin_full_mesh_verdict",
            "left_leg_flips", "co_contraction_text", "findings",
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
-           "VALIDATION_RUNS", "stored_validation", "calibration_threshold", "wilson", "TARGET_GROUPS",
+           "VALIDATION_RUNS", "stored_validation", "calibration_threshold", "centred_threshold", "centred_replay",
+           "centred_lines", "case_statistic", "wilson", "TARGET_GROUPS",
            "replicate_table", "replicate_lines", "named_at", "rule_table", "threshold_sweep", "ranking_misses", "threshold_lines",
            "threshold_draw_lines", "common_mode_table", "common_mode_lines", "stored_baseline_pair", "baseline_pair_lines", "experiment_draws_table", "stored_candidate_baseline", "candidate_baseline_lines", "null_tail_table", "null_tail_lines", "stored_paired", "paired_lines", "PAIRED", "pair_counts", "case_change_lines",
            "stored_load_confusion", "load_confusion_lines", "LOAD_CONFUSION_FILE", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
@@ -374,8 +375,6 @@ VALIDATION_RUNS = {
     "null": "gaitlib gap-validate --set null --derivatives nodes --out benchmarks/results/gap_validation/null",
     "relative": "gaitlib gap-validate --relative --set independent,out-of-library,null --per-band 2 --derivatives nodes "
                 "--out benchmarks/results/gap_validation/relative",
-    "relative_r1": "gaitlib gap-validate --relative --set independent,out-of-library,null --per-band 2 --replicate 1 "
-                   "--derivatives nodes --out benchmarks/results/gap_validation/relative_r1",
 }
 
 
@@ -401,7 +400,7 @@ def stored_validation(name: str = "real") -> gval.Validation:
 SUPERSEDED_VALIDATIONS = {"real_rev1": 1, "relative_rev0": 0, "relative_rev1": 1, "relative_rev2": 2,
                           "relative_rev3": 3, "relative_rev4": 4, "relative_rev4_r1": 4, "relative_rev5": 5,
                           "relative_rev6": 6, "relative_rev6_r1": 6, "relative_rev7": 7, "relative_rev8": 8,
-                          "relative_rev8_r1": 8}
+                          "relative_rev8_r1": 8, "relative_rev9": 9, "relative_rev9_r1": 9}
 
 
 def superseded_validation(name: str = "real_rev1") -> gval.Validation:
@@ -714,30 +713,135 @@ def _stored_floor(v: gval.Validation) -> float:
     return float(((v.settings or {}).get("relative_method") or {}).get("min_share_closed", 0.0))
 
 
-def named_at(v: gval.Validation, threshold: float) -> pd.DataFrame:
+def _centred(v: gval.Validation) -> bool:
+    """Whether the relative method that made ``v`` decided on the centred statistic
+    (:attr:`gaitlib.gap.method.RelativeMethod.centred`, revision 10 on)."""
+    return bool(((v.settings or {}).get("relative_method") or {}).get("centred", False))
+
+
+def _ranked(x) -> dict:
+    """A stored case's ranked candidates' ΔBIC (``{effect: ΔBIC}``; {} if none was ranked)."""
+    return {str(k): float(b) for k, b in x.items()} if isinstance(x, dict) else {}
+
+
+def case_statistic(v: gval.Validation, centred: bool | None = None) -> pd.Series:
+    """Per case of a relative validation, the statistic its first-ranked effect is held to the
+    threshold with (:func:`gaitlib.gap.method.draw_statistic` of the stored ranking): its
+    ΔBIC, or with ``centred`` its ΔBIC minus the median ranked candidate's (None: as the
+    validation's own method decided). Without a stored ranking, the raw statistic is the
+    stored ``rank1_dBIC`` and the centred one NaN."""
+    c = _centred(v) if centred is None else centred
+    r = v.rows
+    raw = pd.to_numeric(r["rank1_dBIC"], errors="coerce")
+    per = r["dBIC"] if "dBIC" in r else pd.Series([None] * len(r), index=r.index)
+    return pd.Series([gap_method.draw_statistic(_ranked(x), c) if _ranked(x) else (np.nan if c else b)
+                      for x, b in zip(per, raw)], index=r.index, dtype=float)
+
+
+def _lone(v: gval.Validation) -> pd.Series:
+    """Per case, whether no runner-up is within :data:`gaitlib.gap.method.RUNNER_UP_MARGIN` of
+    the first-ranked effect — recomputed from the stored ranking (the stored ``contenders``
+    are empty where nothing passed the case's own threshold, so they do not hold at another);
+    without a stored ranking, from the stored ``contenders``."""
+    def one(x, c):
+        d = _ranked(x)
+        if not d:
+            return len(c) <= 1 if isinstance(c, (list, tuple)) else True
+        return len(diagnose.contenders_of(pd.DataFrame({"effect": list(d), "dBIC": list(d.values()),
+                                                        "ok": True}))) <= 1
+    r = v.rows
+    per = r["dBIC"] if "dBIC" in r else [None] * len(r)
+    cont = r["contenders"] if "contenders" in r else [None] * len(r)
+    return pd.Series([one(x, c) for x, c in zip(per, cont)], index=r.index, dtype=bool)
+
+
+def named_at(v: gval.Validation, threshold: float, centred: bool | None = None,
+             floor: float | None = None) -> pd.DataFrame:
     """The cases of a relative validation decided again at another threshold: a case names
-    its first-ranked effect if that effect's ΔBIC is at or below ``threshold`` (and the fixed
-    :data:`gaitlib.gap.method.BIC_THRESHOLD`) and no runner-up is within the margin (its
-    stored ``contenders``) and, from revision 9, it closes at least the method's
-    ``min_share_closed`` % of the gap, else "unexplained" — :func:`gaitlib.gap.diagnose.
-    assemble`'s rule replayed on the stored ranking (the contenders do not depend on the
-    threshold). Returns
-    the rows with ``named`` and ``correct`` replaced; a failed baseline stays as stored."""
+    its first-ranked effect if its statistic (:func:`case_statistic`: its ΔBIC, or with
+    ``centred`` its ΔBIC minus the median candidate's; None: the validation's own) is at or
+    below ``threshold`` and its ΔBIC at or below the fixed :data:`gaitlib.gap.method.
+    BIC_THRESHOLD`, no runner-up is within the margin (:func:`_lone`) and it closes at least
+    ``floor`` % of the gap (None: the validation's own ``min_share_closed``, revision 9 on),
+    else "unexplained" — :func:`gaitlib.gap.diagnose.assemble`'s rule replayed on the stored
+    ranking. Returns the rows with ``named`` and ``correct`` replaced; a failed baseline
+    stays as stored."""
     thr = min(diagnose.BIC_THRESHOLD, float(threshold))
-    floor = _stored_floor(v)
+    fl = _stored_floor(v) if floor is None else float(floor)
     r = v.rows.copy()
-
-    def one(row):
-        if row["verdict"] == "baseline failed":
-            return row["named"]
-        c = row["contenders"] if isinstance(row["contenders"], (list, tuple)) else []
-        ok = (pd.notna(row["rank1_dBIC"]) and float(row["rank1_dBIC"]) <= thr and len(c) <= 1
-              and (floor <= 0 or float(row["rank1_pct"]) >= floor))
-        return str(row["rank1"]) if ok else "unexplained"
-
-    r["named"] = r.apply(one, axis=1)
+    st = case_statistic(v, centred)
+    dbic = pd.to_numeric(r["rank1_dBIC"], errors="coerce")
+    ok = (st <= thr) & (dbic <= diagnose.BIC_THRESHOLD) & _lone(v)
+    if fl > 0:
+        ok &= pd.to_numeric(r["rank1_pct"], errors="coerce") >= fl
+    r["named"] = np.where(r["verdict"] == "baseline failed", r["named"],
+                          np.where(ok, r["rank1"].astype(str), "unexplained"))
     r["correct"] = [n in str(e).split("|") for n, e in zip(r["named"], r["expected"])]
     return r
+
+
+def centred_threshold(v: gval.Validation) -> float | None:
+    """The threshold ``v``'s null calibration sets on the centred statistic
+    (:func:`gaitlib.gap.method.null_threshold` with ``centred``, its own rank, and the fixed
+    threshold if lower); None without a calibration."""
+    c = (v.unedited or {}).get("null_calibration") or {}
+    t = gap_method.null_threshold(c.get("dBIC") or [], int(c.get("rank", 1)), centred=True)
+    return None if t is None else min(diagnose.BIC_THRESHOLD, t)
+
+
+def centred_replay(reps: dict, floor: float | None = None) -> pd.DataFrame:
+    """Revision 10's statistic replayed on stored rankings (label → relative validation): per
+    validation, named right per target group decided on the raw statistic at its own
+    calibration's threshold and on the centred one at the threshold the same null draws set
+    for it (:func:`centred_threshold`), both with share floor ``floor`` (None: each
+    validation's own) — the same fits, rankings and draws, only the statistic differs — and
+    the pooled counts."""
+    rows, tot = [], {}
+    for lab, v in reps.items():
+        for rule, c, t in (("raw ΔBIC", False, calibration_threshold(v)), ("centred", True, centred_threshold(v))):
+            k = _group_counts(named_at(v, t, centred=c, floor=floor)) if t is not None else {}
+            rows.append({"validation": lab, "statistic": rule, "threshold": t,
+                         **{g: f"{a}/{n}" for g, (a, n) in k.items()}})
+            for g, (a, n) in k.items():
+                x = tot.setdefault((rule, g), [0, 0])
+                x[0], x[1] = x[0] + a, x[1] + n
+    for rule in ("raw ΔBIC", "centred"):
+        rows.append({"validation": "pooled", "statistic": rule, "threshold": np.nan,
+                     **{g: f"{a}/{n} ({100.0 * a / n:.0f} %)" for (r_, g), (a, n) in tot.items() if r_ == rule and n}})
+    return pd.DataFrame(rows).set_index(["validation", "statistic"])
+
+
+def centred_lines(reps: dict, floor: float | None = None) -> list[str]:
+    """:func:`centred_replay` in words, every number from the stored rankings: each
+    validation's threshold on both statistics, the pooled counts, and the cases of the target
+    groups whose answer the statistic changes."""
+    t = centred_replay(reps, floor)
+    g_in, g_ool, g_null = "independent, middle + large", "out-of-library", "null (nothing changed)"
+    thr = "; ".join(f"{lab} {t.loc[(lab, 'raw ΔBIC'), 'threshold']:.0f} → {t.loc[(lab, 'centred'), 'threshold']:.0f}"
+                    for lab in reps)
+    pooled = ", ".join(f"{g} {t.loc[('pooled', 'raw ΔBIC'), g]} → {t.loc[('pooled', 'centred'), g]}"
+                       for g in (g_in, "independent, small", g_ool, g_null))
+    changed = []
+    for lab, v in reps.items():
+        a = named_at(v, calibration_threshold(v), centred=False, floor=floor)
+        b = named_at(v, centred_threshold(v), centred=True, floor=floor)
+        keep = ~((b["set"] == "independent") & (b["band"] == "small"))
+        for i in b.index[(a["named"] != b["named"]) & keep]:
+            changed.append((lab, b.loc[i, "case"], a.loc[i, "named"], b.loc[i, "named"], b.loc[i, "expected"],
+                            bool(b.loc[i, "correct"])))
+    fl = "each validation's own share floor" if floor is None else f"a {floor:g} % share floor"
+    line = (f"Decided on each first-ranked effect's ΔBIC minus the median candidate's instead of its ΔBIC ({fl}), the "
+            f"same null draws set the thresholds {thr}; pooled over the {len(reps)} sets: {pooled}.")
+    if changed:
+        right = {}
+        for lab, *_, ok in changed:
+            right[lab] = right.get(lab, 0) + int(ok)
+        wrong = [x for x in changed if not x[-1]]
+        line += (f" {len(changed)} middle, large, out-of-library or null cases change their answer; to the right one "
+                 + ", ".join(f"{k} on {lab}" for lab, k in right.items() if k)
+                 + ("; to a wrong one " + "; ".join(f"{c} ({lab}) {x} → {y}, right answer {e}"
+                                                   for lab, c, x, y, e, _ in wrong) if wrong else "") + ".")
+    return [line]
 
 
 def _group_counts(rows: pd.DataFrame) -> dict:
@@ -759,9 +863,11 @@ def rule_table(v: gval.Validation) -> pd.DataFrame:
     named right / cases, and each rule's threshold. Paired: the same cases, the same
     rankings, only the threshold differs (:func:`named_at`)."""
     c = (v.unedited or {}).get("null_calibration") or {}
-    per, rank = c.get("dBIC") or [], int(c.get("rank", 1))
-    rules = {f"lowest of the first {min(9, len(per))} draws (revisions 1–4)": gap_method.null_threshold(per[:9], 1),
-             f"{_ORDINAL.get(rank, f'{rank}th')} of {len(per)} draws (this revision)": gap_method.null_threshold(per, rank)}
+    per, rank, cen = c.get("dBIC") or [], int(c.get("rank", 1)), _centred(v)
+    rules = {f"lowest of the first {min(9, len(per))} draws (revisions 1–4)":
+             gap_method.null_threshold(per[:9], 1, cen),
+             f"{_ORDINAL.get(rank, f'{rank}th')} of {len(per)} draws (this revision)":
+             gap_method.null_threshold(per, rank, cen)}
     rows = []
     for lab, t in rules.items():
         k = _group_counts(named_at(v, t)) if t is not None else {}
@@ -803,14 +909,14 @@ def threshold_sweep(reps: dict, thresholds=SWEEP_THRESHOLDS) -> pd.DataFrame:
 
 def ranking_misses(reps: dict, bands=("middle", "large")) -> pd.DataFrame:
     """The independent injections (in ``bands``) that no threshold names right: the expected
-    effect not ranked first, or a runner-up within the margin (the stored ``contenders``) —
-    with the first two ranked effects and their ΔBIC. The ceiling of :func:`threshold_sweep`."""
+    effect not ranked first, or a runner-up within the margin (:func:`_lone`) — with the
+    first two ranked effects and their ΔBIC. The ceiling of :func:`threshold_sweep`."""
     out = []
     for lab, v in reps.items():
-        r = v.rows[(v.rows["set"] == "independent") & v.rows["band"].isin(bands)]
-        for _, x in r.iterrows():
-            c = x["contenders"] if isinstance(x["contenders"], (list, tuple)) else []
-            if x["rank1"] == x["expected"] and len(c) <= 1:
+        sel = (v.rows["set"] == "independent") & v.rows["band"].isin(bands)
+        r, lone = v.rows[sel], _lone(v)[sel]
+        for i, x in r.iterrows():
+            if x["rank1"] == x["expected"] and lone[i]:
                 continue
             out.append({"replicate": lab, "case": x["case"], "expected": x["expected"], "magnitude": x["magnitude"],
                         "rank1": x["rank1"], "rank1_dBIC": x["rank1_dBIC"], "rank2": x["rank2"],
@@ -839,9 +945,8 @@ def _floor_held(v: gval.Validation) -> pd.Series:
     pct = pd.to_numeric(r["rank1_pct"], errors="coerce")
     dbic = pd.to_numeric(r["rank1_dBIC"], errors="coerce")
     thr = pd.to_numeric(r["threshold_used"], errors="coerce").clip(upper=diagnose.BIC_THRESHOLD)
-    lone = r["contenders"].apply(lambda c: len(c) <= 1 if isinstance(c, (list, tuple)) else True)
-    return ((r["named"] == "unexplained") & (r["verdict"] != "baseline failed") & (dbic <= thr) & lone
-            & (pct < floor))
+    return ((r["named"] == "unexplained") & (r["verdict"] != "baseline failed") & (case_statistic(v) <= thr)
+            & (dbic <= diagnose.BIC_THRESHOLD) & _lone(v) & (pct < floor))
 
 
 def with_share_floor(v: gval.Validation, floor: float) -> pd.DataFrame:
@@ -965,15 +1070,17 @@ def threshold_draw_lines(v: gval.Validation, label: str = "") -> list[str]:
     reference in that draw (its objective after the self-consistency rounds) against the
     other draws' median."""
     c = (v.unedited or {}).get("null_calibration") or {}
-    per = c.get("dBIC") or []
-    stats = [(min(p.values()), j) for j, p in enumerate(per) if p]
+    per, cen = c.get("dBIC") or [], _centred(v)
+    stats = [(gap_method.draw_statistic(p, cen), j) for j, p in enumerate(per) if p]
     if not stats:
         return ["(no ranked null draw stored)"]
-    lo, j = min(stats)
+    st, j = min(stats)
     vals = per[j]
     eff = min(vals, key=vals.get)
+    lo = vals[eff]
     near = sorted(x for x in vals.values() if x <= lo / 2)
-    line = (f"The draw that sets {label or 'this calibration'}'s lowest statistic (null{j}): {eff} at ΔBIC {lo:.0f}; "
+    line = (f"The draw that sets {label or 'this calibration'}'s lowest statistic (null{j}): {eff} at ΔBIC {lo:.0f}"
+            + (f" ({st:.0f} from the median candidate's)" if cen else "") + "; "
             f"{len(near)} of its {len(vals)} ranked candidates reached ΔBIC ≤ {lo / 2:.0f} (half of it), from "
             f"{near[-1]:.0f} to {near[0]:.0f}")
     moved = c.get("moved") or {}
@@ -2058,7 +2165,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
              null_tail: dict | None = None, valr_now_reps: dict | None = None, common_mode: dict | None = None,
              ref_pair: tuple | None = None, baseline_pair: dict | None = None,
              candidate_baseline: dict | None = None, pair_rev8: tuple | None = None,
-             current_reps: dict | None = None, floor_reps: dict | None = None) -> list[str]:
+             current_reps: dict | None = None, floor_reps: dict | None = None,
+             centred_reps: dict | None = None) -> list[str]:
     """The chapter's findings as Markdown paragraphs, every number and verdict from the
     results: the twin checks (``tv`` on the coarse mesh, :func:`twin_validation`;
     ``tv_full`` on 20 × 5, :func:`twin_validation_full_mesh`), the SK diagnoses of Schwartz
@@ -2091,7 +2199,9 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     :func:`replicate_lines`, :func:`threshold_lines`; "the method in use" when they are
     :data:`gaitlib.gap.method.RELATIVE`'s); ``floor_reps``: the earlier revision's replicates
     the share floor :attr:`gaitlib.gap.method.RelativeMethod.min_share_closed` was chosen on
-    (:func:`share_floor_lines` at that floor);
+    (:func:`share_floor_lines` at that floor); ``centred_reps``: the earlier revisions'
+    validations the centred statistic (:attr:`gaitlib.gap.method.RelativeMethod.centred`) is
+    replayed on (:func:`centred_lines`, at the method's share floor);
     ``tv_muscle``: the muscle-level twins (:func:`muscle_twin_validation`)."""
     s, sf = tv.summary(), tv_full.summary()
     acc = tv.accuracy()
@@ -2188,6 +2298,10 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
         rev = next(iter(floor_reps.values())).settings["relative_method"]["revision"]
         out.append(f"**The share floor, replayed on revision {rev}'s two sets of draws.** "
                    + " ".join(share_floor_lines(floor_reps, floor=gap_method.RELATIVE.min_share_closed)))
+    if centred_reps:
+        out.append("**The statistic relative to the median candidate, replayed on "
+                   f"{len(centred_reps)} earlier sets of draws.** "
+                   + " ".join(centred_lines(centred_reps, floor=gap_method.RELATIVE.min_share_closed)))
     if baseline_pair is not None:
         out.append("**What remains of the common mode.** " + " ".join(baseline_pair_lines(baseline_pair))
                    + (" " + " ".join(candidate_baseline_lines(candidate_baseline)) if candidate_baseline else ""))
