@@ -951,3 +951,22 @@ def test_the_centred_replay_decides_on_the_top_effect_minus_the_median_candidate
     assert t.loc[("r", "centred"), "independent, middle + large"] == "1/2"  # c: runner-up within the margin
     (line,) = G.centred_lines({"r": v})
     assert "out-of-library 0/1 (0 %) → 1/1 (100 %)" in line and "b_middle_0" not in line.split("to a wrong one")[-1]
+
+
+def test_the_revision_table_reads_each_validation_as_it_decided():
+    """One row per stored relative validation: its revision and change, its set of draws, its
+    calibration's threshold (the fixed one without a calibration), its common-mode null
+    draws counted by hand, and named right per target group from its stored verdicts."""
+    from gaitlib.studies import gap as G
+
+    rows = V.pd.DataFrame({"set": ["independent", "out-of-library", "null"], "band": ["large", "middle", "none"],
+                           "expected": ["knee_offset", "unexplained", "unexplained"],
+                           "named": ["knee_offset", "hip_offset", "unexplained"], "correct": [True, False, True]})
+    calib = {"dBIC": [{"a": -40.0, "b": -30.0, "c": -25.0}, {"a": -12.0, "b": 0.0, "c": 3.0}], "rank": 2,
+             "threshold_dBIC": -12.0}  # medians -30 (common-mode) and 0
+    v = V.Validation(rows, {"null_calibration": calib}, {"relative": True, "replicate": 1})
+    t = G.revision_table({"r": (10, v), "r0": (0, V.Validation(rows, {}, {"relative": True}))})
+    assert t.loc["r", "threshold (ΔBIC ≤)"] == "-12" and t.loc["r", "common-mode null draws"] == "1/2"
+    assert t.loc["r", "draws"] == 1 and t.loc["r", "change"] == G.REVISION_CHANGES[10]
+    assert t.loc["r", "independent, middle + large"] == "1/1" and t.loc["r", "out-of-library"] == "0/1"
+    assert t.loc["r0", "threshold (ΔBIC ≤)"] == "-10 (fixed)" and t.loc["r0", "common-mode null draws"] == "—"

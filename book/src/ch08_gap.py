@@ -906,6 +906,19 @@ display(Markdown("\n\n".join(gap_study.floor_held_lines(valr, "revision 10"))))
 display(gap_study.centred_replay({"revision 10": valr}))
 
 # %% [markdown]
+# **Every revision at a glance**: each stored relative validation as it decided, with the
+# threshold its null draws set and how many of those draws were common-mode (every candidate
+# gaining alike, the median candidate's ΔBIC ≤ −20). Each row is its own draws; the changes'
+# paired runs are in the sections above.
+
+# %%
+rev_vals = {name: (rev, gap_study.superseded_validation(name)) for name, rev in gap_study.SUPERSEDED_VALIDATIONS.items()
+            if name.startswith("relative")}
+rev_vals.update({name: (gap_method.RELATIVE.revision, gap_study.stored_validation(name))
+                 for name in gap_study.VALIDATION_RUNS if name.startswith("relative")})
+display(gap_study.revision_table(rev_vals))
+
+# %% [markdown]
 # ## 3c. Muscle-level twins: co-contraction, joint stiffness and activation timing against EMG
 #
 # The effects of Section 5 show only in the muscles: co-contraction and joint stiffness

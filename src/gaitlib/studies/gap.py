@@ -56,7 +56,7 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "left_leg_flips", "co_contraction_text", "findings",
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
            "VALIDATION_RUNS", "stored_validation", "calibration_threshold", "centred_threshold", "centred_replay",
-           "centred_lines", "case_statistic", "wilson", "TARGET_GROUPS",
+           "centred_lines", "case_statistic", "revision_table", "REVISION_CHANGES", "wilson", "TARGET_GROUPS",
            "replicate_table", "replicate_lines", "named_at", "rule_table", "threshold_sweep", "ranking_misses", "threshold_lines",
            "threshold_draw_lines", "common_mode_table", "common_mode_lines", "stored_baseline_pair", "baseline_pair_lines", "experiment_draws_table", "stored_candidate_baseline", "candidate_baseline_lines", "null_tail_table", "null_tail_lines", "stored_paired", "paired_lines", "PAIRED", "pair_counts", "case_change_lines",
            "stored_load_confusion", "load_confusion_lines", "LOAD_CONFUSION_FILE", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
@@ -705,6 +705,34 @@ def replicate_table(reps: dict) -> pd.DataFrame:
     rows.append({"group": "threshold (ΔBIC ≤)", **{lab: (f"{t:.0f}" if t is not None else "—") for lab, t in thr.items()},
                  "pooled": "", "pooled %": np.nan, "95 % interval": ""})
     return pd.DataFrame(rows).set_index("group")
+
+
+#: What each relative method revision changed, in a few words (Chapter 8's revision table;
+#: :class:`gaitlib.gap.method.RelativeMethod` says why and what it measured).
+REVISION_CHANGES = {0: "relative to the reference, uncalibrated", 1: "null calibration (lowest of 9 draws)",
+                    2: "self-consistent reference fit", 3: "the HAT's tilt located",
+                    4: "baseline also from the candidates' fits", 5: "threshold: second lowest of 19 draws",
+                    6: "quiet points left out", 7: "reference's baseline fit from the candidates'",
+                    8: "fallback baseline; lower of two located pairs", 9: "share floor: closes ≥ 20 %",
+                    10: "statistic relative to the median candidate"}
+
+
+def revision_table(vals: dict) -> pd.DataFrame:
+    """Every stored relative validation at a glance (label → (revision, validation)): the
+    revision and its change (:data:`REVISION_CHANGES`), the set of draws (its replicate), the
+    threshold its null calibration set, how many of its null draws were common-mode (the
+    median candidate's ΔBIC ≤ −20, :func:`common_mode_table`), and named right per target
+    group as the validation decided."""
+    rows = []
+    for lab, (rev, v) in vals.items():
+        t = calibration_threshold(v)
+        d = _draw_modes(v, -20.0)
+        rows.append({"validation": lab, "revision": rev, "change": REVISION_CHANGES.get(rev, ""),
+                     "draws": int((v.settings or {}).get("replicate") or 0),
+                     "threshold (ΔBIC ≤)": f"{t:.0f}" if t is not None else f"{diagnose.BIC_THRESHOLD:.0f} (fixed)",
+                     "common-mode null draws": f"{sum(x[1] for x in d)}/{len(d)}" if d else "—",
+                     **{g: (f"{k}/{n}" if n else "—") for g, (k, n) in _group_counts(v.rows).items()}})
+    return pd.DataFrame(rows).set_index("validation")
 
 
 def _stored_floor(v: gval.Validation) -> float:
