@@ -219,18 +219,25 @@ def test_cli_needs_n_subjects_for_a_foreign_csv(tmp_path):
     assert not (tmp_path / "o").exists()
 
 
-def test_min_share_holds_a_top_effect_that_closes_too_little(tmp_path, real):
-    """``assemble(min_share=)`` (the relative method's ``min_share_closed``): the top effect,
-    past the threshold and alone, is named only if it closes at least that % of the located
-    RSS; just below its own % closed it is named, just above it the diagnosis is
-    "unexplained"."""
+def _rough_and_hat_com(tmp_path, real):
+    """A 5-iteration SK DT baseline on the 4 × 3 mesh and a ``hat_com`` fit that is the
+    converged solve of the same problem (the null value: a candidate that closes part of the
+    rough baseline's gap): (spec, baseline, {"hat_com": Fit})."""
     spec = gait_ocp.GaitSpec(model="SK", cost="DT", n_intervals=4, degree=3, max_iter=5)
     root = tmp_path / "sol"
     rough = D.solve_many({"b": (spec, [("b", real.gait, None)])}, root=root, serial=True, progress=False)["b"]
     good = D.solve_many({"b": (dataclasses.replace(spec, max_iter=1000), [("b", real.gait, None)])}, root=root,
                         serial=True, progress=False)["b"]
-    fits = {"hat_com": D.Fit("hat_com", good, {"hat_com": {"d": 0.0}}, L.locate(good, real), 1, "nlp",
-                             "Solve_Succeeded", True)}
+    return spec, rough, {"hat_com": D.Fit("hat_com", good, {"hat_com": {"d": 0.0}}, L.locate(good, real), 1, "nlp",
+                                          "Solve_Succeeded", True)}
+
+
+def test_min_share_holds_a_top_effect_that_closes_too_little(tmp_path, real):
+    """``assemble(min_share=)`` (the relative method's ``min_share_closed``): the top effect,
+    past the threshold and alone, is named only if it closes at least that % of the located
+    RSS; just below its own % closed it is named, just above it the diagnosis is
+    "unexplained"."""
+    spec, rough, fits = _rough_and_hat_com(tmp_path, real)
     d0 = D.assemble(real, spec, rough, fits, resamples=0, threshold=1e9)
     pct = float(d0.ranking.set_index("effect").loc["hat_com", "pct_closed"])
     assert d0.top_effect == "hat_com" and 0 < pct < 100
@@ -248,15 +255,9 @@ def test_centred_decides_on_the_top_effect_minus_the_median_candidate(tmp_path, 
     candidate's ΔBIC is subtracted. Two candidates: the fitted one and one that changes
     nothing (the baseline itself, ΔBIC = ln n_eff); the median is their mean, so the centred
     statistic is half their difference, computed here from the ranking."""
-    spec = gait_ocp.GaitSpec(model="SK", cost="DT", n_intervals=4, degree=3, max_iter=5)
-    root = tmp_path / "sol"
-    rough = D.solve_many({"b": (spec, [("b", real.gait, None)])}, root=root, serial=True, progress=False)["b"]
-    good = D.solve_many({"b": (dataclasses.replace(spec, max_iter=1000), [("b", real.gait, None)])}, root=root,
-                        serial=True, progress=False)["b"]
-    fits = {"hat_com": D.Fit("hat_com", good, {"hat_com": {"d": 0.0}}, L.locate(good, real), 1, "nlp",
-                             "Solve_Succeeded", True),
-            "hip_offset": D.Fit("hip_offset", rough, {"hip_offset": {"d": 0.0}}, L.locate(rough, real), 1, "nlp",
-                                "Solve_Succeeded", True)}
+    spec, rough, fits = _rough_and_hat_com(tmp_path, real)
+    fits["hip_offset"] = D.Fit("hip_offset", rough, {"hip_offset": {"d": 0.0}}, L.locate(rough, real), 1, "nlp",
+                               "Solve_Succeeded", True)
     d0 = D.assemble(real, spec, rough, fits, resamples=0, threshold=-10.0)
     b = d0.ranking.set_index("effect")["dBIC"].astype(float)
     assert b["hat_com"] <= D.BIC_THRESHOLD and abs(b["hip_offset"] - np.log(d0.located.n_eff)) < 1e-9
