@@ -25,16 +25,20 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 RESULTS = HERE / "results" / "gap_validation"
 
+#: The fields revisions 9 and 10 added, as they were before (off): every experiment on an
+#: earlier revision's draws sets them.
+_LATER_OFF = {"min_share_closed": 0.0, "centred": False}
+
 #: name → (the stored validation whose draws are diagnosed again, the fields changed).
 EXPERIMENTS = {
     # revision 6: the quiet points left out, on revision 5's draws
     "quiet_points_rev5": ("relative_rev5", {"quiet_points": True, "reference_from_candidates": False,
-                                            "baseline_fallback": False, "lowest_pair": False}),
+                                            "baseline_fallback": False, "lowest_pair": False, **_LATER_OFF}),
     # revision 7: the baseline's fit of the reference from the candidates', on revision 6's draws
     "reference_fit_rev6": ("relative_rev6", {"reference_from_candidates": True, "baseline_fallback": False,
-                                            "lowest_pair": False}),
+                                            "lowest_pair": False, **_LATER_OFF}),
     # revision 8: the fallback baseline and the lower of two located pairs, on revision 7's draws
-    "lowest_pair_rev7": ("relative_rev7", {"baseline_fallback": True, "lowest_pair": True}),
+    "lowest_pair_rev7": ("relative_rev7", {"baseline_fallback": True, "lowest_pair": True, **_LATER_OFF}),
 }
 
 
