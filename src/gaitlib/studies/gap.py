@@ -720,7 +720,7 @@ REVISION_CHANGES = {0: "relative to the reference, uncalibrated", 1: "null calib
 def revision_table(vals: dict) -> pd.DataFrame:
     """Every stored relative validation at a glance (label → (revision, validation)): the
     revision and its change (:data:`REVISION_CHANGES`), the set of draws (its replicate), the
-    threshold its null calibration set, how many of its null draws were common-mode (the
+    statistic it decided on, the threshold its null calibration set, how many of its null draws were common-mode (the
     median candidate's ΔBIC ≤ −20, :func:`common_mode_table`), and named right per target
     group as the validation decided."""
     rows = []
@@ -729,6 +729,7 @@ def revision_table(vals: dict) -> pd.DataFrame:
         d = _draw_modes(v, -20.0)
         rows.append({"validation": lab, "revision": rev, "change": REVISION_CHANGES.get(rev, ""),
                      "draws": int((v.settings or {}).get("replicate") or 0),
+                     "statistic": "ΔBIC − median candidate's" if _centred(v) else "ΔBIC",
                      "threshold (ΔBIC ≤)": f"{t:.0f}" if t is not None else f"{diagnose.BIC_THRESHOLD:.0f} (fixed)",
                      "common-mode null draws": f"{sum(x[1] for x in d)}/{len(d)}" if d else "—",
                      **{g: (f"{k}/{n}" if n else "—") for g, (k, n) in _group_counts(v.rows).items()}})
@@ -932,7 +933,10 @@ def threshold_sweep(reps: dict, thresholds=SWEEP_THRESHOLDS) -> pd.DataFrame:
     rows = [{"threshold (ΔBIC ≤)": t, **{g: (f"{k}/{n} ({100.0 * k / n:.0f} %)" if n else "—")
                                           for g, (k, n) in tot.items()}}
             for t, tot in _sweep_counts(reps, thresholds).items()]
-    return pd.DataFrame(rows).set_index("threshold (ΔBIC ≤)")
+    out = pd.DataFrame(rows).set_index("threshold (ΔBIC ≤)")
+    if reps and all(_centred(v) for v in reps.values()):  # revision 10 on: the statistic is centred
+        out.index.name = "threshold (ΔBIC − median candidate's ≤)"
+    return out
 
 
 def ranking_misses(reps: dict, bands=("middle", "large")) -> pd.DataFrame:
