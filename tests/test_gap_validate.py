@@ -942,6 +942,7 @@ def test_the_centred_replay_decides_on_the_top_effect_minus_the_median_candidate
     assert G.case_statistic(v, centred=True).tolist() == [-55.0, -20.0, -5.0]
     assert G._lone(v).tolist() == [True, True, False]
     assert G.centred_threshold(v) == -25.0 and G.calibration_threshold(v) == -30.0
+    assert G.centred_threshold(v, centred=False) == -30.0
     assert G.named_at(v, -30.0)["named"].tolist() == ["knee_offset", "grf_scale", "unexplained"]
     assert G.named_at(v, -30.0, centred=True)["named"].tolist() == ["knee_offset", "unexplained", "unexplained"]
     assert G.named_at(v, -30.0, centred=True, floor=50.0)["named"].tolist() == ["unexplained"] * 3

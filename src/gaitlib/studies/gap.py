@@ -809,27 +809,28 @@ def named_at(v: gval.Validation, threshold: float, centred: bool | None = None,
     return r
 
 
-def centred_threshold(v: gval.Validation) -> float | None:
-    """The threshold ``v``'s null calibration sets on the centred statistic
-    (:func:`gaitlib.gap.method.null_threshold` with ``centred``, its own rank, and the fixed
-    threshold if lower); None without a calibration."""
+def centred_threshold(v: gval.Validation, centred: bool = True) -> float | None:
+    """The threshold ``v``'s null calibration sets on the centred statistic (or with
+    ``centred`` False on the raw one, whichever the validation's own method used):
+    :func:`gaitlib.gap.method.null_threshold` of its stored draws at its own rank, or the
+    fixed threshold if that is lower; None without a calibration."""
     c = (v.unedited or {}).get("null_calibration") or {}
-    t = gap_method.null_threshold(c.get("dBIC") or [], int(c.get("rank", 1)), centred=True)
+    t = gap_method.null_threshold(c.get("dBIC") or [], int(c.get("rank", 1)), centred=centred)
     return None if t is None else min(diagnose.BIC_THRESHOLD, t)
 
 
 def centred_replay(reps: dict, floor: float | None = None) -> pd.DataFrame:
     """Revision 10's statistic replayed on stored rankings (label → relative validation): per
-    validation, named right per target group decided on the raw statistic at its own
-    calibration's threshold and on the centred one at the threshold the same null draws set
-    for it (:func:`centred_threshold`), both with share floor ``floor`` (None: each
+    validation, named right per target group decided on the raw statistic and on the centred
+    one, each at the threshold the same null draws set for it (:func:`centred_threshold`), both with share floor ``floor`` (None: each
     validation's own) — the same fits, rankings and draws, only the statistic differs — and
     the pooled counts."""
     rows, tot = [], {}
     for lab, v in reps.items():
-        for rule, c, t in (("raw ΔBIC", False, calibration_threshold(v)), ("centred", True, centred_threshold(v))):
+        for rule, c in (("raw ΔBIC", False), ("centred", True)):
+            t = centred_threshold(v, c)
             k = _group_counts(named_at(v, t, centred=c, floor=floor)) if t is not None else {}
-            rows.append({"validation": lab, "statistic": rule, "threshold": t,
+            rows.append({"validation": lab, "statistic": rule, "threshold": None if t is None else round(t, 1),
                          **{g: f"{a}/{n}" for g, (a, n) in k.items()}})
             for g, (a, n) in k.items():
                 x = tot.setdefault((rule, g), [0, 0])
@@ -852,7 +853,7 @@ def centred_lines(reps: dict, floor: float | None = None) -> list[str]:
                        for g in (g_in, "independent, small", g_ool, g_null))
     changed = []
     for lab, v in reps.items():
-        a = named_at(v, calibration_threshold(v), centred=False, floor=floor)
+        a = named_at(v, centred_threshold(v, False), centred=False, floor=floor)
         b = named_at(v, centred_threshold(v), centred=True, floor=floor)
         keep = ~((b["set"] == "independent") & (b["band"] == "small"))
         for i in b.index[(a["named"] != b["named"]) & keep]:
