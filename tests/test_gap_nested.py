@@ -267,3 +267,12 @@ def test_centred_decides_on_the_top_effect_minus_the_median_candidate(tmp_path, 
     assert d1.top_effect == "hat_com" and abs(d1.settings["median_dBIC"] - (b["hat_com"] + b["hip_offset"]) / 2) < 1e-9
     d2 = D.assemble(real, spec, rough, fits, resamples=0, threshold=half - 1.0, centred=True)
     assert d2.top_effect == "unexplained" and d2.settings["centred"]
+    # the share floor on what the median candidate leaves: (p - m) / (100 - m), m the mean of the two
+    p = d0.ranking.set_index("effect")["pct_closed"].astype(float)
+    m = (p["hat_com"] + p["hip_offset"]) / 2.0
+    share = 100.0 * (p["hat_com"] - m) / (100.0 - m)
+    assert abs(d1.settings["share_closed"] - share) < 1e-9 and share < p["hat_com"]
+    d3 = D.assemble(real, spec, rough, fits, resamples=0, threshold=half + 1.0, centred=True, min_share=share + 0.5)
+    assert d3.top_effect == "unexplained" and d3.settings["held_by_share_floor"] == "hat_com"
+    d4 = D.assemble(real, spec, rough, fits, resamples=0, threshold=half + 1.0, min_share=share + 0.5)
+    assert d4.top_effect == "hat_com"  # raw: its own % closed is above the floor

@@ -613,3 +613,16 @@ def test_the_centred_statistic_cancels_a_shift_shared_by_every_candidate():
     assert M.null_threshold(per, 2) == -40.0 and M.null_threshold(per, 2, centred=True) == -12.5
     assert M.null_threshold(per, 1, centred=True) == -38.0
     assert M.RELATIVE.centred and M.RelativeMethod(centred=False).hash() != M.RELATIVE.hash()
+
+
+def test_the_share_beyond_the_median_candidate_by_hand():
+    """Revision 10's share: the part of the gap the median ranked candidate leaves open that
+    the top effect closes, 100 (p − m) / (100 − m); raw without ``centred``; 0 if the median
+    closes everything."""
+    from gaitlib.gap import method as M
+
+    # common mode: every candidate closes ~75 %, the top 80 %: it closes 5 of the 25 left
+    assert abs(M.share_beyond_median(80.0, [80.0, 76.0, 75.0, 74.0, 70.0]) - 100.0 * 5.0 / 25.0) < 1e-12
+    assert abs(M.share_beyond_median(40.0, [40.0, 2.0, 1.0]) - 100.0 * 38.0 / 98.0) < 1e-12
+    assert M.share_beyond_median(40.0, [40.0, 2.0, 1.0], centred=False) == 40.0
+    assert M.share_beyond_median(100.0, [100.0, 100.0, 100.0]) == 0.0

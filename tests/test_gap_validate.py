@@ -933,6 +933,9 @@ def test_the_centred_replay_decides_on_the_top_effect_minus_the_median_candidate
         "band": ["middle", "middle", "large"], "expected": ["knee_offset", "unexplained", "body_mass"],
         "rank1": ["knee_offset", "grf_scale", "grf_scale"], "rank1_dBIC": [-60.0, -300.0, -100.0],
         "rank1_pct": [40.0, 70.0, 50.0], "dBIC": [alone, common, tied], "contenders": [[], [], []],
+        "pct_closed": [{"knee_offset": 40.0, "hip_offset": 2.0, "grf_scale": 0.0},
+                       {"grf_scale": 70.0, "body_mass": 60.0, "hip_offset": 55.0},
+                       {"grf_scale": 50.0, "body_mass": 45.0, "hip_offset": 1.0}],
         "verdict": ["unexplained"] * 3, "named": ["unexplained"] * 3, "correct": [False, True, False]})
     null = [{"a": -50.0, "b": -20.0, "c": -25.0}, {"a": -8.0, "b": 0.0, "c": 1.0}, {"a": -30.0, "b": 2.0, "c": 0.0}]
     # raw statistics -50, -8, -30 (second lowest -30); centred -25, -8, -30 (second lowest -25)
@@ -945,7 +948,12 @@ def test_the_centred_replay_decides_on_the_top_effect_minus_the_median_candidate
     assert G.centred_threshold(v, centred=False) == -30.0
     assert G.named_at(v, -30.0)["named"].tolist() == ["knee_offset", "grf_scale", "unexplained"]
     assert G.named_at(v, -30.0, centred=True)["named"].tolist() == ["knee_offset", "unexplained", "unexplained"]
-    assert G.named_at(v, -30.0, centred=True, floor=50.0)["named"].tolist() == ["unexplained"] * 3
+    # shares of what the median candidate leaves: a (40 - 5 ... ) by hand from pct_closed
+    assert G.case_share(v).tolist() == [40.0, 70.0, 50.0]
+    assert np.allclose(G.case_share(v, centred=True), [100 * (40 - 2) / 98, 100 * (70 - 60) / 40, 100 * (50 - 45) / 55])
+    assert G.named_at(v, -30.0, centred=True, floor=30.0)["named"].tolist() == ["knee_offset", "unexplained",
+                                                                                "unexplained"]
+    assert G.named_at(v, -30.0, centred=True, floor=39.0)["named"].tolist() == ["unexplained"] * 3
     t = G.centred_replay({"r": v})
     assert t.loc[("r", "raw ΔBIC"), "out-of-library"] == "0/1" and t.loc[("r", "centred"), "out-of-library"] == "1/1"
     assert t.loc[("r", "centred"), "threshold"] == -25.0 and t.loc[("r", "raw ΔBIC"), "threshold"] == -30.0

@@ -73,7 +73,7 @@ from . import io as gio
 from . import locate
 from . import reference as gref
 from .method import (BIC_THRESHOLD, DEFAULT_BASE, EXPLAINED_PCT, METHOD, PROFILE_GRID, RELATIVE, RUNNER_UP_MARGIN,
-                     null_threshold)
+                     null_threshold, share_beyond_median)
 from .noise import smooth_noise
 from .nullstart import null_start_many
 from .solve import solve_many
@@ -365,7 +365,9 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
     settings' ``held_by_share_floor`` names the effect it held. ``centred`` (a relative
     diagnosis: :attr:`gaitlib.gap.method.RelativeMethod.centred`): the top effect's ΔBIC must
     reach :data:`BIC_THRESHOLD`, and its ΔBIC minus the median ranked candidate's (settings
-    ``median_dBIC``) must reach ``threshold``."""
+    ``median_dBIC``) must reach ``threshold``; ``min_share`` applies to the share of the gap
+    the median candidate leaves open that it closes (:func:`gaitlib.gap.method.
+    share_beyond_median`; settings ``share_closed``)."""
     thr = BIC_THRESHOLD if threshold is None else float(threshold)
     loc0 = locate.locate(base_sol, ds)
     n_eff = loc0.n_eff
@@ -405,7 +407,7 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
         m = int(ranked.sum())
         rank[:m] = np.arange(1, m + 1)
         ranking.insert(0, "rank", rank)
-    med = None  # the median ranked candidate's ΔBIC (centred)
+    med, share = None, None  # the median ranked candidate's ΔBIC; the top effect's share closed
     if ranking.empty:
         elig = ranking
     elif centred:
@@ -415,9 +417,12 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
         elig = ranking[ranked & (dbic <= BIC_THRESHOLD) & (dbic - med <= thr)] if med is not None else ranking[ranked]
     else:
         elig = ranking[(ranking["ok"]) & (ranking["dBIC"] <= thr)]
+    if len(elig):
+        pcts = ranking.loc[ranking["ok"].astype(bool) & np.isfinite(ranking["dBIC"].astype(float)), "pct_closed"]
+        share = share_beyond_median(float(elig.iloc[0]["pct_closed"]), pcts, centred)
     contenders = contenders_of(ranking)
     held = None  # the top effect the share floor held, if it did
-    if len(elig) and len(contenders) <= 1 and float(elig.iloc[0]["pct_closed"]) >= min_share:
+    if len(elig) and len(contenders) <= 1 and share >= min_share:
         top_effect = str(elig.iloc[0]["effect"])
         verdict = "explained" if float(elig.iloc[0]["pct_closed"]) >= EXPLAINED_PCT else "partial"
     else:
@@ -448,7 +453,7 @@ def assemble(ds: gio.DataSet, spec0, base_sol, fits: dict, *, objective="fit", r
     st.update({"resamples": resamples, "seed": seed, "bic_threshold": BIC_THRESHOLD, "threshold_used": thr,
                "runner_up_margin": RUNNER_UP_MARGIN, "contenders": contenders if len(elig) else [],
                "min_share_closed": float(min_share), "held_by_share_floor": held,
-               "centred": bool(centred), "median_dBIC": med,
+               "centred": bool(centred), "median_dBIC": med, "share_closed": share,
                "method": METHOD.to_dict(), "method_hash": METHOD.hash()})
     return Diagnosis(ds, spec0, objective, base_sol, loc0, fits, ranking, top_effect, verdict, shrink, intervals,
                      dict(skipped or {}), st, sol_loc)

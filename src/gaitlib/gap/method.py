@@ -17,7 +17,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 __all__ = ["Method", "METHOD", "RelativeMethod", "RELATIVE", "BIC_THRESHOLD", "PROFILE_GRID", "DEFAULT_BASE", "EXPLAINED_PCT", "RUNNER_UP_MARGIN",
-           "draw_statistic", "null_threshold"]
+           "draw_statistic", "share_beyond_median", "null_threshold"]
 
 
 @dataclass(frozen=True)
@@ -188,21 +188,26 @@ class RelativeMethod:
         injected effect ranked first in 22), small 1 of 12, out-of-library 16 of 16, null 4
         of 4 — pooled, middle + large 25 of 48: the common mode of the calibration, not the
         floor, is what this revision leaves open.
-    centred : decide on each candidate's ΔBIC relative to the median ranked candidate's
-        (:func:`draw_statistic`), in the null draws and the data alike: a top effect is named
-        only if its ΔBIC is at or below :data:`BIC_THRESHOLD` and its ΔBIC minus the median
-        candidate's at or below the null threshold, each null draw's statistic being its
-        lowest ΔBIC minus its median one. A shift every candidate is credited with alike — the
-        baseline's fit of the reference in a worse optimum than the candidates' fits of it (the
-        common mode of revisions 6, 7 and 9) — moves the median with the lowest and so cancels;
-        one effect that absorbs a change stands out from the median. Replayed on the stored
-        rankings of revisions 8 and 9 (two sets of draws each; Chapter 8,
-        ``gaitlib.studies.gap.centred_replay``): revision 9's second set, whose 7 common-mode
-        null draws had set the threshold at −570, gets −32, its middle + large injections named
-        right 4 → 22 of 24; the other three sets' thresholds move by at most 2; pooled over the
-        four, middle + large 68 → 86 of 96, out-of-library 63 → 60 of 64 (the floor on the raw
-        share, three impact-peak bumps on the common-mode set named ``body_mass``), null 16 of
-        16 — chosen on those draws, so revision 10's own fresh draws are its test.
+    centred : decide relative to the median ranked candidate, in the null draws and the data
+        alike. The statistic (:func:`draw_statistic`): a top effect is named only if its ΔBIC
+        is at or below :data:`BIC_THRESHOLD` and its ΔBIC minus the median candidate's at or
+        below the null threshold, each null draw's statistic being its lowest ΔBIC minus its
+        median one. The share (:func:`share_beyond_median`): the ``min_share_closed`` floor
+        applies to the share of the gap the median candidate leaves open that the top effect
+        closes. A shift every candidate is credited with alike — the baseline's fit of the
+        reference in a worse optimum than the candidates' fits of it (the common mode of
+        revisions 6, 7 and 9) — moves the median with the best and so cancels; one effect that
+        absorbs a change stands out from the median. Replayed on the stored rankings of
+        revisions 8 and 9 (two sets of draws each; Chapter 8,
+        ``gaitlib.studies.gap.centred_replay``, 20 % floor throughout): revision 9's second set,
+        whose 7 common-mode null draws had set the threshold at −570, gets −32, its middle +
+        large injections named right 4 → 22 of 24; the other three sets' thresholds move by at
+        most 2; pooled over the four, middle + large 68 → 85 of 96, out-of-library 63 → 64 of
+        64, null 16 of 16. The statistic alone gives 86 and 60 (on the common-mode set three
+        loading-peak bumps were named ``body_mass`` closing 76–82 % of their gap, the median
+        candidate 71–78 %); on that set the share alone changes nothing (no candidate passes
+        −570) — chosen on those draws, so revision 10's own fresh draws are its
+        test.
     revision : bumped when the relative diagnosis decides differently for a reason outside
         these fields. 1: the null calibration; 2: the self-consistent reference fit; 3: the
         HAT tilt located; 4: the baseline from the candidates' fits; 5: the threshold the
@@ -248,6 +253,18 @@ def draw_statistic(dbic: dict, centred: bool = False) -> float | None:
     if not v:
         return None
     return min(v) - float(np.median(v)) if centred else min(v)
+
+
+def share_beyond_median(pct: float, pcts, centred: bool = True) -> float:
+    """The share (%) of the located gap a top effect closes that the floor
+    (:attr:`RelativeMethod.min_share_closed`) is held to: its own ``pct`` closed, or with
+    ``centred`` the part of the gap the median ranked candidate leaves open (``pcts``: every
+    ranked candidate's % closed) that it closes, ``100 (pct − m) / (100 − m)`` for the median
+    ``m`` (0 if the median closes everything)."""
+    if not centred:
+        return float(pct)
+    m = float(np.median([float(x) for x in pcts]))
+    return 0.0 if m >= 100.0 else 100.0 * (float(pct) - m) / (100.0 - m)
 
 
 def null_threshold(per_draw: list, rank: int, centred: bool = False) -> float | None:

@@ -56,7 +56,7 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "left_leg_flips", "co_contraction_text", "findings",
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
            "VALIDATION_RUNS", "stored_validation", "calibration_threshold", "centred_threshold", "centred_replay",
-           "centred_lines", "case_statistic", "revision_table", "REVISION_CHANGES", "wilson", "TARGET_GROUPS",
+           "centred_lines", "case_statistic", "case_share", "revision_table", "REVISION_CHANGES", "wilson", "TARGET_GROUPS",
            "replicate_table", "replicate_lines", "named_at", "rule_table", "threshold_sweep", "ranking_misses", "threshold_lines",
            "threshold_draw_lines", "common_mode_table", "common_mode_lines", "stored_baseline_pair", "baseline_pair_lines", "experiment_draws_table", "stored_candidate_baseline", "candidate_baseline_lines", "null_tail_table", "null_tail_lines", "stored_paired", "paired_lines", "PAIRED", "pair_counts", "case_change_lines",
            "stored_load_confusion", "load_confusion_lines", "LOAD_CONFUSION_FILE", "SUPERSEDED_VALIDATIONS", "superseded_validation", "effect_naming",
@@ -767,6 +767,22 @@ def case_statistic(v: gval.Validation, centred: bool | None = None) -> pd.Series
                       for x, b in zip(per, raw)], index=r.index, dtype=float)
 
 
+def case_share(v: gval.Validation, centred: bool | None = None) -> pd.Series:
+    """Per case of a relative validation, the share (%) of the gap its first-ranked effect
+    closes that the share floor is held to (:func:`gaitlib.gap.method.share_beyond_median`):
+    the stored ``rank1_pct``, or with ``centred`` the share of what the median ranked
+    candidate leaves open (None: as the validation's own method decided). NaN without a
+    stored ranking where centred."""
+    c = _centred(v) if centred is None else centred
+    r = v.rows
+    raw = pd.to_numeric(r["rank1_pct"], errors="coerce")
+    if not c:
+        return raw
+    per = r["pct_closed"] if "pct_closed" in r else pd.Series([None] * len(r), index=r.index)
+    return pd.Series([gap_method.share_beyond_median(p, _ranked(x).values()) if _ranked(x) and np.isfinite(p)
+                      else np.nan for x, p in zip(per, raw)], index=r.index, dtype=float)
+
+
 def _lone(v: gval.Validation) -> pd.Series:
     """Per case, whether no runner-up is within :data:`gaitlib.gap.method.RUNNER_UP_MARGIN` of
     the first-ranked effect — recomputed from the stored ranking (the stored ``contenders``
@@ -791,7 +807,8 @@ def named_at(v: gval.Validation, threshold: float, centred: bool | None = None,
     ``centred`` its ΔBIC minus the median candidate's; None: the validation's own) is at or
     below ``threshold`` and its ΔBIC at or below the fixed :data:`gaitlib.gap.method.
     BIC_THRESHOLD`, no runner-up is within the margin (:func:`_lone`) and it closes at least
-    ``floor`` % of the gap (None: the validation's own ``min_share_closed``, revision 9 on),
+    ``floor`` % (:func:`case_share`, centred alike) of the gap (None: the validation's own
+    ``min_share_closed``, revision 9 on),
     else "unexplained" — :func:`gaitlib.gap.diagnose.assemble`'s rule replayed on the stored
     ranking. Returns the rows with ``named`` and ``correct`` replaced; a failed baseline
     stays as stored."""
@@ -802,7 +819,7 @@ def named_at(v: gval.Validation, threshold: float, centred: bool | None = None,
     dbic = pd.to_numeric(r["rank1_dBIC"], errors="coerce")
     ok = (st <= thr) & (dbic <= diagnose.BIC_THRESHOLD) & _lone(v)
     if fl > 0:
-        ok &= pd.to_numeric(r["rank1_pct"], errors="coerce") >= fl
+        ok &= case_share(v, centred) >= fl
     r["named"] = np.where(r["verdict"] == "baseline failed", r["named"],
                           np.where(ok, r["rank1"].astype(str), "unexplained"))
     r["correct"] = [n in str(e).split("|") for n, e in zip(r["named"], r["expected"])]
@@ -821,8 +838,9 @@ def centred_threshold(v: gval.Validation, centred: bool = True) -> float | None:
 
 def centred_replay(reps: dict, floor: float | None = None) -> pd.DataFrame:
     """Revision 10's statistic replayed on stored rankings (label → relative validation): per
-    validation, named right per target group decided on the raw statistic and on the centred
-    one, each at the threshold the same null draws set for it (:func:`centred_threshold`), both with share floor ``floor`` (None: each
+    validation, named right per target group decided on the raw statistic and share and on
+    the centred ones (:func:`case_statistic`, :func:`case_share`), each at the threshold the
+    same null draws set for it (:func:`centred_threshold`), both with share floor ``floor`` (None: each
     validation's own) — the same fits, rankings and draws, only the statistic differs — and
     the pooled counts."""
     rows, tot = [], {}
@@ -860,8 +878,9 @@ def centred_lines(reps: dict, floor: float | None = None) -> list[str]:
             changed.append((lab, b.loc[i, "case"], a.loc[i, "named"], b.loc[i, "named"], b.loc[i, "expected"],
                             bool(b.loc[i, "correct"])))
     fl = "each validation's own share floor" if floor is None else f"a {floor:g} % share floor"
-    line = (f"Decided on each first-ranked effect's ΔBIC minus the median candidate's instead of its ΔBIC ({fl}), the "
-            f"same null draws set the thresholds {thr}; pooled over the {len(reps)} sets: {pooled}.")
+    line = (f"Decided relative to the median candidate — the first-ranked effect's ΔBIC minus the median candidate's "
+            f"instead of its ΔBIC, and {fl} on the share of what the median candidate leaves open instead of the "
+            f"whole gap — the same null draws set the thresholds {thr}; pooled over the {len(reps)} sets: {pooled}.")
     if changed:
         right = {}
         for lab, *_, ok in changed:
@@ -975,23 +994,22 @@ def _floor_held(v: gval.Validation) -> pd.Series:
     floor = _stored_floor(v)
     if floor <= 0:
         return pd.Series(False, index=r.index)
-    pct = pd.to_numeric(r["rank1_pct"], errors="coerce")
     dbic = pd.to_numeric(r["rank1_dBIC"], errors="coerce")
     thr = pd.to_numeric(r["threshold_used"], errors="coerce").clip(upper=diagnose.BIC_THRESHOLD)
     return ((r["named"] == "unexplained") & (r["verdict"] != "baseline failed") & (case_statistic(v) <= thr)
-            & (dbic <= diagnose.BIC_THRESHOLD) & _lone(v) & (pct < floor))
+            & (dbic <= diagnose.BIC_THRESHOLD) & _lone(v) & (case_share(v) < floor))
 
 
 def with_share_floor(v: gval.Validation, floor: float) -> pd.DataFrame:
     """The cases of a relative validation decided again with another floor on the share of the
     relative gap the named effect closes, post hoc: a named effect that closes less than
-    ``floor`` % (its stored ``rank1_pct``; the named effect is the first-ranked one) is read
-    "unexplained"; a case the validation's own floor held (:func:`_floor_held`) names its
-    first-ranked effect again if it closes ``floor`` % or more (so 0: the method without a
-    floor); everything else as stored. Returns the rows with ``named`` and ``correct``
-    replaced."""
+    ``floor`` % (:func:`case_share`, as the validation's method measured it; the named effect
+    is the first-ranked one) is read "unexplained"; a case the validation's own floor held
+    (:func:`_floor_held`) names its first-ranked effect again if it closes ``floor`` % or more
+    (so 0: the method without a floor); everything else as stored. Returns the rows with
+    ``named`` and ``correct`` replaced."""
     r = v.rows.copy()
-    pct = pd.to_numeric(r["rank1_pct"], errors="coerce")
+    pct = case_share(v)
     back = _floor_held(v) & (pct >= floor)
     r.loc[back, "named"] = r.loc[back, "rank1"]
     held = (r["named"] != "unexplained") & (r["named"] == r["rank1"]) & (pct < floor)
@@ -1047,16 +1065,18 @@ def floor_held_lines(v: gval.Validation, label: str) -> list[str]:
     floor = _stored_floor(v)
     if floor <= 0:
         return []
-    held = v.rows[_floor_held(v)]
+    mask = _floor_held(v)
+    held, share = v.rows[mask], case_share(v)[mask]
     sw = share_floor_sweep({label: v}, (0.0, floor))
     counts = "; ".join(f"{g} {sw.iloc[0][g]} → {sw.iloc[1][g]}" for g in sw.columns)
     if held.empty:
         return [f"On {label}'s draws the {floor:g} % floor held no case: every named effect closed more."]
+    of = " of what the median candidate leaves" if _centred(v) else ""
     return [f"On {label}'s draws the {floor:g} % floor held {len(held)} case{'s' if len(held) > 1 else ''} "
             "(read \"unexplained\" though ranked first within the threshold): "
             + "; ".join(f"{x['case']} ({x['rank1']}, ΔBIC {float(x['rank1_dBIC']):.0f}, "
-                        f"{float(x['rank1_pct']):.0f} % closed; right answer {x['expected']})"
-                        for _, x in held.iterrows())
+                        f"{float(share[i]):.0f} % closed{of}; right answer {x['expected']})"
+                        for i, x in held.iterrows())
             + f". Without the floor → with it: {counts}."]
 
 
