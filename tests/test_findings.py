@@ -432,5 +432,9 @@ def test_diagnosis_text_says_when_the_share_floor_held_the_top_effect():
                         "ΔBIC = -41.7")
     assert t.endswith("hip_offset passes the threshold but closes less than the 20 % of the gap a named effect must "
                       "close).")
+    s.update(centred=True, share_closed=7.6)  # revision 10: the share of what the median candidate leaves
+    assert G._diagnosis_text(s, full=True).endswith(
+        "hip_offset passes the threshold but closes 8 % of what the median candidate leaves of the gap, less than "
+        "the 20 % a named effect must close).")
     s.update(held_by_share_floor=None)
     assert G._diagnosis_text(s, full=True).startswith("No candidate passes the criterion")

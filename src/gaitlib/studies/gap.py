@@ -343,6 +343,8 @@ def summary(diag: diagnose.Diagnosis) -> dict:
     s["contenders"] = list(diag.settings.get("contenders", []))
     s["held_by_share_floor"] = diag.settings.get("held_by_share_floor")
     s["min_share_closed"] = diag.settings.get("min_share_closed", 0.0)
+    s["centred"] = bool(diag.settings.get("centred", False))
+    s["share_closed"] = diag.settings.get("share_closed")
     return s
 
 
@@ -2174,8 +2176,12 @@ def _diagnosis_text(s: dict, full: bool) -> str:
                 f"interval {s['interval'][0]:.0f}–{s['interval'][1]:.0f} %).")
     what = f"best {s['best']}, {s['best_pct']:.0f} % closed, ΔBIC = {s['best_dBIC']:.1f}; threshold {diagnose.BIC_THRESHOLD:g}"
     if s.get("held_by_share_floor"):  # a relative diagnosis's share floor (revision 9 on)
-        why = (f"{s['best']} passes the threshold but closes less than the {s['min_share_closed']:g} % of the gap "
-               "a named effect must close")
+        if s.get("centred") and s.get("share_closed") is not None:  # revision 10 on
+            why = (f"{s['best']} passes the threshold but closes {s['share_closed']:.0f} % of what the median candidate "
+                   f"leaves of the gap, less than the {s['min_share_closed']:g} % a named effect must close")
+        else:
+            why = (f"{s['best']} passes the threshold but closes less than the {s['min_share_closed']:g} % of the gap "
+                   "a named effect must close")
         return (f"No candidate explains enough of the change: **unexplained** ({what}; {why})." if full
                 else f"**unexplained** ({what}; {why}).")
     if len(s.get("contenders", [])) > 1:  # passes the threshold, but does not stand out
