@@ -91,7 +91,8 @@ def cmd_gap(args) -> int:
                        threshold_used=d.settings.get("threshold_used"),
                        min_share_closed=d.settings.get("min_share_closed"),
                        held_by_share_floor=d.settings.get("held_by_share_floor"),
-                       centred=d.settings.get("centred"), median_dBIC=d.settings.get("median_dBIC"))
+                       centred=d.settings.get("centred"), median_dBIC=d.settings.get("median_dBIC"),
+                       share_closed=d.settings.get("share_closed"))
     print(json.dumps(summary, indent=1))
     print(f"wrote {out / 'diagnosis.json'}")
     failed = [(f.effect, f.status) for f in d.fits.values() if not f.ok]
