@@ -207,7 +207,10 @@ class RelativeMethod:
         loading-peak bumps were named ``body_mass`` closing 76–82 % of their gap, the median
         candidate 71–78 %); on that set the share alone changes nothing (no candidate passes
         −570) — chosen on those draws, so revision 10's own fresh draws are its
-        test.
+        test. On them: threshold −35 (18 ranked null draws, none common-mode), independent
+        middle + large 23 of 24 (the miss a plate gain ranked first with ``body_mass`` within
+        the margin), small 7 of 12, out-of-library 16 of 16 (the floor held two, closing 16 %
+        and 19 % of what the median candidate left), null 4 of 4.
     revision : bumped when the relative diagnosis decides differently for a reason outside
         these fields. 1: the null calibration; 2: the self-consistent reference fit; 3: the
         HAT tilt located; 4: the baseline from the candidates' fits; 5: the threshold the

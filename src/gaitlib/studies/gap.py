@@ -882,13 +882,15 @@ def centred_lines(reps: dict, floor: float | None = None) -> list[str]:
     fl = "each validation's own share floor" if floor is None else f"a {floor:g} % share floor"
     line = (f"Decided relative to the median candidate — the first-ranked effect's ΔBIC minus the median candidate's "
             f"instead of its ΔBIC, and {fl} on the share of what the median candidate leaves open instead of the "
-            f"whole gap — the same null draws set the thresholds {thr}; pooled over the {len(reps)} sets: {pooled}.")
+            f"whole gap — the same null draws set the thresholds {thr}; "
+            + (f"pooled over the {len(reps)} sets: " if len(reps) > 1 else "") + f"{pooled}.")
     if changed:
         right = {}
         for lab, *_, ok in changed:
             right[lab] = right.get(lab, 0) + int(ok)
         wrong = [x for x in changed if not x[-1]]
-        line += (f" {len(changed)} middle, large, out-of-library or null cases change their answer; to the right one "
+        noun = "cases change their" if len(changed) > 1 else "case changes its"
+        line += (f" {len(changed)} middle, large, out-of-library or null {noun} answer; to the right one "
                  + ", ".join(f"{k} on {lab}" for lab, k in right.items() if k)
                  + ("; to a wrong one " + "; ".join(f"{c} ({lab}) {x} → {y}, right answer {e}"
                                                    for lab, c, x, y, e, _ in wrong) if wrong else "") + ".")
