@@ -2226,7 +2226,7 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
              null_tail: dict | None = None, valr_now_reps: dict | None = None, common_mode: dict | None = None,
              ref_pair: tuple | None = None, baseline_pair: dict | None = None,
              candidate_baseline: dict | None = None, pair_rev8: tuple | None = None,
-             current_reps: dict | None = None, floor_reps: dict | None = None,
+             current_reps: dict | list | None = None, floor_reps: dict | None = None,
              centred_reps: dict | None = None) -> list[str]:
     """The chapter's findings as Markdown paragraphs, every number and verdict from the
     results: the twin checks (``tv`` on the coarse mesh, :func:`twin_validation`;
@@ -2256,7 +2256,8 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     (:func:`candidate_baseline_lines`);
     ``pair_rev8``: (revision 7's validation, its draws with revision 8's fallback and lower
     located pair or None, :func:`paired_lines`);
-    ``current_reps``: the latest revision's replicates (label → validation,
+    ``current_reps``: the latest revision's replicates (label → validation, or a list of such,
+    one per revision,
     :func:`replicate_lines`, :func:`threshold_lines`; "the method in use" when they are
     :data:`gaitlib.gap.method.RELATIVE`'s); ``floor_reps``: the earlier revision's replicates
     the share floor :attr:`gaitlib.gap.method.RelativeMethod.min_share_closed` was chosen on
@@ -2350,11 +2351,13 @@ def findings(tv, tv_full, diag_s: diagnose.Diagnosis, diag_u: diagnose.Diagnosis
     if pair_rev8 is not None and pair_rev8[1] is not None:
         out.append("**The fallback and the lower located pair, paired on revision 7's draws.** "
                    + " ".join(paired_lines(*pair_rev8, PAIRED["lowest_pair_rev7"])))
-    if current_reps is not None and len(current_reps) > 1:
-        rev = next(iter(current_reps.values())).settings["relative_method"]["revision"]
+    for reps in (current_reps if isinstance(current_reps, list) else [current_reps]):
+        if reps is None or len(reps) < 2:
+            continue
+        rev = next(iter(reps.values())).settings["relative_method"]["revision"]
         now = ", the method in use," if rev == gap_method.RELATIVE.revision else ""
-        out.append(f"**Revision {rev}{now} on two sets of draws.** " + " ".join(replicate_lines(current_reps))
-                   + " " + " ".join(threshold_lines(current_reps)))
+        out.append(f"**Revision {rev}{now} on two sets of draws.** " + " ".join(replicate_lines(reps))
+                   + " " + " ".join(threshold_lines(reps)))
     if floor_reps:
         rev = next(iter(floor_reps.values())).settings["relative_method"]["revision"]
         out.append(f"**The share floor, replayed on revision {rev}'s two sets of draws.** "
