@@ -944,8 +944,8 @@ def test_the_centred_replay_decides_on_the_top_effect_minus_the_median_candidate
     assert G.case_statistic(v).tolist() == [-60.0, -300.0, -100.0]
     assert G.case_statistic(v, centred=True).tolist() == [-55.0, -20.0, -5.0]
     assert G._lone(v).tolist() == [True, True, False]
-    assert G.centred_threshold(v) == -25.0 and G.calibration_threshold(v) == -30.0
-    assert G.centred_threshold(v, centred=False) == -30.0
+    assert G.replayed_threshold(v) == -25.0 and G.calibration_threshold(v) == -30.0
+    assert G.replayed_threshold(v, centred=False) == -30.0
     assert G.named_at(v, -30.0)["named"].tolist() == ["knee_offset", "grf_scale", "unexplained"]
     assert G.named_at(v, -30.0, centred=True)["named"].tolist() == ["knee_offset", "unexplained", "unexplained"]
     # shares of what the median candidate leaves: a (40 - 5 ... ) by hand from pct_closed

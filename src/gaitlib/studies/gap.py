@@ -55,7 +55,7 @@ __all__ = ["TWIN_BASE", "TWIN_SEEDS", "SK_BASE", "MUSCLE_TWIN_BASE", "MUSCLE_TWI
            "book_gaps", "twin_validation_full_mesh", "twin_full_mesh_lines", "twin_full_mesh_verdict",
            "left_leg_flips", "co_contraction_text", "findings",
            "validation_cases", "validation_lines", "visibility_text", "null_tables", "null_lines", "stored_null_refit", "null_refit_lines",
-           "VALIDATION_RUNS", "stored_validation", "calibration_threshold", "centred_threshold", "centred_replay",
+           "VALIDATION_RUNS", "stored_validation", "calibration_threshold", "replayed_threshold", "centred_replay",
            "centred_lines", "case_statistic", "case_share", "revision_table", "REVISION_CHANGES", "wilson", "TARGET_GROUPS",
            "replicate_table", "replicate_lines", "named_at", "rule_table", "threshold_sweep", "ranking_misses", "threshold_lines",
            "threshold_draw_lines", "common_mode_table", "common_mode_lines", "stored_baseline_pair", "baseline_pair_lines", "experiment_draws_table", "stored_candidate_baseline", "candidate_baseline_lines", "null_tail_table", "null_tail_lines", "stored_paired", "paired_lines", "PAIRED", "pair_counts", "case_change_lines",
@@ -828,9 +828,9 @@ def named_at(v: gval.Validation, threshold: float, centred: bool | None = None,
     return r
 
 
-def centred_threshold(v: gval.Validation, centred: bool = True) -> float | None:
-    """The threshold ``v``'s null calibration sets on the centred statistic (or with
-    ``centred`` False on the raw one, whichever the validation's own method used):
+def replayed_threshold(v: gval.Validation, centred: bool = True) -> float | None:
+    """The threshold ``v``'s null calibration sets on the centred statistic (with ``centred``
+    False on the raw one), whichever statistic the validation's own method used:
     :func:`gaitlib.gap.method.null_threshold` of its stored draws at its own rank, or the
     fixed threshold if that is lower; None without a calibration."""
     c = (v.unedited or {}).get("null_calibration") or {}
@@ -842,13 +842,13 @@ def centred_replay(reps: dict, floor: float | None = None) -> pd.DataFrame:
     """Revision 10's statistic replayed on stored rankings (label → relative validation): per
     validation, named right per target group decided on the raw statistic and share and on
     the centred ones (:func:`case_statistic`, :func:`case_share`), each at the threshold the
-    same null draws set for it (:func:`centred_threshold`), both with share floor ``floor`` (None: each
-    validation's own) — the same fits, rankings and draws, only the statistic differs — and
-    the pooled counts."""
+    same null draws set for it (:func:`replayed_threshold`), both with share floor ``floor``
+    (None: each validation's own) — the same fits, rankings and draws, only the statistic and
+    the share differ — and the pooled counts."""
     rows, tot = [], {}
     for lab, v in reps.items():
         for rule, c in (("raw ΔBIC", False), ("centred", True)):
-            t = centred_threshold(v, c)
+            t = replayed_threshold(v, c)
             k = _group_counts(named_at(v, t, centred=c, floor=floor)) if t is not None else {}
             rows.append({"validation": lab, "statistic": rule, "threshold": None if t is None else round(t, 1),
                          **{g: f"{a}/{n}" for g, (a, n) in k.items()}})
@@ -873,8 +873,8 @@ def centred_lines(reps: dict, floor: float | None = None) -> list[str]:
                        for g in (g_in, "independent, small", g_ool, g_null))
     changed = []
     for lab, v in reps.items():
-        a = named_at(v, centred_threshold(v, False), centred=False, floor=floor)
-        b = named_at(v, centred_threshold(v), centred=True, floor=floor)
+        a = named_at(v, replayed_threshold(v, False), centred=False, floor=floor)
+        b = named_at(v, replayed_threshold(v), centred=True, floor=floor)
         keep = ~((b["set"] == "independent") & (b["band"] == "small"))
         for i in b.index[(a["named"] != b["named"]) & keep]:
             changed.append((lab, b.loc[i, "case"], a.loc[i, "named"], b.loc[i, "named"], b.loc[i, "expected"],
