@@ -168,7 +168,8 @@ class RelativeMethod:
         a body-mass injection with ``grf_scale`` within the margin), small 9 of 12,
         out-of-library 13 of 16, null 4 of 4 — pooled, middle + large 44 of 48.
     min_share_closed : % of the relative located gap the top effect must also close to be
-        named (0: no such test). On revision 8's two sets of draws the four out-of-library
+        named (0: no such test; from revision 10, ``centred``, % of what the median ranked
+        candidate leaves open). On revision 8's two sets of draws the four out-of-library
         cases named an effect (a swing-phase hip bump named ``hip_offset`` twice, an ankle
         moment gain ``foot_contact``, a loading-peak bump ``hip_offset``) closed 14–19 % of
         their relative gap, the middle and large injections named right 12 % or more, all but
