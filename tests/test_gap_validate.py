@@ -596,6 +596,45 @@ def test_replicate_table_pools_the_groups_by_hand():
     assert "— 0 with the first-ranked ΔBIC within that replicate's threshold, 1 beyond it" in line
 
 
+def test_target_table_reads_each_target_off_its_results():
+    import pandas as pd
+    from gaitlib.studies import gap as G
+
+    class Twins:  # a twin check's summary, as TwinValidation.summary() gives it
+        def __init__(self, top1, shrink, free):
+            self.s = {"top1_pct": top1, "shrink_pct": shrink, "top1_met": top1 >= 90, "shrink_met": shrink >= 60,
+                      "free_unexplained": free, "free_twins": 2}
+
+        def summary(self):
+            return self.s
+
+    def val(named_right):  # 10 middle/large injections, k named right; 10 out-of-library, all "unexplained"
+        rows = [("independent", "middle", f"a_{i}", i < named_right) for i in range(10)]
+        rows += [("out-of-library", "large", f"o_{i}", True) for i in range(10)]
+        return V.Validation(pd.DataFrame([dict(zip(("set", "band", "case", "correct"), r)) for r in rows]),
+                            {"named": "unexplained"}, {"relative": True})
+
+    mesh = pd.DataFrame({"verdict": ["unexplained", "unexplained"], "top effect": ["unexplained", "unexplained"]},
+                        index=["10 × 3", "20 × 5"])
+    t = G.target_table(Twins(100.0, 85.9, 2), Twins(91.7, 99.9, 0), {"r0": val(10), "r1": val(8)}, mesh)
+    assert t.loc["in-model twins (10 × 3): top-1 at the middle magnitude", "measured"] == "100 %"
+    assert t.loc["in-model twins (20 × 5): top-1 at the middle magnitude", "met"] == "yes"
+    assert t.loc["in-model twins (20 × 5): effect-free twins \"unexplained\"", "measured"] == "0 of 2"
+    assert t.loc["in-model twins (20 × 5): effect-free twins \"unexplained\"", "met"] == "no"
+    row = [i for i in t.index if i.startswith("independent injections")][0]
+    assert "pooled over 2 sets of draws" in row
+    assert t.loc[row, "measured"].startswith("18/20 = 90 %") and t.loc[row, "met"] == "yes"  # 90 % is ≥ 90 %
+    t = G.target_table(Twins(100.0, 85.9, 2), Twins(91.7, 99.9, 0), {"r0": val(10), "r1": val(7)}, mesh)
+    assert t.loc[row, "measured"].startswith("17/20 = 85 %") and t.loc[row, "met"] == "no"
+    ool = [i for i in t.index if i.startswith("out-of-library")][0]
+    assert t.loc[ool, "measured"].startswith("20/20 = 100 %") and t.loc[ool, "met"] == "yes"
+    real = [i for i in t.index if i.startswith("real data")][0]
+    assert t.loc[real, "met"] == "yes" and t.loc[real, "measured"] == "10 × 3: unexplained; 20 × 5: unexplained"
+    mesh.loc["20 × 5"] = ["named", "arm_swing"]
+    t = G.target_table(Twins(100.0, 85.9, 2), Twins(91.7, 99.9, 0), {"r0": val(10)}, mesh)
+    assert t.loc[real, "met"] == "no" and "20 × 5: named (arm_swing)" in t.loc[real, "measured"]
+
+
 def test_replaying_a_stored_relative_validation_at_its_threshold_gives_back_every_verdict():
     """gap_study.named_at replays assemble's rule (first-ranked ΔBIC at or below the
     threshold, no runner-up within the margin) on the stored rankings: at each stored
