@@ -5,7 +5,9 @@ that follow the method's hash."""
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -1018,3 +1020,55 @@ def test_the_revision_table_reads_each_validation_as_it_decided():
     assert t.loc["r", "draws"] == 1 and t.loc["r", "change"] == G.REVISION_CHANGES[10]
     assert t.loc["r", "independent, middle + large"] == "1/1" and t.loc["r", "out-of-library"] == "0/1"
     assert t.loc["r0", "threshold (ΔBIC ≤)"] == "-10 (fixed)" and t.loc["r0", "common-mode null draws"] == "—"
+
+
+def test_a_validation_cut_short_resumes_from_its_checkpoint_to_the_same_result(tmp_path, monkeypatch):
+    """validate.run(checkpoint=...) rewrites the finished cases after each; a rerun takes them
+    (and the relative run's null calibration) from it and diagnoses only the rest — the
+    result equals an uninterrupted run's. The diagnosis is replaced by a stand-in whose answer
+    is a function of the case's data alone (the real one is exercised by the stored runs)."""
+    from types import SimpleNamespace
+
+    calls, ever, given = [], [0], []
+
+    def diag(ds, base=None, resamples=0, reference=None, calibration=None, **kw):
+        calls.append(Path(ds.path).stem)
+        given.append(calibration is not None)
+        ever[0] += 1  # a calibration computed afresh by the resumed run would differ
+        if len(calls) > limit[0]:
+            raise KeyboardInterrupt  # the session ends
+        return SimpleNamespace(settings={"threshold_used": -30.0, "reference": {
+            "null_calibration": calibration or {"dBIC": [{"a": -5.0 - ever[0], "b": -1.0}], "rank": 1},
+            "moved": {}, "rss_reference": 100.0}}, reference_fit=None, data=ds)
+
+    def summary(d, expected=None):  # depends on the case's data only
+        m = d.data.gait.mean
+        return {"named": "unexplained", "verdict": "unexplained",
+                "rss_baseline": float(np.round(np.nansum(np.abs(m.to_numpy(dtype=float))), 6))}
+
+    monkeypatch.setattr(V.diagnose, "diagnose", diag)
+    monkeypatch.setattr(V, "_summary", summary)
+    monkeypatch.setattr(V.locate, "locate", lambda fit, data: SimpleNamespace(rss=1.0))
+    kw = dict(sets=("independent", "null"), relative=True, work_dir=tmp_path / "w")
+    limit = [10**6]
+    whole = V.run(**kw)
+    n = len(whole.rows)
+    assert len(calls) == n
+    calls.clear()
+    ck = tmp_path / "ck" / "partial.json"
+    limit, ever[0] = [5], 0  # the same first calibration as the whole run's; not reset for the resumed run
+    with pytest.raises(KeyboardInterrupt):
+        V.run(checkpoint=ck, **kw)
+    j = json.loads(ck.read_text())
+    assert j["settings"]["partial"] is True and len(j["rows"]) == 5
+    first = list(calls[:5])
+    calls.clear()
+    given.clear()
+    limit = [10**6]
+    resumed = V.run(checkpoint=ck, **kw)
+    assert len(calls) == n - 5 and not set(calls) & set(first)  # only the rest diagnosed
+    assert all(given)  # each with the checkpoint's null calibration
+    a, b = whole.to_dict(), resumed.to_dict()
+    assert a == b  # every row, the unedited record (calibration included) and the settings
+    with pytest.raises(ValueError, match="checkpoint of other settings .*per_band"):
+        V.run(checkpoint=ck, per_band=2, **kw)

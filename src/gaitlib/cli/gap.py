@@ -178,7 +178,7 @@ def cmd_gap_validate(args) -> int:
                     what="the validation's files (validation.json, cases.csv, scores.csv, confusion.csv)") as o:
         v = V.run(sets, per_band=args.per_band, speed_class=args.speed, base=base, root=root,
                   use_cache=not args.no_cache, serial=args.serial, n_workers=args.workers, scheduler=args.scheduler,
-                  progress=True, relative=args.relative, replicate=args.replicate)
+                  progress=True, relative=args.relative, replicate=args.replicate, checkpoint=args.checkpoint)
         v.save(o.tmp)
     print(v.scores().to_string(index=False, float_format=lambda x: f"{x:.0f}"))
     print(f"wrote {out / 'validation.json'}")
@@ -255,6 +255,9 @@ def add_parsers(sub) -> None:
     v.add_argument("--replicate", type=int_at_least(0), default=0,
                    help="0 (default): the method's own draws; k > 0: every draw (magnitudes, signs, resampling "
                         "seeds, the reference) afresh, the method unchanged")
+    v.add_argument("--checkpoint", default=None,
+                   help="JSON file the finished cases are written to after each case; a rerun given the same file "
+                        "diagnoses only the cases not in it (resumes a run cut short, also without the solution cache)")
     v.add_argument("--speed", default="Free", help="speed class of the real data (default Free)")
     v.add_argument("--serial", action="store_true", help="solve in this process without dask")
     v.add_argument("--workers", type=int_at_least(1), default=None, help="LocalCluster workers (default: cores)")

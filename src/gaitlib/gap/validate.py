@@ -380,7 +380,7 @@ def _summary(d: diagnose.Diagnosis, expected: str | None = None) -> dict:
 
 def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_class: str = "Free",
         base: dict | None = None, work_dir=None, resamples: int = 0, progress: bool = False,
-        relative: bool = False, replicate: int = 0, **diag_kw) -> Validation:
+        relative: bool = False, replicate: int = 0, checkpoint=None, **diag_kw) -> Validation:
     """Diagnose every draw of :func:`draws` (and the unedited data) with
     :func:`gaitlib.gap.diagnose` — baseline ``base`` (default: the method's), all
     applicable library effects as candidates. The manipulated CSVs are written to
@@ -398,7 +398,14 @@ def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_clas
     case and reused. No ``model-variant`` set (a variant's twin has no reference of its own).
 
     ``replicate``: 0 for the method's own draws; k > 0 draws everything afresh
-    (:func:`replicate_hash`) with the method unchanged."""
+    (:func:`replicate_hash`) with the method unchanged.
+
+    ``checkpoint``: a JSON file (:meth:`Validation.to_dict`'s form, with ``"partial": true``
+    in its settings) rewritten after every finished case; a run given a checkpoint of the
+    same settings takes its finished cases (and a relative run its null calibration) from it
+    and diagnoses only the rest, so a run cut short resumes without the solution cache (the
+    reference's fits are solved again: the same solves, the same results). A checkpoint of
+    other settings is refused."""
     import tempfile
 
     if relative and "model-variant" in sets:
@@ -409,6 +416,12 @@ def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_clas
     base = dict(method.base if base is None else base, speed_class=speed_class)
     table = draws(sets, per_band, method, seed_hash=h)
     frame = real_frame(speed_class)
+    settings = {"method": method.to_dict(), "method_hash": method.hash(), "base": base, "per_band": per_band,
+                "sets": list(sets), "speed_class": speed_class, "relative": bool(relative),
+                "replicate": int(replicate)}
+    if relative:
+        settings.update(relative_method=RELATIVE.to_dict(), relative_method_hash=RELATIVE.hash())
+    done, kept = _read_checkpoint(checkpoint, settings)
     rows = []
     with tempfile.TemporaryDirectory() as td:
         wd = Path(work_dir) if work_dir is not None else Path(td)
@@ -427,7 +440,13 @@ def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_clas
         else:
             d0 = diagnose.diagnose(gio.read_data(p0), base=base, resamples=resamples, **diag_kw)
             unedited = _summary(d0)
+        if kept:
+            unedited.update(kept)
+            calib = kept.get("null_calibration")
         for _, c in table.iterrows():
+            if c["case"] in done:
+                rows.append(done[c["case"]])
+                continue
             p = wd / f"{c['case']}.csv"
             if c["set"] == "null":
                 resample(frame, int(c["magnitude"]), n0).to_csv(p, index=False)
@@ -484,15 +503,36 @@ def run(sets=("independent", "out-of-library"), *, per_band: int = 1, speed_clas
                 row["expected"] = unedited["named"]
             row["correct"] = row["named"] in str(row["expected"]).split("|")
             rows.append(row)
+            if checkpoint is not None:
+                _write_checkpoint(checkpoint, Validation(pd.DataFrame(rows), unedited, dict(settings, partial=True)))
             if progress:
                 print(f"{c['case']}: {c['magnitude']:+g} {c['unit']} -> {row['named']} ({row['verdict']}), "
                       f"expected {c['expected']}", flush=True)
-    settings = {"method": method.to_dict(), "method_hash": method.hash(), "base": base, "per_band": per_band,
-                "sets": list(sets), "speed_class": speed_class, "relative": bool(relative),
-                "replicate": int(replicate)}
-    if relative:
-        settings.update(relative_method=RELATIVE.to_dict(), relative_method_hash=RELATIVE.hash())
     return Validation(pd.DataFrame(rows), unedited, settings)
+
+
+def _read_checkpoint(path, settings: dict) -> tuple[dict, dict]:
+    """The finished cases of a checkpoint (case → row, as written) and its ``unedited``
+    record; nothing if ``path`` is None or absent. Refused if it was written with other
+    settings (another method, draws, sets or mesh)."""
+    if path is None or not Path(path).exists():
+        return {}, {}
+    j = json.loads(Path(path).read_text())
+    theirs = {k: v for k, v in j.get("settings", {}).items() if k != "partial"}
+    if json.loads(json.dumps(settings)) != theirs:
+        diff = sorted(k for k in set(theirs) | set(settings) if theirs.get(k) != json.loads(json.dumps(settings.get(k))))
+        raise ValueError(f"{path}: a checkpoint of other settings ({', '.join(diff)} differ); remove it or give "
+                         "another --checkpoint")
+    return {r["case"]: r for r in j["rows"]}, j.get("unedited", {})
+
+
+def _write_checkpoint(path, v: Validation) -> None:
+    """:meth:`Validation.to_dict` to ``path`` atomically (a cut-off write leaves the last one)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(json.dumps(v.to_dict(), indent=1))
+    tmp.replace(path)
 
 
 def relative_null_sets(v: Validation, folder) -> tuple:
