@@ -631,10 +631,11 @@ def test_target_table_reads_each_target_off_its_results():
     ool = [i for i in t.index if i.startswith("out-of-library")][0]
     assert t.loc[ool, "measured"].startswith("20/20 = 100 %") and t.loc[ool, "met"] == "yes"
     real = [i for i in t.index if i.startswith("real data")][0]
-    assert t.loc[real, "met"] == "yes" and t.loc[real, "measured"] == "10 × 3: unexplained; 20 × 5: unexplained"
+    assert t.loc[real, "met"] == "yes" and t.loc[real, "measured"] == "unexplained at both"
     mesh.loc["20 × 5"] = ["named", "arm_swing"]
     t = G.target_table(Twins(100.0, 85.9, 2), Twins(91.7, 99.9, 0), {"r0": val(10)}, mesh)
-    assert t.loc[real, "met"] == "no" and "20 × 5: named (arm_swing)" in t.loc[real, "measured"]
+    assert t.loc[real, "met"] == "no" and t.loc[real, "measured"] == "unexplained; named (arm_swing)"
+    assert "(relative method, one set of draws)" in [i for i in t.index if i.startswith("independent")][0]
 
 
 def test_replaying_a_stored_relative_validation_at_its_threshold_gives_back_every_verdict():
