@@ -351,8 +351,11 @@ def _aggregate(points: pd.DataFrame) -> pd.DataFrame:
                                      "p_min", "significant"])
     g = points.groupby(["channel", "phase"], sort=False)
     t = g.agg(kind=("kind", "first"), side=("side", "first"), n=("z", "size"), mean_z=("z", "mean"),
-              rms_z=("z", lambda v: float(np.sqrt(np.mean(np.square(v))))),
               frac_out=("out_of_band", "mean"), p_min=("p_bonf", "min")).reset_index()
+    # RMS per cell over the cell's points in their order (numpy's sum, as over a column)
+    z, at = points["z"].to_numpy(float), g.indices
+    t.insert(t.columns.get_loc("mean_z") + 1, "rms_z",
+             [float(np.sqrt(np.mean(np.square(z[at[k]])))) for k in zip(t["channel"], t["phase"])])
     t["significant"] = t["p_min"] < ALPHA
     t["phase"] = pd.Categorical(t["phase"], categories=list(PHASES), ordered=True)
     order = {c: i for i, c in enumerate(dict.fromkeys(points["channel"]))}

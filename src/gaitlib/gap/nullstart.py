@@ -116,4 +116,4 @@ def null_start_many(groups: dict, *, root=None, use_cache: bool = True, objectiv
     """:func:`null_start_on` for groups of jobs, as :func:`gaitlib.gap.solve.solve_many`:
     ``groups`` name → (spec, [(key, gait, baseline solution), ...]); returns key →
     GaitSolution plus ``"__records__"``."""
-    return sweep_groups(_work, groups, root=root, use_cache=use_cache, objective=objective, **sweep_kw)
+    return sweep_groups(_work, groups, root=root, use_cache=use_cache, objective=objective, where=_where, **sweep_kw)

@@ -224,11 +224,19 @@ def solve_many(groups: dict, *, root=None, use_cache: bool = True, objective: st
     return sweep_groups(_work, groups, root=root, use_cache=use_cache, objective=objective, **sweep_kw)
 
 
-def sweep_groups(work, groups: dict, *, root=None, use_cache: bool = True, objective: str = "fit",
+def sweep_groups(work, groups: dict, *, root=None, use_cache: bool = True, objective: str = "fit", where=None,
                  **sweep_kw) -> dict:
     """``work((spec, jobs, root, use_cache, objective))`` per group through
-    :func:`gaitlib.sweep.sweep`; key → GaitSolution plus ``"__records__"``."""
+    :func:`gaitlib.sweep.sweep`; key → GaitSolution plus ``"__records__"``. ``where(spec,
+    gait, guess, root, objective)``: a job's cache entry (default this module's re-solves');
+    when every job's entry is there the groups are only loaded, in this process (``serial``):
+    no cluster is started for reading files."""
     root = str(Path(root if root is not None else cache.default_dir()).resolve())
+    where = where or _where
+    if use_cache and groups and not sweep_kw.get("serial") and all(
+            cache.find(where(spec, gait, guess, root, objective), "spec.json", to_solve=False) is not None
+            for spec, jobs in groups.values() for _, gait, guess in jobs):
+        sweep_kw = {**sweep_kw, "serial": True}
     items = {name: (spec, jobs, root, use_cache, objective) for name, (spec, jobs) in groups.items()}
     recs = sweep.sweep(work, items, **sweep_kw)
     out: dict = {"__records__": {r.name: r for r in recs}}
