@@ -366,6 +366,59 @@ def test_periodic_activation_is_periodic():
     assert act.DELAY < lag < act.DELAY + 0.1
 
 
+def _activation_point_by_point(t, E, tau_act, c3, delay, periodic, period, u0, substeps=10):
+    """Eqs 5.34–5.37 stepped as written: the delayed excitation interpolated at each sub-step
+    midpoint when it is reached (the reference for the tabulated path in the library)."""
+    T = period if period is not None else (t[-1] - t[0]) + np.mean(np.diff(t))
+    tt, EE = np.concatenate([t, [t[0] + T]]), np.vstack([E, E[:1]])
+
+    def e_at(s):
+        if periodic:
+            s = t[0] + np.mod(s - t[0], T)
+            return np.array([np.interp(s, tt, EE[:, j]) for j in range(E.shape[1])])
+        return np.array([np.interp(s, t, E[:, j]) for j in range(E.shape[1])])
+
+    c1, c2 = 1.0 / tau_act - 1.0 / (act.DEACTIVATION_RATIO * tau_act), 1.0 / (act.DEACTIVATION_RATIO * tau_act)
+
+    def run(u):
+        U = np.empty_like(E)
+        U[0] = u
+        for i in range(len(t) - 1):
+            h = (t[i + 1] - t[i]) / substeps
+            for k in range(substeps):
+                ed = e_at(t[i] + (k + 0.5) * h - delay)
+                u = ed + (u - ed) * np.exp(-(c1 * ed + c2) * h)
+            U[i + 1] = u
+        if periodic:
+            h = (t[0] + T - t[-1]) / substeps
+            for k in range(substeps):
+                ed = e_at(t[-1] + (k + 0.5) * h - delay)
+                u = ed + (u - ed) * np.exp(-(c1 * ed + c2) * h)
+        return U, u
+
+    U, u_end = run(e_at(t[0] - delay) if u0 is None else np.full(E.shape[1], float(u0)))
+    if periodic:
+        for _ in range(200):
+            if np.max(np.abs(u_end - U[0])) < 1e-12:
+                break
+            U, u_end = run(u_end)
+    return U, act.neural_to_muscle_activation(U, c3, 1e-4)
+
+
+@pytest.mark.parametrize("periodic", [False, True])
+def test_activation_tabulated_is_the_point_by_point_integration_to_the_bit(periodic):
+    rng = np.random.default_rng(3)
+    t = np.sort(rng.uniform(0, 1.1, 60))  # uneven steps
+    E = rng.uniform(0, 1, (60, 4))
+    u, a = act.simulate_activation(t, E, 0.012, 0.4, periodic=periodic, period=1.2 if periodic else None)
+    u_ref, a_ref = _activation_point_by_point(t, E, 0.012, 0.4, act.DELAY, periodic, 1.2 if periodic else None, None)
+    np.testing.assert_array_equal(u, u_ref)
+    np.testing.assert_array_equal(a, a_ref)
+    u1, _ = act.simulate_activation(t, E[:, 1], 0.02, 0.1, periodic=periodic, u0=0.2)
+    np.testing.assert_array_equal(u1, _activation_point_by_point(t, E[:, 1:2], 0.02, 0.1, act.DELAY, periodic, None,
+                                                                 0.2)[0][:, 0])
+
+
 def test_neural_to_muscle_activation():
     u = np.linspace(0, 1, 101)
     assert np.allclose(act.neural_to_muscle_activation(u, 0.0), u)

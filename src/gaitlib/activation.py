@@ -256,14 +256,23 @@ def simulate_activation(
 
         def e_at(s):
             s = t[0] + np.mod(s - t[0], T)
-            return np.array([np.interp(s, tt, EE[:, j]) for j in range(E.shape[1])])
+            return np.stack([np.interp(s, tt, EE[:, j]) for j in range(E.shape[1])], axis=-1)
     else:
 
         def e_at(s):
-            return np.array([np.interp(s, t, E[:, j]) for j in range(E.shape[1])])
+            return np.stack([np.interp(s, t, E[:, j]) for j in range(E.shape[1])], axis=-1)
 
     tau_deact = DEACTIVATION_RATIO * tau_act
     c1, c2 = 1.0 / tau_act - 1.0 / tau_deact, 1.0 / tau_deact
+    # every sub-step's midpoint and the delayed excitation there, once for all cycles (the
+    # same numbers as evaluating e_at point by point: interpolation is elementwise)
+    k = np.arange(substeps) + 0.5
+    H = np.diff(t) / substeps
+    mids = [t[:-1, None] + k[None, :] * H[:, None] - delay]
+    if periodic:  # close the cycle: last sample → t0 + T
+        h_close = (t[0] + T - t[-1]) / substeps
+        mids.append(t[-1] + k[None, :] * h_close - delay)
+    ED = e_at(np.concatenate(mids).ravel()).reshape(-1, substeps, E.shape[1])
 
     def run(u_start):
         U = np.empty_like(E)
@@ -271,15 +280,12 @@ def simulate_activation(
         U[0] = u
         for i in range(len(t) - 1):
             h = (t[i + 1] - t[i]) / substeps
-            for k in range(substeps):
-                ed = e_at(t[i] + (k + 0.5) * h - delay)
+            for ed in ED[i]:
                 u = ed + (u - ed) * np.exp(-(c1 * ed + c2) * h)
             U[i + 1] = u
-        if periodic:  # close the cycle: last sample → t0 + T
-            h = (t[0] + T - t[-1]) / substeps
-            for k in range(substeps):
-                ed = e_at(t[-1] + (k + 0.5) * h - delay)
-                u = ed + (u - ed) * np.exp(-(c1 * ed + c2) * h)
+        if periodic:
+            for ed in ED[-1]:
+                u = ed + (u - ed) * np.exp(-(c1 * ed + c2) * h_close)
         return U, u
 
     u_init = e_at(t[0] - delay) if u0 is None else np.full(E.shape[1], float(u0))
