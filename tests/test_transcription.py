@@ -186,3 +186,29 @@ def test_build_reads_the_data_with_default_arguments_unless_fourier_order_is_set
         with pytest.raises(Stop):
             gp_mod.build(gp_mod.GaitSpec(model="SK", n_intervals=2, degree=2, fourier_order=order))
         assert calls == [expected]
+
+
+def test_rebuilt_problems_share_model_functions_and_heights_to_the_bit():
+    """A problem rebuilt on the same data (each cached gap solution loaded) reuses the model's
+    SX functions and the reference heights — the same numbers as computed afresh."""
+    from gaitlib import contact, kinematics
+    from gaitlib import model as model_mod
+    a, b, heavy = model_mod.ChildModel(), model_mod.ChildModel(), model_mod.ChildModel(body_mass=45.0)
+    assert a.function("contact") is b.function("contact")
+    assert heavy.function("inverse_dynamics") is not a.function("inverse_dynamics")
+    gp = gait_ocp.build(gait_ocp.GaitSpec(n_intervals=4, degree=3))
+    pc = contact.default_params()
+    Q = gp.ref.q.to_numpy()[[0, 12, 25]]
+    load = np.array([300.0, 406.5, 520.0])
+    first = kinematics.height_for_load(gp.model, Q, load, pc)
+    first[:] = 0.0  # a copy: the caller's changes do not reach the next call
+    again = kinematics.height_for_load(gp.model, Q, load, pc)
+    kinematics._HEIGHTS.clear()
+    fresh = kinematics.height_for_load(gp.model, Q, load, pc)
+    np.testing.assert_array_equal(again, fresh)
+    # another load (1 N more on one row) is searched again: its row rises, the others stay
+    other = kinematics.height_for_load(gp.model, Q, load + np.array([0.0, 1.0, 0.0]), pc)
+    assert other[1] < fresh[1] and other[0] == fresh[0] and other[2] == fresh[2]
+    # and the rebuilt problem's reference is the first one's, to the bit
+    np.testing.assert_array_equal(gait_ocp.build(gait_ocp.GaitSpec(n_intervals=4, degree=3)).ref.q.to_numpy(),
+                                  gp.ref.q.to_numpy())

@@ -170,9 +170,12 @@ def height_for_load(model, Q, load, p_contact=None, below: float = 0.06, above: 
     """
     from scipy.optimize import brentq
 
-    f_ct = model.function("contact")
     Q = np.array(Q, dtype=float)
     load = np.broadcast_to(np.asarray(load, dtype=float), (Q.shape[0],))
+    key = (model, Q.tobytes(), Q.shape, load.tobytes(), contact_default(p_contact).tobytes(), below, above)
+    if key in _HEIGHTS:
+        return _HEIGHTS[key].copy()
+    f_ct = model.function("contact")
     out = np.empty(Q.shape[0])
     zero = np.zeros(Q.shape[1])
     for i, q in enumerate(Q):
@@ -192,7 +195,17 @@ def height_for_load(model, Q, load, p_contact=None, below: float = 0.06, above: 
         if excess(lo) < 0:
             raise LoadNotCarried(f"row {i}: a load of {load[i]:.1f} N needs more than {below} m of penetration")
         out[i] = brentq(excess, lo, hi, xtol=1e-13)
+    if len(_HEIGHTS) >= _HEIGHTS_KEPT:  # the oldest first
+        del _HEIGHTS[next(iter(_HEIGHTS))]
+    _HEIGHTS[key] = out.copy()
     return out
+
+
+#: :func:`height_for_load`'s results by their inputs (the model, the poses, loads and contact
+#: parameters to the last bit): a problem rebuilt on the same data — each cached gap solution
+#: loaded — finds the same heights without the root searches.
+_HEIGHTS: dict = {}
+_HEIGHTS_KEPT = 256
 
 
 def contact_default(p_contact):

@@ -535,6 +535,13 @@ def foot_angles(body_height: float = cv.BODY_HEIGHT, beta_deg: float = 106.0):
     return phi1, total - phi1
 
 
+#: The SX functions built so far, shared by equal models: a :class:`ChildModel`'s functions
+#: depend only on its fields (``p_body`` and ``p_contact`` are their inputs), so every model
+#: built with the same fields — e.g. each cached gap solution's rebuilt problem — reuses them.
+_FUNCTIONS: dict = {}
+_FUNCTIONS_KEPT = 256
+
+
 @dataclass(frozen=True)
 class ChildModel:
     """The 2-D, 9-body, 11-DOF child gait model with 6 contact ellipsoids (thesis Ch 4.1).
@@ -914,10 +921,13 @@ class ChildModel:
           velocity the friction law reads (:func:`gaitlib.contact.friction_coefficient`);
           fn (6,), N: its normal force
         """
-        cache = self.__dict__.setdefault("_functions", {})
-        if name not in cache:
-            cache[name] = self._build(name)
-        return cache[name]
+        key = (type(self), self, name)
+        f = _FUNCTIONS.get(key)
+        if f is None:
+            if len(_FUNCTIONS) >= _FUNCTIONS_KEPT:  # the oldest first: a sweep over many models stays bounded
+                del _FUNCTIONS[next(iter(_FUNCTIONS))]
+            f = _FUNCTIONS[key] = self._build(name)
+        return f
 
     def inverse_dynamics(self, q, qd, qdd, p_body=None, p_contact=None):
         """Joint torques and pelvis residuals needed for the motion (thesis Eq. 4.10).
