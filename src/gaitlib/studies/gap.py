@@ -377,6 +377,8 @@ VALIDATION_RUNS = {
     "null": "gaitlib gap-validate --set null --derivatives nodes --out benchmarks/results/gap_validation/null",
     "relative": "gaitlib gap-validate --relative --set independent,out-of-library,null --per-band 2 --derivatives nodes "
                 "--out benchmarks/results/gap_validation/relative",
+    "relative_r1": "gaitlib gap-validate --relative --set independent,out-of-library,null --per-band 2 --replicate 1 "
+                   "--derivatives nodes --out benchmarks/results/gap_validation/relative_r1",
 }
 
 
