@@ -18,7 +18,6 @@ and MSK solutions loaded, their problems rebuilt). Per run: the process's wall t
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import subprocess
 import sys
