@@ -43,8 +43,8 @@ check-book: $(STAMP)
 	$(BIN)/python tools/check_book.py book/_build/html
 
 test: $(STAMP)
-	$(BIN)/python -m pytest tests
-	$(BIN)/python -m pytest --nbval-lax book --ignore=book/_build -p no:cacheprovider
+	$(BIN)/python -m pytest tests --durations=25
+	$(BIN)/python -m pytest --nbval-lax book --ignore=book/_build -p no:cacheprovider --durations=15
 
 data: $(STAMP)
 	$(BIN)/python -m gaitlib data --out data
