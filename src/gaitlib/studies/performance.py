@@ -863,7 +863,7 @@ def book_budget_findings(res: dict, target_s: float = BOOK_TARGET_S) -> list[str
     big = sorted(rows, key=lambda r: -r["recorded_s"])[:3]
     share = ", ".join(f"{m} {v:.0%}" for m, v in res["ratios"]["eval_share"].items())
     return [
-        f"• From scratch the book solves {tot['solves']:.0f} optimisations ({tot['converged']:.0f} converged), {tot['iterations']:,.0f} IPOPT iterations: recorded "
+        f"• From scratch the book solves {tot['solves']:,.0f} optimisations ({tot['converged']:,.0f} converged), {tot['iterations']:,.0f} IPOPT iterations: recorded "
         f"{tot['recorded_s'] / 3600:.1f} h of build + solve ({tot['build_s'] / 3600:.1f} h building, "
         f"{tot['solve_s'] / 3600:.1f} h in IPOPT), one solve at a time.",
         "• The largest chapters: " + "; ".join(f"{r['chapter']} {r['recorded_s'] / 3600:.1f} h ({r['solves']} solves)"
