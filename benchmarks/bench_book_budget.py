@@ -1,7 +1,7 @@
 """The whole book from scratch: what it solves, chapter by chapter, and how far each lever of
 issue 22 could take it (target 1: ≤ 45 min on this 2-core machine).
 
-    .venv/bin/python benchmarks/bench_book_budget.py            # ≈ 15 min: every notebook from the store
+    .venv/bin/python benchmarks/bench_book_budget.py            # ≈ 6 min: every notebook from the store, nothing solved
     .venv/bin/python benchmarks/bench_book_budget.py --reuse    # recompute from results/book_budget.json
 
 A from-scratch ``make book`` solves exactly the optimisations whose solutions the book reads
@@ -200,6 +200,7 @@ def report(doc: dict) -> list[str]:
           f"evaluations' share of the whole-graph solve {', '.join(f'{m} {v:.0%}' for m, v in rat['eval_share'].items())}"
           f" (build.json, {rat['sources']['build.json']}); compiled / uncompiled per-node evaluations "
           f"{rat['compiled_eval_ratio']:.2f} (e2e.json, {rat['sources']['e2e.json']}).", ""]
+    table = table.reset_index()
     md += md_table(list(table.columns), table.to_dict("records"))
     md += ["", "What each chapter solves (kind, model, mesh):", ""]
     md += [f"- {r['chapter']}: {r['problems']}" for r in doc["rows"] if r["solves"]]

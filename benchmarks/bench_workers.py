@@ -1,7 +1,7 @@
 """One worker vs two: the book's sweeps on a dask cluster of separate processes (issue 22,
 target 1: "measure 1 vs 2 workers").
 
-    .venv/bin/python benchmarks/bench_workers.py              # ≈ 25 min
+    .venv/bin/python benchmarks/bench_workers.py              # ≈ 15 min
     .venv/bin/python benchmarks/bench_workers.py --quick      # 4 × 3 meshes: checks the script
 
 Each workload is a user's command sent to a cluster started the way the README shows —

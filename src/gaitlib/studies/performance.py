@@ -850,7 +850,8 @@ def book_budget_table(res: dict) -> pd.DataFrame:
     df = pd.concat([df, pd.DataFrame([{"chapter": "whole book", **total.to_dict()}])], ignore_index=True)
     for c in [c for c in _BUDGET_COLS if c.endswith("_s")]:
         df[c] = df[c] / 3600
-    return df.rename(columns=_BUDGET_COLS)
+    df[["solves", "converged", "iterations"]] = df[["solves", "converged", "iterations"]].astype(int)
+    return df.rename(columns=_BUDGET_COLS).set_index("chapter")
 
 
 def book_budget_findings(res: dict, target_s: float = BOOK_TARGET_S) -> list[str]:
