@@ -112,6 +112,25 @@ def test_pose_from_data_puts_lowest_ellipsoid_at_penetration(model, free, penetr
     np.testing.assert_allclose(Qp[:, cv.COORDS.index("hip_r")], ang["hip_r"].to_numpy())
 
 
+@pytest.mark.parametrize("p_contact", [None, "scaled"])
+def test_ellipsoid_bottoms_of_all_rows_at_once_are_the_row_by_row_numbers(model, free, p_contact):
+    # the mapped call evaluates the same function per row: equal to the last bit, so the
+    # tracking references built on it (pose_from_data) keep every solution's numbers
+    rng = np.random.default_rng(4)
+    p = None if p_contact is None else contact.default_params() * rng.uniform(0.9, 1.1, contact.default_params().size)
+    Q = kinematics.pose_from_data(model, free, np.linspace(0.0, free.cycle_time, 17), p) + rng.normal(0, 0.05, (17, 11))
+    rows = kinematics.ellipsoid_bottoms_rows(model, Q, p)
+    assert rows.shape == (17, 6)
+    np.testing.assert_array_equal(rows, np.array([kinematics.ellipsoid_bottoms(model, q, p) for q in Q]))
+    # pose_from_data against its former row-by-row construction
+    t = np.linspace(0.0, free.cycle_time, 9)
+    Q = kinematics.pose_from_data(model, free, t, p, penetration=0.002)
+    for q in Q:
+        q0 = q.copy()
+        q0[1] = 0.0
+        assert q[1] == -kinematics.ellipsoid_bottoms(model, q0, p).min() - 0.002
+
+
 def test_settle_height_balances_body_weight(model, free):
     q = kinematics.pose_from_data(model, free, [0.25 * free.cycle_time])[0]
     q[1] = kinematics.settle_height(model, q)

@@ -20,6 +20,7 @@ import numpy as np
 
 from gaitlib import conventions as cv
 from gaitlib import contact
+from gaitlib.model import ELLIPSOID_LABELS
 
 __all__ = [
     "ellipsoid_bottoms_sx",
@@ -27,6 +28,7 @@ __all__ = [
     "ellipsoid_bottom",
     "ellipsoid_radii",
     "ellipsoid_bottoms",
+    "ellipsoid_bottoms_rows",
     "pose_from_data",
     "settle_height",
     "height_for_load",
@@ -61,6 +63,20 @@ def ellipsoid_bottoms(model, q, p_contact=None) -> np.ndarray:
     centres, Rs = model.ellipsoid_poses(np.asarray(q, dtype=float), p_contact)
     radii = ellipsoid_radii(p_contact)
     return np.array([ellipsoid_bottom(c, R, r) for c, R, r in zip(centres, Rs, radii)])
+
+
+def ellipsoid_bottoms_rows(model, Q, p_contact=None) -> np.ndarray:
+    """:func:`ellipsoid_bottoms` of every row of ``Q`` (n, 11) → (n, 6) m, the model's
+    ``ellipsoid_poses`` evaluated for all rows in one mapped call (the same numbers as row
+    by row: each column runs the same function)."""
+    Q = np.atleast_2d(np.asarray(Q, dtype=float))
+    p = contact.default_params() if p_contact is None else np.asarray(p_contact, dtype=float)
+    f = model.function("ellipsoid_poses")
+    out = dict(zip(f.name_out(), (np.asarray(o.full()) for o in f.map(Q.shape[0]).call([Q.T, p]))))
+    centres, Rs = out["centres"], [out[f"R_{e}"] for e in ELLIPSOID_LABELS]
+    radii = ellipsoid_radii(p)
+    return np.array([[ellipsoid_bottom(centres[k, 3 * i:3 * i + 3], R[:, 3 * i:3 * i + 3], radii[k])
+                      for k, R in enumerate(Rs)] for i in range(Q.shape[0])])
 
 
 def ellipsoid_bottoms_sx(model, q, p_contact=None):
@@ -120,10 +136,8 @@ def pose_from_data(model, gait_data, times, p_contact=None, penetration: float =
         q[:, cv.COORDS.index(j)] = ang[j].to_numpy()
         if thigh == "lab" and j.startswith("hip_"):
             q[:, cv.COORDS.index(j)] = cv.thigh_in_lab(q[:, cv.COORDS.index(j)], ang["pelvis_tilt"].to_numpy())
-    for i in range(times.size):
-        q[i, 1] = 0.0
-        low = ellipsoid_bottoms(model, q[i], p_contact).min()
-        q[i, 1] = -low - penetration
+    q[:, 1] = 0.0
+    q[:, 1] = -ellipsoid_bottoms_rows(model, q, p_contact).min(axis=1) - penetration
     return q
 
 

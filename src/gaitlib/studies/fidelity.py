@@ -66,7 +66,7 @@ def data_clearance(speed_class: str = "Free", source: str = "schwartz2008", n: i
     if ankle_offset_deg:
         for s in cv.SIDES:
             Q[:, cv.COORDS.index(f"ankle_{s}")] += np.deg2rad(ankle_offset_deg)
-    bottoms = np.array([kinematics.ellipsoid_bottoms(model, q) for q in Q])
+    bottoms = kinematics.ellipsoid_bottoms_rows(model, Q)
     k = len(cv.ELLIPSOIDS)
     foot = {"r": bottoms[:, :k].min(axis=1), "l": bottoms[:, k:].min(axis=1)}
     low = np.minimum(foot["r"], foot["l"])

@@ -224,7 +224,7 @@ def foot_sink(q: pd.DataFrame, p_contact, model: ChildModel | None = None) -> fl
     ``model``: the model the motion is of (default the thesis's; :func:`gaitlib.problems.gait.spec_model`)."""
     m = ChildModel() if model is None else model
     Q = q[list(cv.COORDS)].to_numpy(float)
-    return float(max(0.0, max(-kinematics.ellipsoid_bottoms(m, row, p_contact).min() for row in Q)))
+    return float(max(0.0, -kinematics.ellipsoid_bottoms_rows(m, Q, p_contact).min()))
 
 
 def pelvic_hip_velocity(gd: data_mod.GaitData, hip_width: float, speed_class: str = "Free",
