@@ -74,3 +74,22 @@ def test_workers_findings_scale_the_floor_by_the_measured_speed_up():
     text = "\n".join(perf.workers_findings(res, budget, target_s=3600.0))
     assert "w 100 → 62 s (1.60×, efficiency 80%)" in text
     assert "floor with the evaluations free is 5.0 h on two workers (5.0× the target of 60 min)" in text
+
+
+def test_warm_chain_findings_separate_other_optima_from_failures():
+    def row(cls, start, status, its, rms=None):
+        return {"model": "MSK", "class": cls, "start": start, "status": status, "iterations": its, "solve_s": 10.0,
+                "build_s": 1.0, "objective": 0.1, "gates": "valid", "rms_from_book_deg": rms}
+
+    res = {"rows": [row("Slow", "book", "Solve_Succeeded", 800), row("Slow", "chain: x", "Solve_Succeeded", 400, 2.26),
+                    row("Fast", "book", "Solve_Succeeded", 700), row("Fast", "chain: y", "Solve_Succeeded", 600, 0.2),
+                    row("VeryFast", "book", "Solve_Succeeded", 900),
+                    row("VeryFast", "chain: z", "Infeasible_Problem_Detected", 165, 30.0)],
+           "summary": [{"model": "MSK", "start": "book", "converged": 3, "valid": 3, "runs": 3, "iterations": 2400,
+                        "solve_s": 30.0},
+                       {"model": "MSK", "start": "chain", "converged": 2, "valid": 2, "runs": 3, "iterations": 1165,
+                        "solve_s": 30.0}]}
+    (line,) = perf.warm_chain_findings(res)
+    assert "another solution (joint angles ≥ 1° RMS from the book's run): Slow (2.3°)." in line
+    assert "Not converged: VeryFast (Infeasible_Problem_Detected)." in line and "Fast (0.2" not in line
+    assert "the chain 2/3 converged, 2 valid, 1165 iterations" in line

@@ -224,6 +224,28 @@ for name in ("ipopt_options", "ipopt_options_nmsk"):  # MSK (all variants), then
         print("\n".join(perf.ipopt_options_findings(ipo)))
 
 # %% [markdown]
+# ### Fewer iterations? A warm-start chain across the speeds
+#
+# Chapter 7 starts every speed class from its model's Ch 5 solution (the Free data tracked),
+# scaled in time to the class's cycle. `bench_warm_chain.py` starts the same specs the other
+# way a continuation would: Slow and Fast from the whole Ch 5 solution, VerySlow from the
+# Slow run's solution and VeryFast from the Fast run's, each scaled the same way — in the
+# book's reading (the swing foot unloaded: the chapter's main runs) and in the thesis's (the
+# problem as printed, shown beside them). The book's
+# runs are read from the store with the statistics recorded at their solve (before their
+# 3000-iteration reruns); the chained runs are solved here. The last column is the RMS
+# distance of each chained run's joint angles from the book's run of the same class.
+
+# %%
+for name in ("warm_chain", "warm_chain_thesis"):  # the book's reading (Ch 7's main runs), the thesis's
+    chain = perf.load_optional(name)
+    if chain is not None:
+        print(f"{chain['reading']}'s reading — " + perf.measured_on(chain))
+        with pd.option_context("display.max_colwidth", 70):
+            display(perf.warm_chain_table(chain))
+        print("\n".join(perf.warm_chain_findings(chain)))
+
+# %% [markdown]
 # ## The whole book from scratch
 #
 # Issue 22's first target is the whole book from an empty cache in 45 minutes on this 2-core

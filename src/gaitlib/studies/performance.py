@@ -49,7 +49,8 @@ __all__ = ["results_dir", "load", "load_optional", "fit_power_law", "scaling_tab
            "MSK_SOLVE_TARGET_S", "CONVERGED", "THESIS_MESH_NODES", "MUMPS_AUTO_ORDERING",
            "SAME_OBJECTIVE_RTOL", "msk_profile_findings", "eval_floor_findings", "compiled_solve_finding",
            "thesis_times_findings", "mumps_orderings_findings", "fatrop_table", "fatrop_findings", "defect_form_findings", "book_budget_table",
-           "book_budget_findings", "BOOK_TARGET_S", "workers_table", "workers_findings", "findings"]
+           "book_budget_findings", "BOOK_TARGET_S", "workers_table", "workers_findings", "warm_chain_table",
+           "warm_chain_findings", "findings"]
 
 #: Runs of the scaling benchmark whose time per iteration is a measurement (the solver ran
 #: to the end: converged or stopped by its own criterion), as opposed to "timeout"/"error".
@@ -902,6 +903,35 @@ def workers_findings(res: dict, budget: dict | None = None, target_s: float = BO
         out.append(f"• At the best measured speed-up ({best:.2f}×) the book's floor with the evaluations free is "
                    f"{one / best / 3600:.1f} h on two workers ({one / best / target_s:.1f}× the target of "
                    f"{target_s / 60:.0f} min).")
+    return out
+
+
+def warm_chain_table(res: dict) -> pd.DataFrame:
+    """``bench_warm_chain.py``: each Ch 7 run as the book starts it beside the same spec
+    started from the neighbouring speed's solution — status, iterations, times, objective,
+    validity gates and the RMS distance of its joint angles from the book's run (deg)."""
+    return pd.DataFrame(res["rows"]).set_index(["model", "class", "start"])
+
+
+def warm_chain_findings(res: dict) -> list[str]:
+    """Per model: converged and valid runs, iterations and IPOPT time in all, book's start vs
+    the chain; and how many chained runs reached another solution (joint angles ≥ 1° RMS from
+    the book's)."""
+    out = []
+    summ = {(s["model"], s["start"]): s for s in res["summary"]}
+    for m in dict.fromkeys(s["model"] for s in res["summary"]):
+        b, c = summ[(m, "book")], summ[(m, "chain")]
+        chain = [r for r in res["rows"] if r["model"] == m and r["start"].startswith("chain")]
+        ok = [r for r in chain if r["status"] == CONVERGED]
+        other = [f"{r['class']} ({r['rms_from_book_deg']:.1f}°)" for r in ok if r["rms_from_book_deg"] >= 1.0]
+        failed = [f"{r['class']} ({r['status']})" for r in chain if r["status"] != CONVERGED]
+        out.append(f"• {m}: the book's starts {b['converged']}/{b['runs']} converged, {b['valid']} valid, "
+                   f"{b['iterations']} iterations, {b['solve_s']:.0f} s in IPOPT (as recorded); the chain "
+                   f"{c['converged']}/{c['runs']} converged, {c['valid']} valid, {c['iterations']} iterations, "
+                   f"{c['solve_s']:.0f} s. "
+                   + (f"Converged to another solution (joint angles ≥ 1° RMS from the book's run): "
+                      f"{', '.join(other)}. " if other else "Every converged chained run within 1° RMS of the book's. ")
+                   + (f"Not converged: {', '.join(failed)}." if failed else ""))
     return out
 
 
