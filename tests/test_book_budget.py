@@ -93,3 +93,20 @@ def test_warm_chain_findings_separate_other_optima_from_failures():
     assert "another solution (joint angles ≥ 1° RMS from the book's run): Slow (2.3°)." in line
     assert "Not converged: VeryFast (Infeasible_Problem_Detected)." in line and "Fast (0.2" not in line
     assert "the chain 2/3 converged, 2 valid, 1165 iterations" in line
+
+
+def test_targets_table_marks_each_target_from_its_results():
+    e2e = {"gait": [{"variant": "graph", "status": "Solve_Succeeded", "e2e_s": 30.0},
+                    {"variant": "nodes", "status": "Maximum_Iterations_Exceeded", "e2e_s": 5.0}],  # not a result
+           "gap": [{"variant": "graph", "status": "ok", "e2e_s": 59.0}]}
+    moco = {"speedups": {"trapezoidal": {"speedup_e2e": {"tool": "a", "speedup": 5.0},
+                                         "speedup_best": {"tool": "b", "speedup": 19.9}}}}
+    budget = {"rows": [{"evals_free_s": 2 * 45 * 60.0}]}
+    workers = {"summary": [{"speed-up": 1.5}, {"speed-up": 2.0}]}
+    t = perf.targets_table(e2e, moco, budget, workers).set_index("target")
+    assert bool(t.loc["the whole book from an empty cache", "met"])  # 90 min / 2.0 = 45 min
+    assert "two workers at 2.00×" in t.loc["the whole book from an empty cache", "measured"]
+    assert not t.loc["MSK DT Free, build + solve", "met"] and "30.0 s (graph)" in t.loc["MSK DT Free, build + solve", "measured"]
+    assert bool(t.loc["gaitlib gap on a new CSV", "met"])
+    assert bool(t.loc["T9-track vs Moco, trapezoidal, setup + solve", "met"])
+    assert not t.loc["T9-track vs Moco, trapezoidal, solve", "met"]

@@ -50,7 +50,7 @@ __all__ = ["results_dir", "load", "load_optional", "fit_power_law", "scaling_tab
            "SAME_OBJECTIVE_RTOL", "msk_profile_findings", "eval_floor_findings", "compiled_solve_finding",
            "thesis_times_findings", "mumps_orderings_findings", "fatrop_table", "fatrop_findings", "defect_form_findings", "book_budget_table",
            "book_budget_findings", "BOOK_TARGET_S", "workers_table", "workers_findings", "warm_chain_table",
-           "warm_chain_findings", "findings"]
+           "warm_chain_findings", "targets_table", "findings"]
 
 #: Runs of the scaling benchmark whose time per iteration is a measurement (the solver ran
 #: to the end: converged or stopped by its own criterion), as opposed to "timeout"/"error".
@@ -933,6 +933,38 @@ def warm_chain_findings(res: dict) -> list[str]:
                       f"{', '.join(other)}. " if other else "Every converged chained run within 1° RMS of the book's. ")
                    + (f"Not converged: {', '.join(failed)}." if failed else ""))
     return out
+
+
+def targets_table(e2e: dict | None, moco: dict | None, budget: dict | None, workers: dict | None) -> pd.DataFrame:
+    """Issue 22's time targets beside what the benchmarks measured (any results file may be
+    None): the whole book from scratch (``bench_book_budget.py``: the floor every measured
+    lever leaves, on two workers at the best measured speed-up of ``bench_workers.py``, else a
+    perfect split), the MSK command and the gap diagnosis end to end (``bench_e2e.py``,
+    fastest path), and the ratios to Moco (``bench_moco_t9track.py``)."""
+    rows = []
+    if budget is not None:
+        free = sum(r["evals_free_s"] for r in budget["rows"])
+        speed = max((s["speed-up"] for s in workers["summary"]), default=2.0) if workers else 2.0
+        rows.append({"target": "the whole book from an empty cache", "threshold": f"≤ {BOOK_TARGET_S / 60:.0f} min",
+                     "measured": f"floor {free / speed / 3600:.1f} h (every lever, two workers at {speed:.2f}×)",
+                     "met": free / speed <= BOOK_TARGET_S})
+    if e2e is not None:
+        for key, what in (("gait", "MSK DT Free, build + solve"), ("gap", "gaitlib gap on a new CSV")):
+            ok = [r for r in e2e.get(key, []) if r.get("status") in (CONVERGED, "ok")]
+            if ok:
+                best = min(ok, key=lambda r: r["e2e_s"])
+                rows.append({"target": what, "threshold": f"≤ {E2E_TARGETS[key]:.0f} s",
+                             "measured": f"{best['e2e_s']:.1f} s ({best['variant']})",
+                             "met": best["e2e_s"] <= E2E_TARGETS[key]})
+    if moco is not None:
+        for scheme, s in moco.get("speedups", {}).items():
+            for kind, key in (("setup + solve", "speedup_e2e"), ("solve", "speedup_best")):
+                if key in s:
+                    v = s[key]["speedup"]
+                    rows.append({"target": f"T9-track vs Moco, {scheme}, {kind}",
+                                 "threshold": f"≥ {MOCO_TARGETS[kind]:g}×", "measured": f"{v:.1f}× ({s[key]['tool']})",
+                                 "met": v >= MOCO_TARGETS[kind]})
+    return pd.DataFrame(rows, columns=["target", "threshold", "measured", "met"])
 
 
 def build_reuse_findings(res: dict) -> list[str]:
