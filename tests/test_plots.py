@@ -121,6 +121,7 @@ def test_ellipsoid_bottoms_of_all_rows_at_once_are_the_row_by_row_numbers(model,
     Q = kinematics.pose_from_data(model, free, np.linspace(0.0, free.cycle_time, 17), p) + rng.normal(0, 0.05, (17, 11))
     rows = kinematics.ellipsoid_bottoms_rows(model, Q, p)
     assert rows.shape == (17, 6)
+    assert kinematics.ellipsoid_bottoms_rows(model, np.empty((0, 11)), p).shape == (0, 6)
     np.testing.assert_array_equal(rows, np.array([kinematics.ellipsoid_bottoms(model, q, p) for q in Q]))
     # pose_from_data against its former row-by-row construction
     t = np.linspace(0.0, free.cycle_time, 9)

@@ -70,6 +70,8 @@ def ellipsoid_bottoms_rows(model, Q, p_contact=None) -> np.ndarray:
     ``ellipsoid_poses`` evaluated for all rows in one mapped call (the same numbers as row
     by row: each column runs the same function)."""
     Q = np.atleast_2d(np.asarray(Q, dtype=float))
+    if Q.shape[0] == 0:
+        return np.empty((0, len(ELLIPSOID_LABELS)))
     p = contact.default_params() if p_contact is None else np.asarray(p_contact, dtype=float)
     f = model.function("ellipsoid_poses")
     out = dict(zip(f.name_out(), (np.asarray(o.full()) for o in f.map(Q.shape[0]).call([Q.T, p]))))
