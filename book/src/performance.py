@@ -495,7 +495,8 @@ print("\n".join(perf.findings(scaling, moco, kkt=kkt, fill=fill)))
 # file; where a target is not met, its section above gives the measured floor of every lever):
 
 # %%
-display(perf.targets_table(e2e, moco, budget, workers))
+with pd.option_context("display.max_colwidth", 100):
+    display(perf.targets_table(e2e, moco, budget, workers).set_index("target"))
 
 # %% [markdown]
 # **Where this differs from the thesis, and what the numbers do not separate.** The thesis
