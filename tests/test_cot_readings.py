@@ -14,7 +14,7 @@ import pytest
 
 from gaitlib import metabolics as met
 from gaitlib import mtg
-from gaitlib.studies import msk
+from gaitlib.studies import fidelity, msk
 
 BM = 41.4  # kg, the child (thesis Sec 4.1)
 EPS = 0.1  # W, the smooth max's width (metabolics module docstring)
@@ -170,3 +170,33 @@ def test_cot_readings_table(monkeypatch):
     th = df.iloc[-1]
     assert "thesis" in df.index[-1] and th["COT"] == msk.THESIS_COT
     assert th[list(TERMS)].isna().all() and math.isnan(th["change vs NLP reading (%)"])
+
+
+def test_cot_ranges_by_hand(monkeypatch):
+    """msk.cot_ranges: the model's COT, the gross one (OpenSim's whole-body basal), per stride,
+    against Waters et al.'s gross mean and Weyand et al.'s per-stride mean ± SD, by hand."""
+    calls = []
+    monkeypatch.setattr(msk, "_recompute_edot", _fake_edot(calls))
+    monkeypatch.setattr(msk, "_stride", lambda sol: STRIDE)
+    sol = _fake_sol()
+    df = msk.cot_ranges({"nlp": sol, "bh": sol}, {"bh": {"isometric_torque": "bhargava"}})
+    tot = sum(BASE.values())
+    net = tot * T_F / (BM * STRIDE)
+    gross = (tot - BASE["basal"] + 1.2 * BM) * T_F / (BM * STRIDE)
+    r = df.loc["nlp"]
+    assert r["D (m)"] == STRIDE
+    assert r["COT"] == pytest.approx(net, rel=1e-12)
+    assert r["COT gross"] == pytest.approx(gross, rel=1e-12)
+    assert r["per stride"] == pytest.approx(tot * T_F / BM, rel=1e-12)  # J/kg per stride: Ė t_f / BM
+    assert r["gross ÷ Waters"] == pytest.approx(gross / (0.22 * 20.1), rel=1e-12)
+    assert r["z (net)"] == pytest.approx((tot * T_F / BM - 2.74) / 0.12, rel=1e-12)
+    assert r["z (gross)"] == pytest.approx((gross * STRIDE - 2.74) / 0.12, rel=1e-12)
+    b = df.loc["bh"]
+    assert b["COT"] == pytest.approx((tot - 100.0 + 35.0) * T_F / (BM * STRIDE), rel=1e-12)
+    assert {tuple(sorted(c.items())) for c in calls} == {
+        (), (("basal_whole_body", 1.2),), (("isometric_torque", "bhargava"),),
+        (("basal_whole_body", 1.2), ("isometric_torque", "bhargava"))}
+    # the sentences: a marked run is never counted in range
+    text = fidelity.cot_range_findings(df.assign(**{"z (net)": [0.5, 1.0]}), {"nlp": "", "bh": "INVALID: x"})
+    assert text[-1] == "**In the measured range:** nlp."
+    assert "INVALID: x" in text[2] and "no conclusion" in text[2]

@@ -167,6 +167,50 @@ def test_mtb_and_act_integrands_equal_independent_evaluation():
     assert _eval_integrand(gp, "Jrk", x, u, np.array([t_f])) == pytest.approx(t_f**6 * j1, rel=1e-12)
 
 
+def test_bhargava_isometric_torque_reaches_the_nlp():
+    """``isometric_torque="bhargava"``: the NLP's Ė (the function the Mtb term and the lifted
+    rate use) equals metabolics.nmsk_metabolic_rate in Bhargava's reading at a node, differs
+    from the thesis's reading only in the shortening heat, and the option is NMSK-only and
+    left out of the key while unset."""
+    base = gait_ocp.GaitSpec(model="NMSK", cost="DT", n_intervals=4, degree=3)
+    assert "isometric_torque" not in base.to_dict()
+    spec = dataclasses.replace(base, isometric_torque="bhargava")
+    assert spec.to_dict()["isometric_torque"] == "bhargava"
+    with pytest.raises(ValueError, match="NMSK model's metabolic rate only"):
+        gait_ocp.GaitSpec(model="MSK", isometric_torque="bhargava")
+    with pytest.raises(ValueError, match="isometric_torque must be None or one of"):
+        gait_ocp.GaitSpec(model="NMSK", isometric_torque="thesis")
+    gb, gt = gait_ocp.build(spec), gait_ocp.build(base)
+    ph = gb.problem.phases[0]
+    g = gb.guess.phases["cycle"]
+    k, rng = 40, np.random.default_rng(11)
+    xv = {s: float(np.asarray(g.states[s])[k]) for s in ph.states}
+    uv = {c: float(np.asarray(g.controls[c])[k]) for c in ph.controls}
+    for m in gait_ocp.NMSK_MUSCLES:
+        xv[f"u_{m}"] = rng.uniform(0.05, 0.6)
+        uv[f"ed_{m}"] = rng.uniform(0.0, 0.8)
+    x = np.array([xv[s] for s in ph.states])
+    u = np.array([uv[c] for c in ph.controls])
+    ts = np.asarray(gb.t_stim, float)
+    assert np.allclose(ts, gt.t_stim)
+    names = gb.edot.name_out()
+    nlp_b = dict(zip(names, (float(v) for v in gb.edot(x, u, np.zeros(0), ts))))
+    nlp_t = dict(zip(names, (float(v) for v in gt.edot(x, u, np.zeros(0), ts))))
+    c3 = activation.ACTIVATION_IDENTIFIED["c3"]
+    act = {m: activation.neural_to_muscle_activation(xv[f"u_{m}"], c3) for m in gait_ocp.NMSK_MUSCLES}
+    ref = metabolics.nmsk_metabolic_rate(
+        {j: xv[j] for j in cv.JOINTS}, {j: xv[f"qd_{j}"] for j in cv.JOINTS},
+        {m: uv[f"ed_{m}"] for m in gait_ocp.NMSK_MUSCLES}, act, s1=0.25, s2=0.25,
+        mtp_torques={"mtp_r": uv["tau_mtp_r"], "mtp_l": uv["tau_mtp_l"]},
+        t_stim=dict(zip(gait_ocp.NMSK_MUSCLES, ts)), isometric_torque="bhargava")
+    for part in names:
+        assert nlp_b[part] == pytest.approx(float(ref[part]), rel=1e-9, abs=1e-9), part
+    for part in ("activation", "maintenance", "basal", "work"):
+        assert nlp_b[part] == pytest.approx(nlp_t[part], rel=1e-12, abs=1e-12), part
+    # a relaxed-or-partly-active generator: Bhargava's isometric term a s^τ τ0 t^A < s^τ τ0
+    assert abs(nlp_b["shortening"] - nlp_t["shortening"]) > 1e-3
+
+
 @pytest.fixture(scope="module")
 def coarse_nmsk():
     return gait_ocp.solve(gait_ocp.GaitSpec(model="NMSK", cost="DT", n_intervals=8, degree=3, max_iter=1500))

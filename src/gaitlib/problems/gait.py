@@ -230,7 +230,10 @@ for _name, _w in _T62_NMSK.items():
 #: while unset: added after the store was written, they must not change existing keys.
 KEY_STABLE_OPTIONS = ("swing_load_max", "derivatives", "jerk_ranges", "track_mtp", "activation_params",
                       "fourier_order", "defects", "track_norm", "friction_floor", "max_sink",
-                      "leg_scale")
+                      "leg_scale", "isometric_torque")
+#: Readings of the concentric shortening heat's isometric term other than the thesis's
+#: (``None``, Eq 5.47 as printed; :func:`gaitlib.metabolics.nmsk_metabolic_rate`'s ``isometric_torque``).
+ISOMETRIC_TORQUES = ("bhargava",)
 #: The Fourier order of the left leg generated from the right (thesis Eqs 4.1–4.3: 5).
 FOURIER_ORDER = 5
 #: The highest order a cycle of the data's 51 samples (50 distinct) carries: the left leg is
@@ -379,6 +382,13 @@ class GaitSpec:
         ``"integral"``: the same defects multiplied by the inverse of their end columns
         (:func:`gaitlib.collocation.integral_form`) — the same problem, other row scaling,
         another path for IPOPT (measured: ``benchmarks/bench_defect_form.py``).
+    isometric_torque : NMSK only — ``None`` (Eq 5.47 as printed: the concentric
+        shortening heat's isometric term is 0.16 s^τ τ0 ω_f, the generator's maximum isometric
+        torque, even for a relaxed generator) or ``"bhargava"`` (Bhargava et al. 2004 / OpenSim:
+        0.16 a s^τ τ0 t^A(θ) ω_f, the isometric torque at the current activation and angle).
+        The Ė the Mtb term minimises and the reported COT follow it
+        (:func:`gaitlib.metabolics.nmsk_metabolic_rate`); an ablation of the Fidelity II study
+        (:func:`gaitlib.studies.msk.cot_ranges`).
     """
 
     model: str = "SK"
@@ -419,6 +429,7 @@ class GaitSpec:
     friction_floor: float | None = None
     max_sink: float | None = None
     leg_scale: float | None = None
+    isometric_torque: str | None = None
 
     def __post_init__(self):
         if self.fourier_order is not None:
@@ -440,6 +451,10 @@ class GaitSpec:
         if self.leg_scale is not None and (isinstance(self.leg_scale, bool) or not isinstance(self.leg_scale, (int, float))
                                            or not 0.8 <= float(self.leg_scale) <= 1.3):
             raise ValueError(f"leg_scale must be None or a factor in [0.8, 1.3], got {self.leg_scale!r}")
+        if self.isometric_torque not in (None,) + ISOMETRIC_TORQUES:
+            raise ValueError(f"isometric_torque must be None or one of {ISOMETRIC_TORQUES}, got {self.isometric_torque!r}")
+        if self.isometric_torque is not None and self.model != "NMSK":
+            raise ValueError("isometric_torque applies to the NMSK model's metabolic rate only")
         if self.track_norm not in (None,) + TRACK_NORMS:
             raise ValueError(f"track_norm must be None or one of {TRACK_NORMS}, got {self.track_norm!r}")
         if self.derivatives not in (None, "graph", "nodes"):
@@ -1226,7 +1241,8 @@ def build(spec: GaitSpec) -> GaitProblem:
             {j: xn_[j] for j in cv.JOINTS}, {j: xn_[f"qd_{j}"] for j in cv.JOINTS},
             {m: un_[f"ed_{m}"] for m in NMSK_MUSCLES}, muscle_activations(xn_, pn_), mtgp,
             s1=ap_["s1"], s2=ap_["s2"], mtp_torques={f"mtp_{s}": un_[f"tau_mtp_{s}"] for s in cv.SIDES},
-            t_stim={m: ts_[i] for i, m in enumerate(NMSK_MUSCLES)})
+            t_stim={m: ts_[i] for i, m in enumerate(NMSK_MUSCLES)},
+            isometric_torque=spec.isometric_torque or "thesis")
         parts = ("total", "activation", "maintenance", "shortening", "basal", "work")
         edot = ca.Function("edot", [xs_, us_, ps_, ts_], [r[k] for k in parts],
                                         ["x", "u", "p", "t_stim"], list(parts))

@@ -651,20 +651,30 @@ def _ch5(bases: dict) -> list[Row]:
 
 
 def _ch5_unloaded() -> list[Row]:
-    """The Ch 5 NMSK solve with the swing foot unloaded (Ch 5, "the same on valid gaits"):
-    its COT beside the thesis's, with the children's measured gross COT as the cause."""
+    """The Ch 5 NMSK solve with the swing foot unloaded (Ch 5, "the same on valid gaits"), and the
+    same re-optimised with Bhargava's reading of Eq 5.47's F0: their COT beside the thesis's, with
+    children's measured costs (:func:`gaitlib.studies.msk.cot_ranges`) as the cause."""
     b = fidelity.swing_bound()
     m = stored_gait(gait_ocp.cache_dir(msk.ch5_spec("MSK", swing_load_max=b)))
-    n = stored_gait(gait_ocp.cache_dir(msk.ch5_spec("NMSK", swing_load_max=b), guess=m.solution)) if m else None
-    item = "NMSK cost of transport, natural speed, swing foot unloaded (Sec 5.3.5, Eq 5.57)"
-    if n is None:
-        return [Row(5, item, msk.THESIS_COT, np.nan, "J/kg/m", "unknown", "", "")]
-    cot = float(n.stats.get("COT", np.nan))
-    gross = msk.CHILD_COT_GROSS
-    cause = (f"children aged 6–12 measured {gross:.1f} J/kg/m gross at free speed (Waters et al. 1983): ours "
-             f"{cot / gross:.2f}×, the thesis's {msk.THESIS_COT / gross:.2f}× "
-             f"[{_anchor('ch05_msk', 'The same on valid gaits: the swing foot unloaded')}]")
-    return [Row(5, item, msk.THESIS_COT, cot, "J/kg/m", cause, n.name, gate(n, "NMSK"))]
+    where = _anchor("ch05_msk", "Against children's measured cost: which reading of Eq 5.47 lands in range")
+    rows = []
+    for item, kw in (("NMSK cost of transport, natural speed, swing foot unloaded (Sec 5.3.5, Eq 5.57)", {}),
+                     ("NMSK cost of transport, natural speed, swing foot unloaded, Bhargava's F0 in Eq 5.47 (ours) "
+                      "(Sec 5.3.5, Eq 5.57)", {"isometric_torque": "bhargava"})):
+        n = stored_gait(gait_ocp.cache_dir(msk.ch5_spec("NMSK", swing_load_max=b, **kw), guess=m.solution)) if m else None
+        if n is None:
+            rows.append(Row(5, item, msk.THESIS_COT, np.nan, "J/kg/m", "unknown", "", ""))
+            continue
+        r = msk.cot_ranges({"run": n}).iloc[0]
+        mean, sd = msk.STRIDE_COST
+        inside = abs(r["z (net)"]) <= fidelity.RANGE_Z
+        cause = (f"{'inside' if inside else 'outside'} children's measured range: {r['per stride']:.2f} J/kg per stride "
+                 f"against {mean:g} ± {sd:g} (Weyand et al. 2010, read as net), z = {r['z (net)']:+.1f} SD; gross "
+                 f"{r['COT gross']:.2f} J/kg/m = {r['gross ÷ Waters']:.2f}× the 6–12-year-olds' {msk.CHILD_COT_GROSS:.1f} "
+                 f"(Waters et al. 1983); the thesis's {msk.THESIS_COT:g} is "
+                 f"{(msk.THESIS_COT * r['D (m)'] - mean) / sd:+.1f} SD [{where}]")
+        rows.append(Row(5, item, msk.THESIS_COT, float(r["COT"]), "J/kg/m", cause, n.name, gate(n, "NMSK")))
+    return rows
 
 
 def _mtg_causes(ours: dict) -> dict[str, str]:

@@ -100,11 +100,12 @@ def clearance_summary(clear: pd.DataFrame, touch: float = TOUCH, speed_class: st
     return pd.DataFrame(rows).set_index("foot")
 
 
-def ch5_unloaded(model: str = "NMSK", bound_bw: float = SWING_BOUND_BW) -> gait_ocp.GaitSolution:
+def ch5_unloaded(model: str = "NMSK", bound_bw: float = SWING_BOUND_BW, **kw) -> gait_ocp.GaitSolution:
     """The Ch 5 solve of ``model`` (:func:`gaitlib.studies.msk.solve`: its parameter sets,
     cost and start; NMSK warm-started from the MSK solve of the same bound) with a swinging
-    foot's vertical force bounded by :func:`swing_bound`."""
-    return msk.solve(model, swing_load_max=swing_bound(bound_bw))
+    foot's vertical force bounded by :func:`swing_bound`; ``kw``: further spec fields (e.g.
+    ``isometric_torque="bhargava"``)."""
+    return msk.solve(model, swing_load_max=swing_bound(bound_bw), **kw)
 
 
 def ablation_specs(model: str = "MSK", bound_bw: float = SWING_BOUND_BW) -> dict[str, gait_ocp.GaitSpec]:
@@ -818,6 +819,38 @@ def cot_findings(readings: pd.DataFrame, readings_unloaded: pd.DataFrame, sol, s
     big = ch.abs().idxmax()
     out.append(f"Of the open readings, '{big}' moves it most on this motion too ({ch[big]:+.0f} %, "
                f"{alts.loc[big, 'COT']:.2f}).")
+    return out
+
+
+#: |z| within which a COT counts as inside Weyand et al.'s measured spread (:data:`msk.STRIDE_COST`).
+RANGE_Z = 2.0
+
+
+def cot_range_findings(table: pd.DataFrame, labels: dict[str, str]) -> list[str]:
+    """Ch 5's sentences on the COT of NMSK solutions against children's measured costs.
+    ``table``: :func:`msk.cot_ranges`; ``labels``: run → its validity mark (``""`` if valid and
+    converged). A marked run is named with its mark and never counted in range."""
+    mean, sd = msk.STRIDE_COST
+    D = float(table["D (m)"].iloc[0])
+    out = [f"**The measured range.** Walkers aged 5–32 (statures 1.07–1.83 m) spend {mean:g} ± {sd:g} J kg⁻¹ per "
+           f"stride at their most economical speed (Weyand et al. 2010, mean ± SD); on our stride D = {D:.3f} m "
+           f"that is {mean / D:.2f} ± {sd / D:.2f} J kg⁻¹ m⁻¹, and ± {RANGE_Z:g} SD spans {(mean - RANGE_Z * sd) / D:.2f}–"
+           f"{(mean + RANGE_Z * sd) / D:.2f}. The abstract does not say whether this is gross or net; Waters et al.'s "
+           f"gross mean for 6–12-year-olds ({msk.CHILD_COT_GROSS:.2f} J kg⁻¹ m⁻¹) is "
+           f"{msk.CHILD_COT_GROSS * D / mean:.2f}× it per stride, so we read it as a net cost and compare it with the "
+           f"model's own COT, whose basal term (Eq 5.48) covers the muscles only; the gross column (OpenSim's "
+           f"whole-body {msk.OPENSIM_BASAL_W_PER_KG:g} W/kg added) is compared with Waters et al.'s gross mean."]
+    inside = []
+    for run, r in table.iterrows():
+        mark = labels.get(run, "")
+        ok = abs(r["z (net)"]) <= RANGE_Z
+        out.append(f"*{run}*: COT {r['COT']:.2f} J kg⁻¹ m⁻¹, {r['per stride']:.2f} J kg⁻¹ per stride, "
+                   f"z = {r['z (net)']:+.1f} SD — {'inside' if ok else 'outside'} ± {RANGE_Z:g} SD; gross "
+                   f"{r['COT gross']:.2f}, {r['gross ÷ Waters']:.2f}× Waters et al.'s mean"
+                   + (f" (**{mark}**: no conclusion)." if mark else "."))
+        if ok and not mark:
+            inside.append(run)
+    out.append("**In the measured range:** " + (", ".join(inside) if inside else "no valid run") + ".")
     return out
 
 

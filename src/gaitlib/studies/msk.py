@@ -50,10 +50,10 @@ from .. import params as params_mod
 from ..problems import gait as gait_ocp
 from . import gait as sg
 
-__all__ = ["EMG_MAP", "THESIS_TABLE_5_10", "THESIS_COT", "CHILD_COT_GROSS", "THESIS_HOURS", "parameter_sets", "ch5_spec", "solve",
+__all__ = ["EMG_MAP", "THESIS_TABLE_5_10", "THESIS_COT", "CHILD_COT_GROSS", "THESIS_HOURS", "STRIDE_COST", "parameter_sets", "ch5_spec", "solve",
            "save_activation", "activation_sets",
            "emg_table", "emg_reference", "excitation_scores", "activation_table", "cot_breakdown",
-           "cot_readings", "pelvis_travel", "min_generator_torque", "THESIS_DISTANCE_M", "OPENSIM_BASAL_W_PER_KG",
+           "cot_readings", "cot_ranges", "pelvis_travel", "min_generator_torque", "THESIS_DISTANCE_M", "OPENSIM_BASAL_W_PER_KG",
            "mtb_scale_table", "excitation_figure", "saturation", "synergy_cost_table", "MOVED_TOL",
            "verdict_text", "range_text", "thesis_rmse_range", "moved_parameters", "short_generators",
            "angle_errors", "findings"]
@@ -84,6 +84,12 @@ CHILD_COT_GROSS_ML_O2 = 0.22
 #: Energy equivalent of oxygen, J per mL O₂ (≈ 20.1 at a respiratory exchange ratio ≈ 0.85).
 J_PER_ML_O2 = 20.1
 CHILD_COT_GROSS = CHILD_COT_GROSS_ML_O2 * J_PER_ML_O2
+#: Metabolic cost per stride of walkers at their most economical speed, J kg⁻¹ stride⁻¹, mean
+#: and SD: Weyand PG, Smith BR, Puyau MR, Butte NF (2010) "The mass-specific energy cost of
+#: human walking is set by stature", J Exp Biol 213:3972–3979 — 48 subjects aged 5–32 years,
+#: statures 1.07–1.83 m, treadmill, 2.74 ± 0.12 (abstract). "Largely invariant" with size, so a
+#: child of any stature has it too; the abstract does not say whether it is gross or net.
+STRIDE_COST = (2.74, 0.12)
 #: Thesis computation times (GPOPS-II, i7-6700): MSK Sec 5.2.2, NMSK Sec 5.3.5, hours.
 THESIS_HOURS = {"MSK": 2.0, "NMSK": 2.0}
 
@@ -117,7 +123,7 @@ def ch5_spec(model: str = "MSK", **kw) -> gait_ocp.GaitSpec:
 
 
 #: Spec fields that only the NMSK model takes (dropped for its MSK warm start).
-_NMSK_ONLY = ("free_activation", "excitation_guess", "t_stim", "cost", "weights", "max_iter")
+_NMSK_ONLY = ("free_activation", "excitation_guess", "t_stim", "cost", "weights", "max_iter", "isometric_torque")
 
 
 def solve(model: str = "MSK", *, guess: str = "msk", root=None, progress: bool = False, **kw) -> gait_ocp.GaitSolution:
@@ -368,7 +374,9 @@ def saturation(sol: gait_ocp.GaitSolution, level: float = 0.99) -> pd.Series:
 
 
 def _nmsk_rate(sol: gait_ocp.GaitSolution, **kw) -> dict:
-    """:func:`gaitlib.metabolics.nmsk_metabolic_rate` on an NMSK solution's control nodes."""
+    """:func:`gaitlib.metabolics.nmsk_metabolic_rate` on an NMSK solution's control nodes, in the
+    reading its NLP minimised (the spec's ``isometric_torque``) unless ``kw`` says otherwise."""
+    kw.setdefault("isometric_torque", getattr(sol.spec, "isometric_torque", None) or "thesis")
     U = sol.solution.phase("cycle").controls
     q = {j: sol.q[j].to_numpy() for j in cv.JOINTS}
     qd = {j: sol.qd[j].to_numpy() for j in cv.JOINTS}
@@ -495,6 +503,33 @@ def cot_readings(sol: gait_ocp.GaitSolution) -> pd.DataFrame:
     df.loc["thesis, Sec 5.3.5 (reference)"] = {"what changes": "printed value; no breakdown printed",
                                                 "COT": THESIS_COT}
     return df
+
+
+def cot_ranges(solutions: dict, readings: dict | None = None) -> pd.DataFrame:
+    """The cost of transport of NMSK solutions against children's measured costs.
+
+    ``solutions``: label → NMSK solution; ``readings``: label → keyword arguments of
+    :func:`gaitlib.metabolics.nmsk_metabolic_rate` to recompute that solution's Ė in another
+    reading than its NLP's (e.g. ``{"isometric_torque": "bhargava"}``: not re-optimised).
+
+    Columns, all at the data's stride D (Eq 5.57): ``COT`` — the model's own (Eq 5.38, muscle-only
+    basal rate Eq 5.48: a net cost, J kg⁻¹ m⁻¹); ``COT gross`` — the same with OpenSim's
+    whole-body resting rate (:data:`OPENSIM_BASAL_W_PER_KG`) in place of Eq 5.48's; ``per stride``
+    and ``per stride gross`` — both × D (J kg⁻¹ stride⁻¹); ``gross ÷ Waters`` — ``COT gross`` over
+    the gross COT of 6–12-year-olds at free speed (:data:`CHILD_COT_GROSS`); ``z (net)`` and
+    ``z (gross)`` — (per stride − mean) / SD of :data:`STRIDE_COST` (Weyand et al. 2010)."""
+    readings = dict(readings or {})
+    mean, sd = STRIDE_COST
+    rows = []
+    for lab, sol in solutions.items():
+        kw = dict(readings.get(lab, {}))
+        D = _stride(sol)
+        net = _cot_of(sol, _recompute_edot(sol, **kw)["total"])
+        gross = _cot_of(sol, _recompute_edot(sol, basal_whole_body=OPENSIM_BASAL_W_PER_KG, **kw)["total"])
+        rows.append({"run": lab, "D (m)": D, "COT": net, "COT gross": gross, "per stride": net * D,
+                     "per stride gross": gross * D, "gross ÷ Waters": gross / CHILD_COT_GROSS,
+                     "z (net)": (net * D - mean) / sd, "z (gross)": (gross * D - mean) / sd})
+    return pd.DataFrame(rows).set_index("run")
 
 
 def mtb_scale_table(sol: gait_ocp.GaitSolution) -> pd.DataFrame:
