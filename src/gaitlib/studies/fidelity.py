@@ -890,7 +890,8 @@ def ball_friction(which: str = "default") -> tuple[float, float]:
 FRICTION_FLOOR = gait_study.FRICTION_FLOOR
 
 
-def consistent_speed_study(friction_floor: float | None = None, legs: bool = False, **kw):
+def consistent_speed_study(friction_floor: float | None = None, legs: bool = False,
+                           isometric_torque: str | None = None, **kw):
     """Thesis Ch 7's NMSK DT problem at **every** speed class, *Free* included (same cost,
     activation parameters and parameter sets at each speed; Free data scaled in time), with
     the swing foot unloaded (:func:`swing_bound`), warm-started from the swing-unloaded
@@ -898,10 +899,14 @@ def consistent_speed_study(friction_floor: float | None = None, legs: bool = Fal
     every ellipsoid's friction coefficients at least this (:attr:`GaitSpec.friction_floor`,
     e.g. :data:`FRICTION_FLOOR`), the Ch 5 start solved with the same floor. ``legs``: the
     probe of :data:`LEG_SET_ROW` at every speed — thigh and shank × :data:`LEG_SCALE` with the
-    contact and body set identified on them (``ch4_legs``), the Ch 5 start solved on them too."""
+    contact and body set identified on them (``ch4_legs``), the Ch 5 start solved on them too.
+    ``isometric_torque``: ``"bhargava"`` — the metabolic rate every run (and the Ch 5 start)
+    minimises reads Eq 5.47's F0 as Bhargava's (:attr:`GaitSpec.isometric_torque`)."""
     params = {**pr.default_params(), "swing_load_max": swing_bound()}
     if friction_floor is not None:
         params["friction_floor"] = float(friction_floor)
+    if isometric_torque is not None:
+        params["isometric_torque"] = isometric_torque
     if legs:
         params.update(LEG_SET_CHANGE)
     return pr.speed_study(models=("NMSK",), classes=cv.SPEED_CLASSES, params=params, **kw)

@@ -376,7 +376,7 @@ def saturation(sol: gait_ocp.GaitSolution, level: float = 0.99) -> pd.Series:
 def _nmsk_rate(sol: gait_ocp.GaitSolution, **kw) -> dict:
     """:func:`gaitlib.metabolics.nmsk_metabolic_rate` on an NMSK solution's control nodes, in the
     reading its NLP minimised (the spec's ``isometric_torque``) unless ``kw`` says otherwise."""
-    kw.setdefault("isometric_torque", getattr(sol.spec, "isometric_torque", None) or "thesis")
+    kw.setdefault("isometric_torque", getattr(getattr(sol, "spec", None), "isometric_torque", None) or "thesis")
     U = sol.solution.phase("cycle").controls
     q = {j: sol.q[j].to_numpy() for j in cv.JOINTS}
     qd = {j: sol.qd[j].to_numpy() for j in cv.JOINTS}
@@ -412,17 +412,25 @@ def _cot_of(sol, edot, distance: float | None = None) -> float:
     return metabolics.cost_of_transport(tt, ee, distance=_stride(sol) if distance is None else distance)
 
 
+#: The two readings of Eq 5.47's F0 (:func:`gaitlib.metabolics.nmsk_metabolic_rate`'s
+#: ``isometric_torque``) → their column label in :func:`cot_breakdown`.
+F0_READINGS = {"thesis": "F0 = s^τ τ0 (thesis)", "bhargava": "Bhargava F_iso = a τ0 t^A"}
+
+
 def cot_breakdown(sol: gait_ocp.GaitSolution) -> pd.DataFrame:
     """Cost of transport (Eq 5.57, J kg⁻¹ m⁻¹) of an NMSK solution by term of Eq 5.38
     (each term integrated alone; 'total' includes the clipping of negative non-basal
     power, so the terms need not add up to it), for two readings of the shortening heat:
     the thesis's F0 in Eq 5.47 (isometric term 0.16 s^τ τ0 ω_f even for a relaxed
-    generator — what the NLP minimised; the heat's sign is Bhargava's, :func:`cot_readings`) and Bhargava's (0.16 a s^τ τ0 t^A(θ) ω_f). Same
-    trajectory, recomputed; not re-optimised."""
+    generator; the heat's sign is Bhargava's, :func:`cot_readings`) and Bhargava's
+    (0.16 a s^τ τ0 t^A(θ) ω_f). The reading the NLP minimised (its spec's
+    ``isometric_torque``) is the first column, labelled "NLP: …"; the other is the same
+    trajectory, recomputed, not re-optimised."""
+    nlp = getattr(getattr(sol, "spec", None), "isometric_torque", None) or "thesis"
     out = {}
-    for lab, kw in (("NLP: F0 = s^τ τ0 (thesis)", {}), ("Bhargava F_iso = a τ0 t^A", {"isometric_torque": "bhargava"})):
-        e = _recompute_edot(sol, **kw)
-        out[lab] = {k: _cot_of(sol, v) for k, v in e.items()}
+    for k in [nlp] + [r for r in F0_READINGS if r != nlp]:
+        e = _recompute_edot(sol, isometric_torque=k)
+        out[("NLP: " if k == nlp else "") + F0_READINGS[k]] = {t: _cot_of(sol, v) for t, v in e.items()}
     df = pd.DataFrame(out)
     df.index.name = "term of Eq 5.38"
     return df
@@ -471,6 +479,9 @@ def cot_readings(sol: gait_ocp.GaitSolution) -> pd.DataFrame:
     ``maintenance``, ``shortening``, ``basal``, ``work``; the total includes the clipping,
     so the terms need not add up to it).
     """
+    if getattr(getattr(sol, "spec", None), "isometric_torque", None):
+        raise ValueError("cot_readings: its rows change one thing from the thesis's F0 reading; this solve minimised "
+                         f"isometric_torque={sol.spec.isometric_torque!r} (use cot_breakdown or cot_ranges)")
     D = _stride(sol)
     rec = [
         ("NLP's reading (default)", ("Ṡ = α ω_f (> 0 shortening), split on ω_f, F0 = s^τ τ0; Ḃ = 0.0225 m; "
@@ -648,7 +659,7 @@ def findings(ident, ident_thesis_tol, params_table: pd.DataFrame, margins: pd.Da
     out.append("Activation parameters (ours): " + ", ".join(
         f"{k} = {v:.4g}" + (f" (at its {b} bound)" if b else "") for k, v, b in
         zip(act.index, act["ours"], act["ours at bound"])) + f" — thesis Table 5.10: {THESIS_ACTIVATION_TEXT}.")
-    c, cb = cot["NLP: F0 = s^τ τ0 (thesis)"], cot["Bhargava F_iso = a τ0 t^A"]
+    c, cb = cot["NLP: " + F0_READINGS["thesis"]], cot[F0_READINGS["bhargava"]]
     out.append(f"COT {c['total']:.2f} J/(kg·m) (thesis {THESIS_COT:g}): shortening heat {c['shortening']:.2f}, "
                f"activation {c['activation']:.2f}, maintenance {c['maintenance']:.2f}, work {c['work']:.2f}, "
                f"basal {c['basal']:.3f}; with Bhargava's isometric force the same motion costs {cb['total']:.2f}.")
