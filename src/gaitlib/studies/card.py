@@ -1379,9 +1379,27 @@ def _ch7_consistent() -> list[Row]:
     where = _anchor("ch07_speed", "One consistent problem on valid gaits")
     cause = f"{cause} [{where}]" if cause else ""
     skate = _skating_cause(cot, res)
-    cause = "; ".join(x for x in (cause, skate, _legs_clause("cot")) if x) or "unknown"
+    cause = "; ".join(x for x in (cause, skate, _legs_clause("cot"), _f0_clause()) if x) or "unknown"
     return [Row(7, item, "U, minimum at natural speed", ours, "", cause,
                 "Ch 7 NMSK DT, swing unloaded", _joint(valid), holds=at == "Free")]
+
+
+def _f0_clause() -> str:
+    """The card's clause on the consistent curve re-optimised with Bhargava's reading of Eq 5.47's
+    F0 (Ch 7, "With Bhargava's reading of Eq 5.47's F0"): its valid points and minimum; empty
+    when not stored."""
+    try:
+        _, _, res = fidelity.stored_consistent_study("the runs with Bhargava's F0", isometric_torque="bhargava")
+    except cache.NotCached:
+        return ""
+    cot, terms, _ = fidelity.curve_tables(res)
+    where = _anchor("ch07_speed", "With Bhargava's reading of Eq 5.47's F0")
+    if len(terms) < 3:
+        return f"with Bhargava's F0 re-optimised only {len(terms)} of {len(cot)} speeds are valid [{where}]"
+    at = terms["total"].astype(float).idxmin()
+    pts = ", ".join(f"{c} {v:.2f}" for c, v in terms["total"].items())
+    return (f"with Bhargava's F0 in Eq 5.47 re-optimised at every speed ({len(terms)} of {len(cot)} valid): {pts}, "
+            f"minimum at {at} [{where}]")
 
 
 #: The Ch 7 page's section of the consistent curve on longer legs (the card links to it).
