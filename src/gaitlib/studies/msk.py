@@ -87,8 +87,8 @@ CHILD_COT_GROSS = CHILD_COT_GROSS_ML_O2 * J_PER_ML_O2
 #: Metabolic cost per stride of walkers at their most economical speed, J kg⁻¹ stride⁻¹, mean
 #: and SD: Weyand PG, Smith BR, Puyau MR, Butte NF (2010) "The mass-specific energy cost of
 #: human walking is set by stature", J Exp Biol 213:3972–3979 — 48 subjects aged 5–32 years,
-#: statures 1.07–1.83 m, treadmill, 2.74 ± 0.12 (abstract). "Largely invariant" with size, so a
-#: child of any stature has it too; the abstract does not say whether it is gross or net.
+#: statures 1.07–1.83 m, treadmill, 2.74 ± 0.12 (abstract). "Largely invariant" with size, so it
+#: applies to a child within those statures; the abstract does not say whether it is gross or net.
 STRIDE_COST = (2.74, 0.12)
 #: Thesis computation times (GPOPS-II, i7-6700): MSK Sec 5.2.2, NMSK Sec 5.3.5, hours.
 THESIS_HOURS = {"MSK": 2.0, "NMSK": 2.0}
