@@ -200,3 +200,18 @@ def test_cot_ranges_by_hand(monkeypatch):
     text = fidelity.cot_range_findings(df.assign(**{"z (net)": [0.5, 1.0]}), {"nlp": "", "bh": "INVALID: x"})
     assert text[-1] == "**In the measured range:** nlp."
     assert "INVALID: x" in text[2] and "no conclusion" in text[2]
+
+
+def test_restart_findings_by_hand():
+    """fidelity.restart_findings: the lowest objective among valid starts decides; the curve's
+    minimum is read with that Free point in place of the study's."""
+    own = fidelity.FREE_OWN_START
+    t = pd.DataFrame({"mark": ["", "", "INVALID: x"], "objective": [0.20, 0.18, 0.10],
+                      "COT (J/kg/m)": [4.0, 2.0, 1.0]}, index=[own, "a", "b"])
+    terms = pd.DataFrame({"total": [3.0, 4.0, 2.5]}, index=["Slow", "Free", "Fast"])
+    out = fidelity.restart_findings(t, terms)
+    assert "local optimum" in out[0] and "from a " in out[0] and "-10.0 %" in out[0]  # 0.18 / 0.20 − 1
+    assert "Slow 3.00, Free 2.00, Fast 2.50" in out[1] and "minimum at **Free**" in out[1]
+    # the invalid start's lower objective is never used; the study's own best → no local optimum
+    t2 = t.assign(objective=[0.15, 0.18, 0.10])
+    assert fidelity.restart_findings(t2, terms)[0].startswith("No other start reaches a lower objective")

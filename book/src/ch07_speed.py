@@ -319,6 +319,26 @@ if res_b is not None:
     display(Markdown("\n\n".join(fidelity.cot_curve_findings(cot_b, terms_b, name="The curve with Bhargava's F0"))))
 
 # %% [markdown]
+# ### Is the Free point a local optimum? The Free run from other starts
+#
+# The consistent curve's *Free* point sits above its neighbours. "A local optimum" is a
+# hypothesis until measured: here the same Free problem (the consistent study's spec, thesis's
+# F0) is solved again from the solutions of the study's Fast and VeryFast runs, scaled in time
+# to the Free cycle (`fidelity.free_restarts`). The objective is the same problem's at every
+# start, so the lowest one is the better optimum.
+
+# %%
+try:
+    with cache.only("the Free restarts are read from the store (fidelity.free_restarts solves them)"):
+        restarts = fidelity.restart_table(fidelity.free_restarts(res_u))
+except cache.NotCached as e:
+    restarts = None
+    print(f"Not stored yet: {e}")
+if restarts is not None:
+    display(restarts)
+    display(Markdown("\n\n".join(fidelity.restart_findings(restarts, terms_u))))
+
+# %% [markdown]
 # ### On longer legs with the contact identified on them (a probe)
 #
 # Chapters 4 and 5 traced the sliding feet to the data's stride being longer than the data's

@@ -1379,9 +1379,23 @@ def _ch7_consistent() -> list[Row]:
     where = _anchor("ch07_speed", "One consistent problem on valid gaits")
     cause = f"{cause} [{where}]" if cause else ""
     skate = _skating_cause(cot, res)
-    cause = "; ".join(x for x in (cause, skate, _legs_clause("cot"), _f0_clause()) if x) or "unknown"
+    cause = "; ".join(x for x in (cause, skate, _restart_clause(res, terms), _legs_clause("cot"), _f0_clause())
+                      if x) or "unknown"
     return [Row(7, item, "U, minimum at natural speed", ours, "", cause,
                 "Ch 7 NMSK DT, swing unloaded", _joint(valid), holds=at == "Free")]
+
+
+def _restart_clause(res, terms: pd.DataFrame) -> str:
+    """The card's clause on the consistent curve's Free run from other starts (Ch 7, "Is the
+    Free point a local optimum?", :func:`gaitlib.studies.fidelity.free_restarts`); empty when
+    not stored."""
+    try:
+        with cache.only("the Free restarts"):
+            table = fidelity.restart_table(fidelity.free_restarts(res))
+    except cache.NotCached:
+        return ""
+    where = _anchor("ch07_speed", "Is the Free point a local optimum? The Free run from other starts")
+    return " ".join(x.replace("**", "") for x in fidelity.restart_findings(table, terms)) + f" [{where}]"
 
 
 def _f0_clause() -> str:

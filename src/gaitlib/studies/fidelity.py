@@ -969,6 +969,71 @@ def cot_terms(cot: pd.DataFrame, solutions: dict) -> pd.DataFrame:
     return pd.DataFrame(rows).T
 
 
+#: The consistent study's runs whose solutions start its Free run again (:func:`free_restarts`).
+FREE_RESTART_SOURCES = ("Fast", "VeryFast")
+#: The label of the consistent study's own Free run in :func:`free_restarts`.
+FREE_OWN_START = "the swing-unloaded Ch 5 solution (the study's start)"
+
+
+def free_restarts(res, sources=FREE_RESTART_SOURCES) -> dict:
+    """Is the consistent curve's *Free* point a local optimum? The study's Free problem (same
+    spec) solved again from the solutions of its runs at ``sources`` (every state and control,
+    scaled in time to the Free cycle and stride: :func:`gaitlib.studies.predictive.run_guess`),
+    solved or reloaded from the cache. Returns start label → solution, the study's own Free run
+    first (:data:`FREE_OWN_START`)."""
+    spec = res.specs["NMSK Free"]
+    g = data_mod.load_gait_data("Free", spec.source)
+    out = {FREE_OWN_START: res.solutions["NMSK Free"]}
+    for c in sources:
+        guess = pr.run_guess(res.solutions[f"NMSK {c}"], "ch5", cycle_time=g.cycle_time, stride=g.speed * g.cycle_time)
+        out[f"the NMSK {c} run's solution"] = gait_ocp.solve_cached(spec, guess=guess)
+    return out
+
+
+def restart_table(sols: dict) -> pd.DataFrame:
+    """One row per start of :func:`free_restarts`: its validity mark, status, iterations, the
+    objective (the same problem at every start, so comparable), the COT (J kg⁻¹ m⁻¹) and the
+    worst RMSE per kind (deg, N·m, N)."""
+    rows = {}
+    for k, s in sols.items():
+        worst = s.rmse.groupby("kind")["rmse"].max()
+        lab = validity.label(s)
+        rows[k] = {"mark": "" if lab == "valid" else lab, "status": s.stats["status"],
+                   "iterations": s.stats["iterations"], "objective": s.stats["objective"], "COT (J/kg/m)": s.stats["COT"],
+                   "worst angle RMSE (deg)": worst.get("angle"), "worst torque RMSE (N·m)": worst.get("torque"),
+                   "worst GRF RMSE (N)": worst.get("grf")}
+    return pd.DataFrame.from_dict(rows, orient="index").rename_axis("start")
+
+
+def restart_findings(table: pd.DataFrame, terms: pd.DataFrame) -> list[str]:
+    """The sentences on :func:`restart_table`: whether another start reaches a lower objective on
+    the Free problem (the study's Free point then a local optimum, measured), and where the curve's
+    minimum is with the best-objective Free point in place of the study's (``terms``:
+    :func:`cot_terms` of the study, its valid points)."""
+    ok = table[table["mark"] == ""]
+    own = table.loc[FREE_OWN_START]
+    if own["mark"] or len(ok) < 2:
+        return [f"Too few valid starts to compare ({len(ok)} of {len(table)})."]
+    best = ok["objective"].astype(float).idxmin()
+    if best == FREE_OWN_START:
+        return [f"No other start reaches a lower objective on the Free problem than the study's "
+                f"({own['objective']:.4g}): the Free point ({own['COT (J/kg/m)']:.2f} J kg⁻¹ m⁻¹) is the best of "
+                f"{len(ok)} starts."]
+    b = ok.loc[best]
+    out = [f"**The study's Free point is a local optimum**: from {best} the same problem ends at objective "
+           f"{b['objective']:.4g}, {100 * (b['objective'] / own['objective'] - 1):+.1f} % against the study's "
+           f"{own['objective']:.4g}, with COT {b['COT (J/kg/m)']:.2f} J kg⁻¹ m⁻¹ instead of {own['COT (J/kg/m)']:.2f}."]
+    if "Free" in terms.index:
+        pts = terms["total"].astype(float).copy()
+        pts["Free"] = float(b["COT (J/kg/m)"])
+        at = pts.idxmin()
+        out.append("With that Free point the curve reads " + ", ".join(f"{c} {v:.2f}" for c, v in pts.items())
+                   + f": minimum at **{at}**" + (" — the natural speed." if at == "Free" else
+                                                 ", still not at the natural speed: the local optimum raises the "
+                                                 "Free point but does not make the curve's minimum."))
+    return out
+
+
 def skating_findings(cot: pd.DataFrame, slip: pd.DataFrame, cot_f: pd.DataFrame, slip_f: pd.DataFrame,
                      terms_f: pd.DataFrame, floor: float = FRICTION_FLOOR, reruns: tuple = (),
                      reference: dict | None = None) -> list[str]:
