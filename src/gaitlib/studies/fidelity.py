@@ -836,8 +836,8 @@ def cot_range_findings(table: pd.DataFrame, labels: dict[str, str]) -> list[str]
            f"stride at their most economical speed (Weyand et al. 2010, mean ± SD); on our stride D = {D:.3f} m "
            f"that is {mean / D:.2f} ± {sd / D:.2f} J kg⁻¹ m⁻¹, and ± {RANGE_Z:g} SD spans {(mean - RANGE_Z * sd) / D:.2f}–"
            f"{(mean + RANGE_Z * sd) / D:.2f}. The abstract does not say whether this is gross or net; Waters et al.'s "
-           f"gross mean for 6–12-year-olds ({msk.CHILD_COT_GROSS:.2f} J kg⁻¹ m⁻¹) is "
-           f"{msk.CHILD_COT_GROSS * D / mean:.2f}× it per stride, so we read it as a net cost and compare it with the "
+           f"gross mean for 6–12-year-olds ({msk.CHILD_COT_GROSS:.2f} J kg⁻¹ m⁻¹), taken over the same stride, is "
+           f"{msk.CHILD_COT_GROSS * D / mean:.2f}× it, so we read it as a net cost and compare it with the "
            f"model's own COT, whose basal term (Eq 5.48) covers the muscles only; the gross column (OpenSim's "
            f"whole-body {msk.OPENSIM_BASAL_W_PER_KG:g} W/kg added) is compared with Waters et al.'s gross mean."]
     inside = []
@@ -1012,7 +1012,9 @@ def restart_findings(table: pd.DataFrame, terms: pd.DataFrame) -> list[str]:
     :func:`cot_terms` of the study, its valid points)."""
     ok = table[table["mark"] == ""]
     own = table.loc[FREE_OWN_START]
-    if own["mark"] or len(ok) < 2:
+    if own["mark"]:
+        return [f"The study's own Free run is marked ({own['mark']}): nothing to compare it with."]
+    if len(ok) < 2:
         return [f"Too few valid starts to compare ({len(ok)} of {len(table)})."]
     best = ok["objective"].astype(float).idxmin()
     if best == FREE_OWN_START:
