@@ -991,15 +991,15 @@ def free_restarts(res, sources=FREE_RESTART_SOURCES) -> dict:
 
 
 def restart_table(sols: dict) -> pd.DataFrame:
-    """One row per start of :func:`free_restarts`: its validity mark, status, iterations, the
-    objective (the same problem at every start, so comparable), the COT (J kg⁻¹ m⁻¹) and the
+    """One row per start of :func:`free_restarts`: its validity mark (:func:`gaitlib.validity.label`),
+    status, :func:`gaitlib.studies.predictive.solve_row` (iterations, solve and build time, the
+    objective — the same problem at every start, so comparable — the COT, J kg⁻¹ m⁻¹) and the
     worst RMSE per kind (deg, N·m, N)."""
     rows = {}
     for k, s in sols.items():
         worst = s.rmse.groupby("kind")["rmse"].max()
         lab = validity.label(s)
-        rows[k] = {"mark": "" if lab == "valid" else lab, "status": s.stats["status"],
-                   "iterations": s.stats["iterations"], "objective": s.stats["objective"], "COT (J/kg/m)": s.stats["COT"],
+        rows[k] = {"mark": "" if lab == "valid" else lab, "status": s.stats["status"], **pr.solve_row(s),
                    "worst angle RMSE (deg)": worst.get("angle"), "worst torque RMSE (N·m)": worst.get("torque"),
                    "worst GRF RMSE (N)": worst.get("grf")}
     return pd.DataFrame.from_dict(rows, orient="index").rename_axis("start")

@@ -50,7 +50,7 @@ from ..marks import failure_label
 
 __all__ = ["CH6_COSTS", "CH7_CLASSES", "THESIS_CLASS", "THESIS_HOURS_TABLE_6_3", "THESIS_HOURS_TABLE_7_2",
            "THESIS_COT_FIG_7_5", "THESIS_FP_GAIN_PCT", "THESIS_FP_EXCITATION_GAIN_PCT",
-           "THESIS_TORQUE_GAIN_PCT_CH7", "BASELINE_COST", "GUESS_POLICY", "GUESS_POLICY_CH7", "START_COLUMNS", "thesis_guess_runs", "baseline", "default_params", "thesis_guess", "run_guess", "ch6_specs", "ch7_specs",
+           "THESIS_TORQUE_GAIN_PCT_CH7", "BASELINE_COST", "GUESS_POLICY", "GUESS_POLICY_CH7", "START_COLUMNS", "solve_row", "thesis_guess_runs", "baseline", "default_params", "thesis_guess", "run_guess", "ch6_specs", "ch7_specs",
            "score", "excitation_score", "StudyResult", "cost_function_study", "speed_study", "cot_table", "u_breaks",
            "times_table", "guess_lines", "SDT3_ENOUGH_FACTOR", "COT_CURVE_MIN_POINTS", "kind_nrmse", "mean_nrmse", "ch6_findings",
            "ch7_findings", "cot_figure"]
@@ -432,15 +432,22 @@ class StudyResult:
         rows = []
         for name, rec in self.records.items():
             sol = self.solutions.get(name)
-            st = sol.stats if sol is not None else {}
             rows.append({"run": name, "mark": marks.failure_label(sol if sol is not None else rec) or "",
-                         "guess": self.guess.get(name.split(" ", 1)[0]), "status": rec.status, "converged": bool(st.get("success", False)),
-                         "iterations": st.get("iterations"), "solve (s)": st.get("solve_time_s"),
-                         "ms/iteration": 1e3 * st["time_per_iteration_s"] if st else np.nan,
-                         "build (s)": st.get("build_time_s"), "objective": st.get("objective"),
-                         "max violation": st.get("max_violation"), "from cache": st.get("from_cache"),
-                         "COT (J/kg/m)": st.get("COT", np.nan), "error": rec.error})
+                         "guess": self.guess.get(name.split(" ", 1)[0]), "status": rec.status,
+                         **solve_row(sol), "error": rec.error})
         return pd.DataFrame(rows).set_index("run")
+
+
+def solve_row(sol) -> dict:
+    """What a solve reports, as one table row: converged, iterations, solve and build time (s),
+    ms per iteration, objective, max violation, whether it came from the cache and the COT
+    (J kg⁻¹ m⁻¹; NaN for MSK). ``sol`` None (the run raised) → the same keys, empty."""
+    st = sol.stats if sol is not None else {}
+    return {"converged": bool(st.get("success", False)), "iterations": st.get("iterations"),
+            "solve (s)": st.get("solve_time_s"), "ms/iteration": 1e3 * st["time_per_iteration_s"] if st else np.nan,
+            "build (s)": st.get("build_time_s"), "objective": st.get("objective"),
+            "max violation": st.get("max_violation"), "from cache": st.get("from_cache"),
+            "COT (J/kg/m)": st.get("COT", np.nan)}
 
 
 def _run(specs: dict, guesses: dict, *, root, scheduler, n_workers, serial, progress) -> tuple[dict, dict]:
