@@ -202,16 +202,30 @@ def test_cot_ranges_by_hand(monkeypatch):
     assert "INVALID: x" in text[2] and "no conclusion" in text[2]
 
 
-def test_restart_findings_by_hand():
-    """fidelity.restart_findings: the lowest objective among valid starts decides; the curve's
-    minimum is read with that Free point in place of the study's."""
-    own = fidelity.FREE_OWN_START
-    t = pd.DataFrame({"mark": ["", "", "INVALID: x"], "objective": [0.20, 0.18, 0.10],
-                      "COT (J/kg/m)": [4.0, 2.0, 1.0]}, index=[own, "a", "b"])
-    terms = pd.DataFrame({"total": [3.0, 4.0, 2.5]}, index=["Slow", "Free", "Fast"])
-    out = fidelity.restart_findings(t, terms)
-    assert "local optimum" in out[0] and "from a " in out[0] and "-10.0 %" in out[0]  # 0.18 / 0.20 − 1
-    assert "Slow 3.00, Free 2.00, Fast 2.50" in out[1] and "minimum at **Free**" in out[1]
-    # the invalid start's lower objective is never used; the study's own best → no local optimum
-    t2 = t.assign(objective=[0.15, 0.18, 0.10])
-    assert fidelity.restart_findings(t2, terms)[0].startswith("No other start reaches a lower objective")
+def test_best_starts_and_restart_findings_by_hand():
+    """fidelity.best_starts: within a class the lowest objective among converged, valid starts
+    decides (a marked start's lower objective never counts); restart_findings names the local
+    optima and reads the curve of the best starts."""
+    own = fidelity.OWN_START
+    rows = {("Slow", own): ["", 0.20, 4.0], ("Slow", "Free"): ["", 0.18, 3.0], ("Slow", "Fast"): ["INVALID: x", 0.10, 1.0],
+            ("Free", own): ["", 0.30, 5.0], ("Free", "Slow"): ["", 0.33, 2.0]}
+    t = pd.DataFrame.from_dict(rows, orient="index", columns=["mark", "objective", "COT (J/kg/m)"])
+    t.index = pd.MultiIndex.from_tuples(t.index, names=["class", "start"])
+    best = fidelity.best_starts(t)
+    assert list(best.index) == ["Slow", "Free"]  # speed order
+    assert best.loc["Slow", "best start"] == "Free" and best.loc["Slow", "valid starts"] == "2 of 3"
+    assert best.loc["Slow", "objective change (%)"] == pytest.approx(-10.0)  # 0.18 / 0.20 − 1
+    assert best.loc["Free", "best start"] == own and best.loc["Free", "objective change (%)"] == pytest.approx(0.0)
+    assert best.loc["Slow", "COT over valid starts (J/kg/m)"] == "3.00–4.00"
+    idx = ["Slow", "Free", "Fast"]
+    terms = pd.DataFrame({"speed (m/s)": [0.8, 1.2, 1.5], "total": [4.0, 5.0, 4.5]}, index=idx)
+    terms_b = pd.DataFrame({"speed (m/s)": [0.8, 1.2, 1.5], "total": [3.0, 5.0, 4.5], "work": [1.0, 2.5, 2.0]},
+                           index=idx)
+    cot_b = pd.DataFrame({"mark": ["", "", ""]}, index=idx)
+    out = fidelity.restart_findings(best, terms, cot_b, terms_b, n_runs=3)
+    assert out[0].startswith("**1 of 2 of the study's valid points are local optima**")
+    assert "Slow from Free -10.0 %, COT 4.00 → 3.00" in out[0]
+    assert "minimum at **Slow**" in out[1] and "work +1.50" in out[2] and out[-1] == "(The study's own curve has its minimum at Slow.)"
+    # the study's own run best everywhere → no local optimum named
+    best2 = fidelity.best_starts(t.drop(index=("Slow", "Free")))
+    assert fidelity.restart_findings(best2, terms, cot_b, terms_b, n_runs=2)[0].startswith("No restart (2 solved)")

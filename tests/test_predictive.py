@@ -263,3 +263,40 @@ def test_guess_lines_count_converged_and_invalid_runs_per_start():
     assert la == ("- partial: MSK 2 of 3 runs converged within 1000 iterations (500–900 iterations); not converged: "
                   "MSK SP3 (Maximum_Iterations_Exceeded); converged but invalid: MSK FP (INVALID: double support).")
     assert lb == "- whole: MSK 2 of 2 runs converged within 1000 iterations (201–450 iterations)."
+
+
+def test_data_start_runs_rejects_an_unknown_start():
+    with pytest.raises(ValueError, match="start must be one of"):
+        pr.data_start_runs({}, "free data")
+
+
+def _start_rows(rows):
+    t = pd.DataFrame.from_dict(rows, orient="index", columns=["mark", "objective", "vs class data", "vs tracked input",
+                                                              "cells closer than the input"])
+    t.index = pd.MultiIndex.from_tuples(t.index, names=["class", "start"])
+    return t
+
+
+def test_start_findings_by_hand():
+    """pr.start_findings: cells summed per start over unmarked runs; the verdict compares the
+    own and the probe start only where both are unmarked, by objective and by cells."""
+    own, probe = pr.CH7_OWN_START, "class data"
+    rows = {("Slow", own): ["", 0.30, 0.20, 0.10, 0], ("Slow", probe): ["", 0.25, 0.15, 0.20, 2],
+            ("Fast", own): ["", 0.40, 0.30, 0.10, 1], ("Fast", probe): ["", 0.35, 0.20, 0.20, 3],
+            ("VeryFast", own): ["", 0.50, 0.30, 0.10, 0], ("VeryFast", probe): ["NOT CONVERGED", 0.10, 0.10, 0.3, 3]}
+    t = _start_rows(rows)
+    out = pr.start_findings(t, own, probe)
+    assert out[0].startswith(f"From {own}: closer to the class data than the scaled input in 1 of 9 cells;")
+    assert "in 5 of 6 cells (left out, marked: VeryFast (NOT CONVERGED))" in out[1]
+    assert "mean NRMSE against the class data 0.175" in out[1]  # (0.15 + 0.20) / 2
+    assert out[2].startswith("**The start pins the predictions**")
+    assert "lower than from" in out[2] and "in 2 of 2 (Slow, Fast), closer to the class data in 5 cells against 1" in out[2]
+    # the probe's runs end worse (higher objective) though closer: the objective holds them
+    t2 = t.copy()
+    t2.loc[("Slow", probe), "objective"] = 0.31
+    t2.loc[("Fast", probe), "objective"] = 0.41
+    assert pr.start_findings(t2, own, probe)[-1].startswith("**The objective holds the predictions, not the start**")
+    # no closer cells from the probe: the start does not pin them
+    t3 = t.copy()
+    t3.loc[[("Slow", probe), ("Fast", probe)], "cells closer than the input"] = 0
+    assert pr.start_findings(t3, own, probe)[-1].startswith("**The start does not pin the predictions**")

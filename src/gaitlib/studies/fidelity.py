@@ -969,70 +969,124 @@ def cot_terms(cot: pd.DataFrame, solutions: dict) -> pd.DataFrame:
     return pd.DataFrame(rows).T
 
 
-#: The consistent study's runs whose solutions start its Free run again (:func:`free_restarts`).
-FREE_RESTART_SOURCES = ("Fast", "VeryFast")
-#: The label of the consistent study's own Free run in :func:`free_restarts`.
-FREE_OWN_START = "the swing-unloaded Ch 5 solution (the study's start)"
+#: The label of a consistent run's own start (the swing-unloaded Ch 5 solution the study starts
+#: every class from) in :func:`curve_restarts`.
+OWN_START = "Ch 5 (the study's start)"
 
 
-def free_restarts(res, sources=FREE_RESTART_SOURCES) -> dict:
-    """Is the consistent curve's *Free* point a local optimum? The study's Free problem (same
-    spec) solved again from the solutions of its runs at ``sources`` (every state and control,
-    scaled in time to the Free cycle and stride: :func:`gaitlib.studies.predictive.run_guess`),
-    solved or reloaded from the cache. Returns start label → solution, the study's own Free run
-    first (:data:`FREE_OWN_START`)."""
-    spec = res.specs["NMSK Free"]
-    g = data_mod.load_gait_data("Free", spec.source)
-    out = {FREE_OWN_START: res.solutions["NMSK Free"]}
-    for c in sources:
-        guess = pr.run_guess(res.solutions[f"NMSK {c}"], "ch5", cycle_time=g.cycle_time, stride=g.speed * g.cycle_time)
-        out[f"the NMSK {c} run's solution"] = gait_ocp.solve_cached(spec, guess=guess)
+def restart_runs(res, classes=None) -> tuple[dict, dict]:
+    """The runs of :func:`curve_restarts`: each class's problem of the consistent study ``res``
+    (its spec unchanged: same cost, parameters and data) started from every *other* class's
+    solution in ``res`` — every state and control, scaled in time to the class's cycle and
+    stride (:func:`gaitlib.studies.predictive.run_guess`). ``classes``: default every class of
+    ``res`` in speed order. Returns ``(specs, guesses)`` keyed ``"NMSK <class> from <source>"``."""
+    have = [c for c in cv.SPEED_CLASSES if f"NMSK {c}" in res.specs]
+    classes = have if classes is None else list(classes)
+    specs, guesses = {}, {}
+    for c in classes:
+        spec = res.specs[f"NMSK {c}"]
+        legs = {} if spec.leg_scale is None else {"leg_scale": spec.leg_scale}
+        g = data_mod.load_gait_data(c, spec.source, **legs)
+        for src in have:
+            if src == c or res.solutions.get(f"NMSK {src}") is None:
+                continue
+            k = f"NMSK {c} from {src}"
+            specs[k] = spec
+            guesses[k] = pr.run_guess(res.solutions[f"NMSK {src}"], "ch5", cycle_time=g.cycle_time,
+                                      stride=g.speed * g.cycle_time)
+    return specs, guesses
+
+
+def curve_restarts(res, classes=None, *, scheduler: str | None = None, n_workers: int | None = None,
+                   progress: bool = True) -> dict:
+    """Is each point of a consistent curve a local optimum? Every class's problem solved again
+    from every other class's solution (:func:`restart_runs`; one dask sweep, solved or reloaded
+    from the cache). Returns class → {start → solution (None if the run raised)}: the study's
+    own run first (:data:`OWN_START`), then the other classes' solutions by class name."""
+    specs, guesses = restart_runs(res, classes)
+    recs = gait_ocp.solve_specs(specs, guesses=guesses, scheduler=scheduler, n_workers=n_workers,
+                                progress=progress)
+    out = {}
+    for k, r in recs.items():
+        c, src = k.removeprefix("NMSK ").split(" from ")
+        out.setdefault(c, {OWN_START: res.solutions.get(f"NMSK {c}")})[src] = r.value
     return out
 
 
-def restart_table(sols: dict) -> pd.DataFrame:
-    """One row per start of :func:`free_restarts`: its validity mark (:func:`gaitlib.validity.label`),
-    status, :func:`gaitlib.studies.predictive.solve_row` (iterations, solve and build time, the
-    objective — the same problem at every start, so comparable — the COT, J kg⁻¹ m⁻¹) and the
-    worst RMSE per kind (deg, N·m, N)."""
+def restart_table(restarts: dict) -> pd.DataFrame:
+    """One row per class and start of :func:`curve_restarts`: its validity mark
+    (:func:`gaitlib.validity.label`; "raised" when the run raised), status,
+    :func:`gaitlib.studies.predictive.solve_row` (iterations, solve and build time, the
+    objective — the same problem for every start of a class, so comparable within it — the
+    COT, J kg⁻¹ m⁻¹) and the worst RMSE per kind against the tracked data (deg, N·m, N)."""
     rows = {}
-    for k, s in sols.items():
-        worst = s.rmse.groupby("kind")["rmse"].max()
-        lab = validity.label(s)
-        rows[k] = {"mark": "" if lab == "valid" else lab, "status": s.stats["status"], **pr.solve_row(s),
-                   "worst angle RMSE (deg)": worst.get("angle"), "worst torque RMSE (N·m)": worst.get("torque"),
-                   "worst GRF RMSE (N)": worst.get("grf")}
-    return pd.DataFrame.from_dict(rows, orient="index").rename_axis("start")
+    for c, sols in restarts.items():
+        for k, s in sols.items():
+            if s is None:
+                rows[(c, k)] = {"mark": "raised", "status": "error", **pr.solve_row(None)}
+                continue
+            worst = s.rmse.groupby("kind")["rmse"].max()
+            lab = validity.label(s)
+            rows[(c, k)] = {"mark": "" if lab == "valid" else lab, "status": s.stats["status"], **pr.solve_row(s),
+                            "worst angle RMSE (deg)": worst.get("angle"),
+                            "worst torque RMSE (N·m)": worst.get("torque"), "worst GRF RMSE (N)": worst.get("grf")}
+    return pd.DataFrame.from_dict(rows, orient="index").rename_axis(["class", "start"])
 
 
-def restart_findings(table: pd.DataFrame, terms: pd.DataFrame) -> list[str]:
-    """The sentences on :func:`restart_table`: whether another start reaches a lower objective on
-    the Free problem (the study's Free point then a local optimum, measured), and where the curve's
-    minimum is with the best-objective Free point in place of the study's (``terms``:
-    :func:`cot_terms` of the study, its valid points)."""
-    ok = table[table["mark"] == ""]
-    own = table.loc[FREE_OWN_START]
-    if own["mark"]:
-        return [f"The study's own Free run is marked ({own['mark']}): nothing to compare it with."]
-    if len(ok) < 2:
-        return [f"Too few valid starts to compare ({len(ok)} of {len(table)})."]
-    best = ok["objective"].astype(float).idxmin()
-    if best == FREE_OWN_START:
-        return [f"No other start reaches a lower objective on the Free problem than the study's "
-                f"({own['objective']:.4g}): the Free point ({own['COT (J/kg/m)']:.2f} J kg⁻¹ m⁻¹) is the best of "
-                f"{len(ok)} starts."]
-    b = ok.loc[best]
-    out = [f"**The study's Free point is a local optimum**: from {best} the same problem ends at objective "
-           f"{b['objective']:.4g}, {100 * (b['objective'] / own['objective'] - 1):+.1f} % against the study's "
-           f"{own['objective']:.4g}, with COT {b['COT (J/kg/m)']:.2f} J kg⁻¹ m⁻¹ instead of {own['COT (J/kg/m)']:.2f}."]
-    if "Free" in terms.index:
-        pts = terms["total"].astype(float).copy()
-        pts["Free"] = float(b["COT (J/kg/m)"])
-        at = pts.idxmin()
-        out.append("With that Free point the curve reads " + ", ".join(f"{c} {v:.2f}" for c, v in pts.items())
-                   + f": minimum at **{at}**" + (" — the natural speed." if at == "Free" else
-                                                 ", still not at the natural speed: the local optimum raises the "
-                                                 "Free point but does not make the curve's minimum."))
+def best_starts(table: pd.DataFrame) -> pd.DataFrame:
+    """Per class of a :func:`restart_table`: the study's own run (its objective and COT, or its
+    mark) beside the lowest-objective start among the converged, valid ones, the objective's
+    change (%) and that start's COT. Rows in speed order."""
+    rows = {}
+    for c in [c for c in cv.SPEED_CLASSES if c in table.index.get_level_values("class")]:
+        t = table.loc[c]
+        own = t.loc[OWN_START]
+        ok = t[t["mark"] == ""]
+        best = ok["objective"].astype(float).idxmin() if len(ok) else None
+        b = ok.loc[best] if best is not None else None
+        rows[c] = {"own mark": own["mark"], "own objective": own["objective"], "own COT (J/kg/m)": own["COT (J/kg/m)"],
+                   "valid starts": f"{len(ok)} of {len(t)}", "best start": best,
+                   "best objective": None if b is None else b["objective"],
+                   "objective change (%)": (np.nan if b is None or own["mark"] else
+                                            100 * (b["objective"] / own["objective"] - 1)),
+                   "best COT (J/kg/m)": np.nan if b is None else b["COT (J/kg/m)"],
+                   "COT over valid starts (J/kg/m)": (f"{ok['COT (J/kg/m)'].min():.2f}–{ok['COT (J/kg/m)'].max():.2f}"
+                                                      if len(ok) else "")}
+    return pd.DataFrame.from_dict(rows, orient="index").rename_axis("class")
+
+
+def best_curve(restarts: dict, best: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The curve of the lowest-objective valid start of each class (``best``: :func:`best_starts`
+    of ``restarts``): its :func:`gaitlib.studies.predictive.cot_table` and :func:`cot_terms`."""
+    sols = {f"NMSK {c}": restarts[c][r["best start"]] for c, r in best.iterrows() if r["best start"]}
+    study = type("BestOfStarts", (), {"solutions": sols})()
+    cot = pr.cot_table(study)
+    return cot, cot_terms(cot, sols)
+
+
+def restart_findings(best: pd.DataFrame, terms: pd.DataFrame, cot_best: pd.DataFrame, terms_best: pd.DataFrame,
+                     n_runs: int) -> list[str]:
+    """The sentences on the multistart of a consistent curve: in how many classes another start
+    reaches a lower objective than the study's own run (that run then a local optimum, measured)
+    and how far the COT moves; then where the curve of the best starts has its minimum
+    (:func:`cot_curve_findings`; ``terms``: :func:`cot_terms` of the study, ``cot_best`` and
+    ``terms_best``: :func:`best_curve`; ``n_runs``: the restarts solved)."""
+    ok = best[best["own mark"] == ""]
+    lower = ok[ok["objective change (%)"].astype(float) < -0.01]
+    out = []
+    if len(lower):
+        out.append(f"**{len(lower)} of {len(ok)} of the study's valid points are local optima** (measured, "
+                   f"{n_runs} restarts): another class's solution as start ends the same problem lower — "
+                   + "; ".join(f"{c} from {r['best start']} {r['objective change (%)']:+.1f} %, COT "
+                               f"{r['own COT (J/kg/m)']:.2f} → {r['best COT (J/kg/m)']:.2f}" for c, r in lower.iterrows())
+                   + " J kg⁻¹ m⁻¹.")
+    else:
+        out.append(f"No restart ({n_runs} solved) ends any class's problem lower than the study's own run: "
+                   f"each of its {len(ok)} valid points is the best of its starts.")
+    if len(terms) and len(terms_best):
+        old = terms["total"].astype(float).idxmin()
+        out += cot_curve_findings(cot_best, terms_best, name="The curve of the best starts")
+        out.append(f"(The study's own curve has its minimum at {old}.)")
     return out
 
 

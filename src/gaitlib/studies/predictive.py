@@ -634,6 +634,112 @@ def pin_findings(pull: pd.DataFrame, loose: pd.DataFrame | None = None) -> list[
     return out
 
 
+#: The starts of :func:`data_start_study`: the problem's own data-based guess (thesis Sec 4.3.2)
+#: on the data it tracks (the time-scaled *Free* data) and the same guess built on the class's
+#: own data, which no Ch 7 problem tracks.
+DATA_STARTS = ("tracked input", "class data")
+#: The label of the chapter's own Ch 7 runs (started from the Ch 5 solution) beside
+#: :data:`DATA_STARTS` in :func:`start_table`.
+CH7_OWN_START = "the Ch 5 solution (the chapter's)"
+
+
+def data_start_runs(specs: Mapping[str, gait_ocp.GaitSpec], start: str, max_iter: int = 3000) -> tuple[dict, dict]:
+    """The runs of :func:`data_start_study`: ``(specs, guesses)`` — the NMSK ``specs`` with the
+    iteration limit ``max_iter`` and, for ``start="class data"``, each one's data-based guess
+    built on its class's own data (``"tracked input"``: no guess, the problem's own)."""
+    if start not in DATA_STARTS:
+        raise ValueError(f"start must be one of {DATA_STARTS}, got {start!r}")
+    specs = {k: replace(s, max_iter=max_iter) for k, s in specs.items() if k.startswith("NMSK ")}
+    guesses = {}
+    if start == "class data":
+        for k, s in specs.items():
+            guesses[k] = gait_ocp.data_guess_on(gait_ocp.build(s), data_mod.load_gait_data(s.speed_class, s.source))
+    return specs, guesses
+
+
+def data_start_study(res: StudyResult, start: str, *, max_iter: int = 3000, root=None, scheduler: str | None = None,
+                     n_workers: int | None = None, serial: bool = False, progress: bool = True) -> StudyResult:
+    """Does the start pin a Ch 7 prediction to its input? The NMSK runs of ``res`` (each spec
+    unchanged but its iteration limit, ``max_iter``: the chapter's rerun limit) solved from the
+    data-based guess (:func:`gaitlib.problems.gait.data_guess_on`) built on ``start`` (one of
+    :data:`DATA_STARTS`): ``"class data"`` — the class's own data, a start only (the problem
+    still tracks the scaled Free data; its objective decides where the run ends) — or
+    ``"tracked input"`` — the problem's own data-based guess, the control
+    (:func:`data_start_runs`). ``res``'s runs start from the Ch 5 solution
+    (:data:`GUESS_POLICY_CH7`); the objectives of the three starts of a class are the same
+    problem's, so comparable."""
+    specs, guesses = data_start_runs(res.specs, start, max_iter)
+    gaits = {c: data_mod.load_gait_data(c, s.source) for s in specs.values() for c in (s.speed_class, "Free")}
+    recs, sols = _run(specs, guesses, root=root, scheduler=scheduler, n_workers=n_workers, serial=serial,
+                      progress=progress)
+    return StudyResult(specs, recs, sols, res.baselines, _scores(sols, gaits, lambda s: s.spec.speed_class),
+                       guess={"NMSK": start}, guesses=guesses)
+
+
+def start_table(studies: Mapping[str, StudyResult], gaits: dict) -> pd.DataFrame:
+    """One row per class and start of the Ch 7 NMSK runs (``studies``: start label → study —
+    the chapter's runs first, then :func:`data_start_study` of each start): the run's mark,
+    iterations, objective (the same problem at every start of a class), COT, its mean NRMSE
+    over the three kinds against the class data and against the input it tracked
+    (:func:`input_pull`), and in how many of its three cells it is closer to the class data
+    than the scaled input (:func:`closer_cells`)."""
+    rows = {}
+    for lab, st in studies.items():
+        nm = {k: v for k, v in st.solutions.items() if k.startswith("NMSK ")}
+        pull = input_pull(type("Runs", (), {"solutions": nm})(), gaits)
+        for name, sol in nm.items():
+            p = pull.loc[name]
+            rows[(sol.spec.speed_class, lab)] = {
+                "mark": marks.failure_label(sol) or "", "iterations": sol.stats.get("iterations"),
+                "objective": sol.stats.get("objective"), "COT (J/kg/m)": sol.stats.get("COT", np.nan),
+                "vs class data": float(p["vs class data"].mean()), "vs tracked input": float(p["vs tracked input"].mean()),
+                "cells closer than the input": int((p["vs class data"] < p["control: input vs class"]).sum())}
+    t = pd.DataFrame.from_dict(rows, orient="index").rename_axis(["class", "start"])
+    order = [c for c in CH7_CLASSES if c in t.index.get_level_values("class")]
+    return t.reindex(order, level="class")
+
+
+def start_findings(table: pd.DataFrame, own: str, probe: str = "class data") -> list[str]:
+    """The sentences on :func:`start_table`: per start, how many unmarked cells come closer to
+    the class data than the scaled input; then, where the ``own`` start's run (the chapter's)
+    and the ``probe`` start's are both converged and valid, whether the probe ends the same
+    problem lower (objective) and closer to the class data — the start pins the predictions —
+    or not (the objective does)."""
+    out = []
+    for lab in table.index.get_level_values("start").unique():
+        t = table.xs(lab, level="start")
+        ok = t[t["mark"] == ""]
+        bad = [f"{c} ({m})" for c, m in t["mark"].items() if m]
+        out.append(f"From {lab}: closer to the class data than the scaled input in "
+                   f"{int(ok['cells closer than the input'].sum())} of {3 * len(ok)} cells"
+                   + (f" (left out, marked: {'; '.join(bad)})" if bad else "")
+                   + (f"; mean NRMSE against the class data {ok['vs class data'].mean():.3f}, against the tracked "
+                      f"input {ok['vs tracked input'].mean():.3f}." if len(ok) else "."))
+    both = [c for c in table.index.get_level_values("class").unique()
+            if (c, own) in table.index and (c, probe) in table.index
+            and not table.loc[(c, own), "mark"] and not table.loc[(c, probe), "mark"]]
+    if not both:
+        return out + [f"No class has both its {own} and its {probe} run converged and valid: no comparison."]
+    o, p = table.loc[[(c, own) for c in both]], table.loc[[(c, probe) for c in both]]
+    lower = [c for c in both if table.loc[(c, probe), "objective"] < table.loc[(c, own), "objective"]]
+    k_o, k_p = int(o["cells closer than the input"].sum()), int(p["cells closer than the input"].sum())
+    d_o, d_p = o["vs class data"].mean(), p["vs class data"].mean()
+    head = (f"Started on the {probe} (a start only; the problem still tracks the scaled Free data), the "
+            f"{len(both)} runs valid at both starts end the same problem lower than from {own} in {len(lower)} of "
+            f"{len(both)}" + (f" ({', '.join(lower)})" if lower else "") + f", closer to the class data in {k_p} "
+            f"cells against {k_o} (mean NRMSE {d_p:.3f} against {d_o:.3f}).")
+    if len(lower) > len(both) / 2 and k_p > k_o:
+        out.append(f"**The start pins the predictions**: {head} The chapter's runs are local optima near their "
+                   "start; a start nearer the class data finds better optima that are nearer it too.")
+    elif k_p > k_o:
+        out.append(f"**The objective holds the predictions, not the start**: {head} The runs that stay nearer the "
+                   "class data are worse optima of the same problem: its cost prefers the input-like gait.")
+    else:
+        out.append(f"**The start does not pin the predictions**: {head} From the class's own data the runs end no "
+                   "closer to it: the problem's optima lie near its input whichever side they are reached from.")
+    return out
+
+
 def cot_table(ch7: StudyResult, natural=None) -> pd.DataFrame:
     """COT (Eq 5.57) of the NMSK runs against walking speed, ours beside the thesis's
     Fig 7.5 point of the class of the same rank (labelled; different classes and speeds).
