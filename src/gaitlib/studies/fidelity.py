@@ -1013,6 +1013,20 @@ def curve_restarts(res, classes=None, *, scheduler: str | None = None, n_workers
     return out
 
 
+def marked_restarts(res, **kw) -> dict:
+    """A consistent curve's marked runs (not converged, or failing a gate) started again from
+    every other class's solution (:func:`curve_restarts` of those classes only; ``kw``: its
+    options), beside the study's own run of every class (the unmarked ones alone): class →
+    {start → solution}, for :func:`best_starts` / :func:`best_curve` — the curve with the best
+    valid restart standing in where the study's own run is marked."""
+    sols = {s.spec.speed_class: s for k, s in res.solutions.items() if k.startswith("NMSK ")}
+    marked = [c for c in cv.SPEED_CLASSES if c in sols and validity.label(sols[c]) != "valid"]
+    out = {c: {OWN_START: s} for c, s in sols.items()}
+    if marked:
+        out.update(curve_restarts(res, classes=marked, **kw))
+    return {c: out[c] for c in cv.SPEED_CLASSES if c in out}
+
+
 def restart_table(restarts: dict) -> pd.DataFrame:
     """One row per class and start of :func:`curve_restarts`: its validity mark
     (:func:`gaitlib.validity.label`; "raised" when the run raised), status,
