@@ -229,3 +229,27 @@ def test_best_starts_and_restart_findings_by_hand():
     # the study's own run best everywhere → no local optimum named
     best2 = fidelity.best_starts(t.drop(index=("Slow", "Free")))
     assert fidelity.restart_findings(best2, terms, cot_b, terms_b, n_runs=2)[0].startswith("No restart (2 solved)")
+
+
+def test_multistart_second_round_starts_from_the_first_rounds_best(monkeypatch):
+    """fidelity.multistart: round 2 starts every class from the other classes' best valid
+    solutions of round 1, skipping a class whose best is the study's own run (round 1's start)."""
+    own = fidelity.OWN_START
+    calls = []
+
+    def fake_restarts(res, classes=None, *, starts=None, label="", **kw):
+        calls.append((starts, label))
+        srcs = ("Slow", "Free") if starts is None else tuple(starts)
+        return {c: {own: f"{c}-own", **{s + label: f"{c}<-{s}{label}" for s in srcs if s != c}}
+                for c in ("Slow", "Free")}
+
+    best = pd.DataFrame({"best start": ["Free", own]}, index=pd.Index(["Slow", "Free"], name="class"))
+    monkeypatch.setattr(fidelity, "curve_restarts", fake_restarts)
+    monkeypatch.setattr(fidelity, "restart_table", lambda r: r)
+    monkeypatch.setattr(fidelity, "best_starts", lambda t: best)
+    out = fidelity.multistart(object())
+    assert calls[0] == (None, "") and calls[1] == ({"Slow": "Slow<-Free"}, fidelity.ROUND_2)
+    assert out["Free"] == {own: "Free-own", "Slow": "Free<-Slow", "Slow (round 2)": "Free<-Slow (round 2)"}
+    assert out["Slow"] == {own: "Slow-own", "Free": "Slow<-Free"}  # no round-2 start but its own best
+    with pytest.raises(ValueError, match="rounds"):
+        fidelity.multistart(object(), rounds=3)

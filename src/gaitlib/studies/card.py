@@ -1410,10 +1410,10 @@ def _ch7_consistent() -> list[Row]:
 
 def _restart_clause(res, terms: pd.DataFrame) -> str:
     """The card's clause on the consistent curve's multistart (Ch 7, "Is each point a local
-    optimum?", :func:`gaitlib.studies.fidelity.curve_restarts`); empty when not stored."""
+    optimum?", :func:`gaitlib.studies.fidelity.multistart`); empty when not stored."""
     try:
         with cache.only("the restarts"):
-            restarts = fidelity.curve_restarts(res, progress=False)
+            restarts = fidelity.multistart(res, progress=False)
     except cache.NotCached:
         return ""
     rt = fidelity.restart_table(restarts)

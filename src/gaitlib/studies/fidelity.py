@@ -974,42 +974,69 @@ def cot_terms(cot: pd.DataFrame, solutions: dict) -> pd.DataFrame:
 OWN_START = "Ch 5 (the study's start)"
 
 
-def restart_runs(res, classes=None) -> tuple[dict, dict]:
+def restart_runs(res, classes=None, starts: dict | None = None) -> tuple[dict, dict]:
     """The runs of :func:`curve_restarts`: each class's problem of the consistent study ``res``
     (its spec unchanged: same cost, parameters and data) started from every *other* class's
-    solution in ``res`` — every state and control, scaled in time to the class's cycle and
-    stride (:func:`gaitlib.studies.predictive.run_guess`). ``classes``: default every class of
-    ``res`` in speed order. Returns ``(specs, guesses)`` keyed ``"NMSK <class> from <source>"``."""
+    solution — ``starts`` (class → solution; default ``res``'s runs) — every state and control
+    scaled in time to the class's cycle and stride (:func:`gaitlib.studies.predictive.run_guess`).
+    ``classes``: default every class of ``res`` in speed order. Returns ``(specs, guesses)``
+    keyed ``"NMSK <class> from <source>"``."""
     have = [c for c in cv.SPEED_CLASSES if f"NMSK {c}" in res.specs]
     classes = have if classes is None else list(classes)
+    if starts is None:
+        starts = {c: res.solutions.get(f"NMSK {c}") for c in have}
     specs, guesses = {}, {}
     for c in classes:
         spec = res.specs[f"NMSK {c}"]
         legs = {} if spec.leg_scale is None else {"leg_scale": spec.leg_scale}
         g = data_mod.load_gait_data(c, spec.source, **legs)
         for src in have:
-            if src == c or res.solutions.get(f"NMSK {src}") is None:
+            if src == c or starts.get(src) is None:
                 continue
             k = f"NMSK {c} from {src}"
             specs[k] = spec
-            guesses[k] = pr.run_guess(res.solutions[f"NMSK {src}"], "ch5", cycle_time=g.cycle_time,
-                                      stride=g.speed * g.cycle_time)
+            guesses[k] = pr.run_guess(starts[src], "ch5", cycle_time=g.cycle_time, stride=g.speed * g.cycle_time)
     return specs, guesses
 
 
-def curve_restarts(res, classes=None, *, scheduler: str | None = None, n_workers: int | None = None,
-                   progress: bool = True) -> dict:
+def curve_restarts(res, classes=None, *, starts: dict | None = None, label: str = "",
+                   scheduler: str | None = None, n_workers: int | None = None, progress: bool = True) -> dict:
     """Is each point of a consistent curve a local optimum? Every class's problem solved again
-    from every other class's solution (:func:`restart_runs`; one dask sweep, solved or reloaded
-    from the cache). Returns class → {start → solution (None if the run raised)}: the study's
-    own run first (:data:`OWN_START`), then the other classes' solutions by class name."""
-    specs, guesses = restart_runs(res, classes)
+    from every other class's solution (:func:`restart_runs`; ``starts``: class → the solution
+    to start from, default the study's runs; one dask sweep, solved or reloaded from the
+    cache). Returns class → {start → solution (None if the run raised)}: the study's own run
+    first (:data:`OWN_START`), then the starts by class name (+ ``label``)."""
+    specs, guesses = restart_runs(res, classes, starts)
     recs = gait_ocp.solve_specs(specs, guesses=guesses, scheduler=scheduler, n_workers=n_workers,
                                 progress=progress)
     out = {}
     for k, r in recs.items():
         c, src = k.removeprefix("NMSK ").split(" from ")
-        out.setdefault(c, {OWN_START: res.solutions.get(f"NMSK {c}")})[src] = r.value
+        out.setdefault(c, {OWN_START: res.solutions.get(f"NMSK {c}")})[src + label] = r.value
+    return out
+
+
+#: The label of the second round's starts in :func:`multistart`.
+ROUND_2 = " (round 2)"
+
+
+def multistart(res, rounds: int = 2, **kw) -> dict:
+    """:func:`curve_restarts` in rounds: round 1 starts every class from every other class's
+    run of the study; round 2 from every other class's best valid solution of round 1
+    (:func:`best_starts`) where that is not the study's own run (that start was round 1's).
+    ``kw``: :func:`curve_restarts`'s options. Returns class → {start → solution}, round 2's
+    starts labelled :data:`ROUND_2`."""
+    if rounds not in (1, 2):
+        raise ValueError(f"rounds must be 1 or 2, got {rounds!r}")
+    out = curve_restarts(res, **kw)
+    if rounds == 1:
+        return out
+    best = best_starts(restart_table(out))
+    starts = {c: out[c][r["best start"]] for c, r in best.iterrows()
+              if r["best start"] not in (None, OWN_START)}
+    if starts:
+        for c, sols in curve_restarts(res, starts=starts, label=ROUND_2, **kw).items():
+            out[c].update({k: v for k, v in sols.items() if k != OWN_START})
     return out
 
 
