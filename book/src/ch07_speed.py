@@ -388,7 +388,8 @@ if restarts is not None:
     rt = fidelity.restart_table(restarts)
     best_u = fidelity.best_starts(rt)
     cot_best, terms_best = fidelity.best_curve(restarts, best_u)
-    fig = pr.cot_figure(cot_best, label="ours: one problem, best of its starts per speed (converged, valid)")
+    fig = pr.cot_figure(cot_best, label="ours: one problem, best of its starts per speed (converged, valid)",
+                        others={"ours: the same problem from the Ch 5 start (above)": cot_u})
     display(rt, best_u, terms_best)
     display(Markdown("\n\n".join(fidelity.restart_findings(best_u, terms_u, cot_best, terms_best,
                                                              n_runs=len(rt) - len(best_u)))))

@@ -1077,10 +1077,11 @@ def ch7_findings(res: StudyResult, classes, control: pd.DataFrame, cot: pd.DataF
 
 
 def cot_figure(cot: pd.DataFrame, ch5_row: str | None = None,
-               label: str = "ours (NMSK DT, converged; Free = Ch 6 DT)"):
+               label: str = "ours (NMSK DT, converged; Free = Ch 6 DT)", others: dict | None = None):
     """Thesis Fig 7.5: COT (J kg⁻¹ m⁻¹) against walking speed (m/s) from :func:`cot_table` —
     the converged points joined, the marked ones as labelled crosses, the ``ch5_row`` point
-    (the Ch 5 solution) apart, and the thesis's points at their own speeds."""
+    (the Ch 5 solution) apart, and the thesis's points at their own speeds. ``others``: label →
+    another :func:`cot_table` whose unmarked points are drawn joined and dotted, for comparison."""
     import matplotlib.pyplot as plt
 
     curve = cot.drop(index=ch5_row, errors="ignore") if ch5_row else cot
@@ -1102,6 +1103,9 @@ def cot_figure(cot: pd.DataFrame, ch5_row: str | None = None,
         r5 = cot.loc[ch5_row]
         ax.plot([r5["speed (m/s)"]], [r5["COT (J/kg/m)"]], "D", mfc="none", color="C2", ms=7,
                 label=marks.run_label("Ch 5 NMSK Eq 5.55 (own activation params)", r5["mark"]))
+    for i, (lab, other) in enumerate((others or {}).items()):
+        ok_o = other[other["mark"] == ""]
+        ax.plot(ok_o["speed (m/s)"], ok_o["COT (J/kg/m)"], "o:", color=f"C{4 + i}", mfc="none", label=lab)
     th = pd.DataFrame(THESIS_COT_FIG_7_5, columns=["class", "speed", "COT"])
     ax.plot(th["speed"], th["COT"], "s--", color="0.5", label="thesis, Fig 7.5 (different data)")
     for name, r in curve.iterrows():
