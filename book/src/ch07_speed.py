@@ -356,9 +356,7 @@ if res_b is not None:
         rs_b = None
         print(f"Not stored yet: {e}")
     if rs_b is not None:
-        rt_b = fidelity.restart_table(rs_b)
-        best_rb = fidelity.best_starts(rt_b)
-        cot_rb, terms_rb = fidelity.best_curve(rs_b, best_rb)
+        rt_b, best_rb, cot_rb, terms_rb = fidelity.restart_curve(rs_b)
         display(rt_b[rt_b.index.get_level_values("start") != fidelity.OWN_START], best_rb, terms_rb)
         display(Markdown("\n\n".join(fidelity.cot_curve_findings(
             cot_rb, terms_rb, name="The curve with Bhargava's F0, the best valid restart standing in"))))
@@ -385,9 +383,7 @@ except cache.NotCached as e:
     restarts = None
     print(f"Not stored yet: {e}")
 if restarts is not None:
-    rt = fidelity.restart_table(restarts)
-    best_u = fidelity.best_starts(rt)
-    cot_best, terms_best = fidelity.best_curve(restarts, best_u)
+    rt, best_u, cot_best, terms_best = fidelity.restart_curve(restarts)
     fig = pr.cot_figure(cot_best, label="ours: one problem, best of its starts per speed (converged, valid)",
                         others={"ours: the same problem from the Ch 5 start (above)": cot_u})
     display(rt, best_u, terms_best)

@@ -1416,9 +1416,7 @@ def _restart_clause(res, terms: pd.DataFrame) -> str:
             restarts = fidelity.multistart(res, progress=False)
     except cache.NotCached:
         return ""
-    rt = fidelity.restart_table(restarts)
-    best = fidelity.best_starts(rt)
-    cot_b, terms_b = fidelity.best_curve(restarts, best)
+    rt, best, cot_b, terms_b = fidelity.restart_curve(restarts)
     where = _anchor("ch07_speed", "Is each point a local optimum? Every run from every other run's solution")
     text = fidelity.restart_findings(best, terms, cot_b, terms_b, n_runs=len(rt) - len(best))
     return " ".join(x.replace("**", "") for x in text) + f" [{where}]"
@@ -1443,11 +1441,10 @@ def _f0_clause() -> str:
             rs = fidelity.marked_restarts(res, progress=False)
     except cache.NotCached:
         return f"{text} [{where}]"
-    best = fidelity.best_starts(fidelity.restart_table(rs))
+    _, best, _, terms_r = fidelity.restart_curve(rs)
     stand = [f"{c} from the {r['best start']} run's solution" for c, r in best.iterrows()
              if r["best start"] not in (None, fidelity.OWN_START)]
     if stand:
-        _, terms_r = fidelity.best_curve(rs, best)
         text += (f"; with {', '.join(stand)} standing in (the best valid restart; {len(terms_r)} of {len(cot)} valid): "
                  f"{_curve_points(terms_r)}")
     return f"{text} [{where}]"

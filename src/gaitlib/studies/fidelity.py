@@ -1105,6 +1105,15 @@ def best_curve(restarts: dict, best: pd.DataFrame) -> tuple[pd.DataFrame, pd.Dat
     return cot, cot_terms(cot, sols)
 
 
+def restart_curve(restarts: dict) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame, pd.DataFrame]:
+    """Everything the book and the card read from restarts (:func:`curve_restarts`,
+    :func:`multistart`, :func:`marked_restarts`): ``(table, best, cot, terms)`` —
+    :func:`restart_table`, :func:`best_starts` and the :func:`best_curve` of its best starts."""
+    table = restart_table(restarts)
+    best = best_starts(table)
+    return (table, best, *best_curve(restarts, best))
+
+
 def restart_findings(best: pd.DataFrame, terms: pd.DataFrame, cot_best: pd.DataFrame, terms_best: pd.DataFrame,
                      n_runs: int) -> list[str]:
     """The sentences on the multistart of a consistent curve: in how many classes another start
