@@ -278,25 +278,26 @@ def _start_rows(rows):
 
 
 def test_start_findings_by_hand():
-    """pr.start_findings: cells summed per start over unmarked runs; the verdict compares the
-    own and the probe start only where both are unmarked, by objective and by cells."""
+    """pr.start_findings: cells summed per start over unmarked runs; the per-class comparison
+    only where the own and the probe start are both unmarked: objective change, NRMSE, cells;
+    then where the probe's runs end (nearer the input or the class data)."""
     own, probe = pr.CH7_OWN_START, "class data"
-    rows = {("Slow", own): ["", 0.30, 0.20, 0.10, 0], ("Slow", probe): ["", 0.25, 0.15, 0.20, 2],
-            ("Fast", own): ["", 0.40, 0.30, 0.10, 1], ("Fast", probe): ["", 0.35, 0.20, 0.20, 3],
+    rows = {("Slow", own): ["", 0.30, 0.20, 0.10, 0], ("Slow", probe): ["", 0.15, 0.15, 0.10, 2],
+            ("Fast", own): ["", 0.40, 0.30, 0.10, 1], ("Fast", probe): ["", 0.402, 0.20, 0.10, 1],
             ("VeryFast", own): ["", 0.50, 0.30, 0.10, 0], ("VeryFast", probe): ["NOT CONVERGED", 0.10, 0.10, 0.3, 3]}
     t = _start_rows(rows)
     out = pr.start_findings(t, own, probe)
     assert out[0].startswith(f"From {own}: closer to the class data than the scaled input in 1 of 9 cells;")
-    assert "in 5 of 6 cells (left out, marked: VeryFast (NOT CONVERGED))" in out[1]
+    assert "in 3 of 6 cells (left out, marked: VeryFast (NOT CONVERGED))" in out[1]
     assert "mean NRMSE against the class data 0.175" in out[1]  # (0.15 + 0.20) / 2
-    assert out[2].startswith("**The start pins the predictions**")
-    assert "lower than from" in out[2] and "in 2 of 2 (Slow, Fast), closer to the class data in 5 cells against 1" in out[2]
-    # the probe's runs end worse (higher objective) though closer: the objective holds them
+    assert "Slow: objective -50.0 %, NRMSE against the class data 0.200 → 0.150, cells closer 0 → 2" in out[2]
+    assert "Fast: objective +0.5 %" in out[2] and "VeryFast" not in out[2]
+    assert out[3].startswith("**Where the runs started on the class data end:** nearer the input they track than "
+                             "the class data they started from in 2 of 2 (mean NRMSE 0.100 against 0.175)")
+    assert "in 3 of 6 cells (1 from" in out[3]
+    assert "in Slow they find a better optimum" in out[3] and "in Fast both starts end at the same objective" in out[3]
+    assert out[3].endswith("the start does not explain the cells that stay near it.")
+    # nothing comparable
     t2 = t.copy()
-    t2.loc[("Slow", probe), "objective"] = 0.31
-    t2.loc[("Fast", probe), "objective"] = 0.41
-    assert pr.start_findings(t2, own, probe)[-1].startswith("**The objective holds the predictions, not the start**")
-    # no closer cells from the probe: the start does not pin them
-    t3 = t.copy()
-    t3.loc[[("Slow", probe), ("Fast", probe)], "cells closer than the input"] = 0
-    assert pr.start_findings(t3, own, probe)[-1].startswith("**The start does not pin the predictions**")
+    t2["mark"] = ["", "x", "", "x", "", "x"]
+    assert pr.start_findings(t2, own, probe)[-1].startswith("No class has both")

@@ -699,12 +699,18 @@ def start_table(studies: Mapping[str, StudyResult], gaits: dict) -> pd.DataFrame
     return t.reindex(order, level="class")
 
 
-def start_findings(table: pd.DataFrame, own: str, probe: str = "class data") -> list[str]:
+#: Objectives of two starts within this many per cent: the same optimum (:func:`start_findings`).
+SAME_OPTIMUM_PCT = 1.0
+
+
+def start_findings(table: pd.DataFrame, own: str, probe: str = "class data",
+                   tol: float = SAME_OPTIMUM_PCT) -> list[str]:
     """The sentences on :func:`start_table`: per start, how many unmarked cells come closer to
-    the class data than the scaled input; then, where the ``own`` start's run (the chapter's)
-    and the ``probe`` start's are both converged and valid, whether the probe ends the same
-    problem lower (objective) and closer to the class data — the start pins the predictions —
-    or not (the objective does)."""
+    the class data than the scaled input; then, per class where the ``own`` start's run (the
+    chapter's) and the ``probe`` start's are both converged and valid, the objective's change
+    (the same problem: lower is a better optimum; within ``tol`` % the same one), the NRMSE
+    against the class data and the closer cells at each start; last, where the probe's runs
+    end: nearer the input they track or nearer the class data they started from."""
     out = []
     for lab in table.index.get_level_values("start").unique():
         t = table.xs(lab, level="start")
@@ -720,23 +726,32 @@ def start_findings(table: pd.DataFrame, own: str, probe: str = "class data") -> 
             and not table.loc[(c, own), "mark"] and not table.loc[(c, probe), "mark"]]
     if not both:
         return out + [f"No class has both its {own} and its {probe} run converged and valid: no comparison."]
-    o, p = table.loc[[(c, own) for c in both]], table.loc[[(c, probe) for c in both]]
-    lower = [c for c in both if table.loc[(c, probe), "objective"] < table.loc[(c, own), "objective"]]
-    k_o, k_p = int(o["cells closer than the input"].sum()), int(p["cells closer than the input"].sum())
-    d_o, d_p = o["vs class data"].mean(), p["vs class data"].mean()
-    head = (f"Started on the {probe} (a start only; the problem still tracks the scaled Free data), the "
-            f"{len(both)} runs valid at both starts end the same problem lower than from {own} in {len(lower)} of "
-            f"{len(both)}" + (f" ({', '.join(lower)})" if lower else "") + f", closer to the class data in {k_p} "
-            f"cells against {k_o} (mean NRMSE {d_p:.3f} against {d_o:.3f}).")
-    if len(lower) > len(both) / 2 and k_p > k_o:
-        out.append(f"**The start pins the predictions**: {head} The chapter's runs are local optima near their "
-                   "start; a start nearer the class data finds better optima that are nearer it too.")
-    elif k_p > k_o:
-        out.append(f"**The objective holds the predictions, not the start**: {head} The runs that stay nearer the "
-                   "class data are worse optima of the same problem: its cost prefers the input-like gait.")
-    else:
-        out.append(f"**The start does not pin the predictions**: {head} From the class's own data the runs end no "
-                   "closer to it: the problem's optima lie near its input whichever side they are reached from.")
+    cells = "cells closer than the input"
+    parts, lower, same = [], [], []
+    for c in both:
+        o, p = table.loc[(c, own)], table.loc[(c, probe)]
+        d = 100 * (p["objective"] / o["objective"] - 1)
+        (same if abs(d) <= tol else lower if d < 0 else []).append(c)
+        parts.append(f"{c}: objective {d:+.1f} %, NRMSE against the class data {o['vs class data']:.3f} → "
+                     f"{p['vs class data']:.3f}, cells closer {o[cells]} → {p[cells]}")
+    out.append(f"Started on the {probe} (a start only; the problem still tracks the scaled Free data), against "
+               f"{own}: " + "; ".join(parts) + ".")
+    p = table.loc[[(c, probe) for c in both]]
+    near = int((p["vs tracked input"] < p["vs class data"]).sum())
+    k_o = int(table.loc[[(c, own) for c in both], cells].sum())
+    k_p = int(p[cells].sum())
+    line = (f"**Where the runs started on the {probe} end:** nearer the input they track than the class data they "
+            f"started from in {near} of {len(both)} (mean NRMSE {p['vs tracked input'].mean():.3f} against "
+            f"{p['vs class data'].mean():.3f}), closer to the class data than the input in {k_p} of {3 * len(both)} "
+            f"cells ({k_o} from {own})")
+    if lower:
+        line += (f"; in {', '.join(lower)} they find a better optimum of the same problem — the chapter's run "
+                 "there is a local optimum, held by its start")
+    if same:
+        line += (f"; in {', '.join(same)} both starts end at the same objective (within {tol:g} %) — there the "
+                 "problem, not the start, sets the prediction")
+    out.append(line + (f". The problem's cost pulls its optima to the input it tracks: the start does not "
+                       f"explain the cells that stay near it." if near > len(both) / 2 else "."))
     return out
 
 
