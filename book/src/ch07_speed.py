@@ -342,26 +342,6 @@ if res_b is not None:
     display(Markdown("\n\n".join(fidelity.cot_curve_findings(cot_b, terms_b, name="The curve with Bhargava's F0"))))
 
 # %% [markdown]
-# A run of this curve that did not converge (from the Ch 5 start, nor in its 3000-iteration
-# rerun) is started again from the solution of every other class's run
-# (`fidelity.marked_restarts`, as in the multistart below); where a restart converges to a
-# valid gait, the best one (lowest objective of the same problem) stands in, labelled.
-
-# %%
-if res_b is not None:
-    try:
-        with cache.only("the restarts of the marked runs are read from the store (fidelity.marked_restarts)"):
-            rs_b = fidelity.marked_restarts(res_b, progress=False)
-    except cache.NotCached as e:
-        rs_b = None
-        print(f"Not stored yet: {e}")
-    if rs_b is not None:
-        rt_b, best_rb, cot_rb, terms_rb = fidelity.restart_curve(rs_b)
-        display(rt_b[rt_b.index.get_level_values("start") != fidelity.OWN_START], best_rb, terms_rb)
-        display(Markdown("\n\n".join(fidelity.cot_curve_findings(
-            cot_rb, terms_rb, name="The curve with Bhargava's F0, the best valid restart standing in"))))
-
-# %% [markdown]
 # ### Is each point a local optimum? Every run from every other run's solution
 #
 # The consistent curve's *Free* point sits above its neighbours. "A local optimum" is a

@@ -1434,26 +1434,10 @@ def _f0_clause() -> str:
     where = _anchor("ch07_speed", "With Bhargava's reading of Eq 5.47's F0")
     if len(terms) < 3:
         return f"with Bhargava's F0 re-optimised only {len(terms)} of {len(cot)} speeds are valid [{where}]"
-    text = (f"with Bhargava's F0 in Eq 5.47 re-optimised at every speed ({len(terms)} of {len(cot)} valid): "
-            f"{_curve_points(terms)}")
-    try:
-        with cache.only("the restarts of the marked runs"):
-            rs = fidelity.marked_restarts(res, progress=False)
-    except cache.NotCached:
-        return f"{text} [{where}]"
-    _, best, _, terms_r = fidelity.restart_curve(rs)
-    stand = [f"{c} from the {r['best start']} run's solution" for c, r in best.iterrows()
-             if r["best start"] not in (None, fidelity.OWN_START)]
-    if stand:
-        text += (f"; with {', '.join(stand)} standing in (the best valid restart; {len(terms_r)} of {len(cot)} valid): "
-                 f"{_curve_points(terms_r)}")
-    return f"{text} [{where}]"
-
-
-def _curve_points(terms: pd.DataFrame) -> str:
-    """A COT curve's points (:func:`gaitlib.studies.fidelity.cot_terms`) and its minimum, as text."""
-    return (", ".join(f"{c} {v:.2f}" for c, v in terms["total"].items())
-            + f", minimum at {terms['total'].astype(float).idxmin()}")
+    at = terms["total"].astype(float).idxmin()
+    pts = ", ".join(f"{c} {v:.2f}" for c, v in terms["total"].items())
+    return (f"with Bhargava's F0 in Eq 5.47 re-optimised at every speed ({len(terms)} of {len(cot)} valid): {pts}, "
+            f"minimum at {at} [{where}]")
 
 
 #: The Ch 7 page's section of the consistent curve on longer legs (the card links to it).

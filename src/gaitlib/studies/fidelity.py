@@ -1040,20 +1040,6 @@ def multistart(res, rounds: int = 2, **kw) -> dict:
     return out
 
 
-def marked_restarts(res, **kw) -> dict:
-    """A consistent curve's marked runs (not converged, or failing a gate) started again from
-    every other class's solution (:func:`curve_restarts` of those classes only; ``kw``: its
-    options), beside the study's own run of every class (the unmarked ones alone): class →
-    {start → solution}, for :func:`best_starts` / :func:`best_curve` — the curve with the best
-    valid restart standing in where the study's own run is marked."""
-    sols = {s.spec.speed_class: s for k, s in res.solutions.items() if k.startswith("NMSK ")}
-    marked = [c for c in cv.SPEED_CLASSES if c in sols and validity.label(sols[c]) != "valid"]
-    out = {c: {OWN_START: s} for c, s in sols.items()}
-    if marked:
-        out.update(curve_restarts(res, classes=marked, **kw))
-    return {c: out[c] for c in cv.SPEED_CLASSES if c in out}
-
-
 def restart_table(restarts: dict) -> pd.DataFrame:
     """One row per class and start of :func:`curve_restarts`: its validity mark
     (:func:`gaitlib.validity.label`; "raised" when the run raised), status,
@@ -1107,7 +1093,7 @@ def best_curve(restarts: dict, best: pd.DataFrame) -> tuple[pd.DataFrame, pd.Dat
 
 def restart_curve(restarts: dict) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame, pd.DataFrame]:
     """Everything the book and the card read from restarts (:func:`curve_restarts`,
-    :func:`multistart`, :func:`marked_restarts`): ``(table, best, cot, terms)`` —
+    :func:`multistart`): ``(table, best, cot, terms)`` —
     :func:`restart_table`, :func:`best_starts` and the :func:`best_curve` of its best starts."""
     table = restart_table(restarts)
     best = best_starts(table)
