@@ -253,3 +253,20 @@ def test_multistart_second_round_starts_from_the_first_rounds_best(monkeypatch):
     assert out["Slow"] == {own: "Slow-own", "Free": "Slow<-Free"}  # no round-2 start but its own best
     with pytest.raises(ValueError, match="rounds"):
         fidelity.multistart(object(), rounds=3)
+
+
+def test_round_findings_by_hand():
+    """fidelity.round_findings: a round-2 start counts only where it lowers round 1's best valid
+    objective of its class; none → the first round's best stand."""
+    own, r2 = fidelity.OWN_START, fidelity.ROUND_2
+    rows = {("Slow", own): ["", 0.20, 4.0], ("Slow", "Free"): ["", 0.18, 3.0], ("Slow", "Free" + r2): ["", 0.09, 2.5],
+            ("Free", own): ["", 0.30, 5.0], ("Free", "Slow"): ["", 0.33, 2.0],
+            ("Free", "Slow" + r2): ["INVALID: x", 0.01, 1.0]}
+    t = pd.DataFrame.from_dict(rows, orient="index", columns=["mark", "objective", "COT (J/kg/m)"])
+    t.index = pd.MultiIndex.from_tuples(t.index, names=["class", "start"])
+    out = fidelity.round_findings(t)
+    assert out[0].startswith("**Round 2 lowers the best objective again in 1 of 2 classes** (2 restarts, 1 converged")
+    assert "Slow -50.0 % (COT 3.00 → 2.50)" in out[0]  # 0.09 / 0.18 − 1
+    t2 = t.drop(index=("Slow", "Free" + r2))
+    assert fidelity.round_findings(t2)[0].startswith("Round 2 (1 restarts, 0 converged and valid) lowers no class's")
+    assert fidelity.round_findings(t2[~t2.index.get_level_values("start").str.endswith(r2)]) == []

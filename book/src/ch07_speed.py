@@ -368,7 +368,7 @@ if restarts is not None:
                         others={"ours: the same problem from the Ch 5 start (above)": cot_u})
     display(rt, best_u, terms_best)
     display(Markdown("\n\n".join(fidelity.restart_findings(best_u, terms_u, cot_best, terms_best,
-                                                             n_runs=len(rt) - len(best_u)))))
+                                                             n_runs=len(rt) - len(best_u), table=rt))))
 
 # %% [markdown]
 # ### On longer legs with the contact identified on them (a probe)

@@ -1418,7 +1418,7 @@ def _restart_clause(res, terms: pd.DataFrame) -> str:
         return ""
     rt, best, cot_b, terms_b = fidelity.restart_curve(restarts)
     where = _anchor("ch07_speed", "Is each point a local optimum? Every run from every other run's solution")
-    text = fidelity.restart_findings(best, terms, cot_b, terms_b, n_runs=len(rt) - len(best))
+    text = fidelity.restart_findings(best, terms, cot_b, terms_b, n_runs=len(rt) - len(best), table=rt)
     return " ".join(x.replace("**", "") for x in text) + f" [{where}]"
 
 

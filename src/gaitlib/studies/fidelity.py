@@ -1100,13 +1100,37 @@ def restart_curve(restarts: dict) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFr
     return (table, best, *best_curve(restarts, best))
 
 
+def round_findings(table: pd.DataFrame) -> list[str]:
+    """The sentence on the second round of :func:`multistart` (``table``: its
+    :func:`restart_table`): in how many classes a round-2 start lowers the best objective of
+    round 1 (the study's own run and round 1's restarts), by how much and with what COT; empty
+    without a round 2."""
+    r2 = table.index.get_level_values("start").str.endswith(ROUND_2)
+    if not r2.any():
+        return []
+    b1, b2 = best_starts(table[~r2]), best_starts(table)
+    n2, v2 = int(r2.sum()), int((table[r2]["mark"] == "").sum())
+    better = [c for c in b2.index if b2.loc[c, "best start"] and b2.loc[c, "best start"].endswith(ROUND_2)
+              and b1.loc[c, "best start"] and b2.loc[c, "best objective"] < b1.loc[c, "best objective"]]
+    if not better:
+        return [f"Round 2 ({n2} restarts, {v2} converged and valid) lowers no class's best objective: the first "
+                "round's best starts are the best this multistart finds."]
+    return [f"**Round 2 lowers the best objective again in {len(better)} of {len(b2)} classes** ({n2} restarts, {v2} "
+            "converged and valid): " + "; ".join(
+                f"{c} {100 * (b2.loc[c, 'best objective'] / b1.loc[c, 'best objective'] - 1):+.1f} % (COT "
+                f"{b1.loc[c, 'best COT (J/kg/m)']:.2f} → {b2.loc[c, 'best COT (J/kg/m)']:.2f})" for c in better)
+            + " — the problem has optima below what one round of restarts finds: each point of the best curve is "
+            "the best found, not shown to be the problem's optimum."]
+
+
 def restart_findings(best: pd.DataFrame, terms: pd.DataFrame, cot_best: pd.DataFrame, terms_best: pd.DataFrame,
-                     n_runs: int) -> list[str]:
+                     n_runs: int, table: pd.DataFrame | None = None) -> list[str]:
     """The sentences on the multistart of a consistent curve: in how many classes another start
     reaches a lower objective than the study's own run (that run then a local optimum, measured)
     and how far the COT moves; then where the curve of the best starts has its minimum
     (:func:`cot_curve_findings`; ``terms``: :func:`cot_terms` of the study, ``cot_best`` and
-    ``terms_best``: :func:`best_curve`; ``n_runs``: the restarts solved)."""
+    ``terms_best``: :func:`best_curve`; ``n_runs``: the restarts solved); with ``table`` (the
+    :func:`restart_table`) last :func:`round_findings`."""
     ok = best[best["own mark"] == ""]
     lower = ok[ok["objective change (%)"].astype(float) < -0.01]
     out = []
@@ -1123,7 +1147,7 @@ def restart_findings(best: pd.DataFrame, terms: pd.DataFrame, cot_best: pd.DataF
         old = terms["total"].astype(float).idxmin()
         out += cot_curve_findings(cot_best, terms_best, name="The curve of the best starts")
         out.append(f"(The study's own curve has its minimum at {old}.)")
-    return out
+    return out + (round_findings(table) if table is not None else [])
 
 
 def skating_findings(cot: pd.DataFrame, slip: pd.DataFrame, cot_f: pd.DataFrame, slip_f: pd.DataFrame,
