@@ -347,18 +347,17 @@ if res_b is not None:
 # The consistent curve's *Free* point sits above its neighbours. "A local optimum" is a
 # hypothesis until measured: here each class's problem of the consistent study (its spec
 # unchanged, thesis's F0) is solved again from the solution of **every other class's run**,
-# every state and control scaled in time to the class's cycle and stride — and, in a second
-# round, from every other class's best solution of the first (`fidelity.multistart`: 2 × 5 × 4
-# restarts, two dask sweeps). Within a class the objective is the same problem's at every
-# start, so the lowest one among the converged, valid starts is the better optimum; the
-# curve of those best starts is then read as above (its minimum, and which term moves it). If
-# the second round still lowers objectives, the best starts are local optima too: the
-# table's "(round 2)" rows say by how much.
+# every state and control scaled in time to the class's cycle and stride (one round of
+# `fidelity.multistart`: 5 × 4 restarts, one dask sweep; `fidelity.CH7_ROUNDS`). Within a class the objective is the
+# same problem's at every start, so the lowest one among the converged, valid starts is the
+# better optimum; the curve of those best starts is then read as above (its minimum, and
+# which term moves it). One round finds better optima; it does not show that they are the
+# problem's best (a second round, from the best starts, would test that).
 
 # %%
 try:
     with cache.only("the restarts are read from the store (fidelity.multistart solves them)"):
-        restarts = fidelity.multistart(res_u, progress=False)
+        restarts = fidelity.multistart(res_u, rounds=fidelity.CH7_ROUNDS, progress=False)
 except cache.NotCached as e:
     restarts = None
     print(f"Not stored yet: {e}")

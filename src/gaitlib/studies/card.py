@@ -1413,7 +1413,7 @@ def _restart_clause(res, terms: pd.DataFrame) -> str:
     optimum?", :func:`gaitlib.studies.fidelity.multistart`); empty when not stored."""
     try:
         with cache.only("the restarts"):
-            restarts = fidelity.multistart(res, progress=False)
+            restarts = fidelity.multistart(res, rounds=fidelity.CH7_ROUNDS, progress=False)
     except cache.NotCached:
         return ""
     rt, best, cot_b, terms_b = fidelity.restart_curve(restarts)

@@ -1016,6 +1016,8 @@ def curve_restarts(res, classes=None, *, starts: dict | None = None, label: str 
     return out
 
 
+#: The rounds of :func:`multistart` the Ch 7 page and the card read (round 2 not yet stored).
+CH7_ROUNDS = 1
 #: The label of the second round's starts in :func:`multistart`.
 ROUND_2 = " (round 2)"
 
