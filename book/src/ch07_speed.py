@@ -348,9 +348,9 @@ if res_b is not None:
 # hypothesis until measured: here each class's problem of the consistent study (its spec
 # unchanged, thesis's F0) is solved again from the solution of **every other class's run**,
 # every state and control scaled in time to the class's cycle and stride (one round of
-# `fidelity.multistart`: 5 × 4 restarts, one dask sweep; `fidelity.CH7_ROUNDS`). Within a class the objective is the
-# same problem's at every start, so the lowest one among the converged, valid starts is the
-# better optimum; the curve of those best starts is then read as above (its minimum, and
+# `fidelity.multistart`, `fidelity.CH7_ROUNDS`: 5 × 4 restarts, one dask sweep). Within a
+# class the objective is the same problem's at every start, so the lowest one among the
+# converged, valid starts is the better optimum; the curve of those best starts is then read as above (its minimum, and
 # which term moves it). One round finds better optima; it does not show that they are the
 # problem's best (a second round, from the best starts, would test that).
 
