@@ -350,9 +350,10 @@ if res_b is not None:
 # every state and control scaled in time to the class's cycle and stride (one round of
 # `fidelity.multistart`, `fidelity.CH7_ROUNDS`: 5 × 4 restarts, one dask sweep). Within a
 # class the objective is the same problem's at every start, so the lowest one among the
-# converged, valid starts is the better optimum; the curve of those best starts is then read as above (its minimum, and
-# which term moves it). One round finds better optima; it does not show that they are the
-# problem's best (a second round, from the best starts, would test that).
+# converged, valid starts is the better optimum; the curve of those best starts is then read
+# as above (its minimum, and which term moves it). One round finds better optima; it does
+# not show that they are the problem's best (a second round, from the best starts, would
+# test that).
 
 # %%
 try:
