@@ -225,6 +225,11 @@ def test_best_starts_and_restart_findings_by_hand():
     out = fidelity.restart_findings(best, terms, cot_b, terms_b, n_runs=3)
     assert out[0].startswith("**1 of 2 of the study's valid points are local optima**")
     assert "Slow from Free -10.0 %, COT 4.00 → 3.00" in out[0]
+    # Free's valid starts: 5.0 (own) and 2.0; the best curve 3.0 … 5.0
+    assert out[1] == ("Across a class's valid starts the COT spans up to 3.00 J kg⁻¹ m⁻¹ (Free: 2.00–5.00), against "
+                      "2.00 between the highest and the lowest point of the best starts' curve: which optimum a run "
+                      "ends in moves a point as much as the speed does.")
+    out = out[:1] + out[2:]
     assert "minimum at **Slow**" in out[1] and "work +1.50" in out[2] and out[-1] == "(The study's own curve has its minimum at Slow.)"
     # the study's own run best everywhere → no local optimum named
     best2 = fidelity.best_starts(t.drop(index=("Slow", "Free")))

@@ -1080,7 +1080,8 @@ def best_starts(table: pd.DataFrame) -> pd.DataFrame:
                                             100 * (b["objective"] / own["objective"] - 1)),
                    "best COT (J/kg/m)": np.nan if b is None else b["COT (J/kg/m)"],
                    "COT over valid starts (J/kg/m)": (f"{ok['COT (J/kg/m)'].min():.2f}–{ok['COT (J/kg/m)'].max():.2f}"
-                                                      if len(ok) else "")}
+                                                      if len(ok) else ""),
+                   "COT spread (J/kg/m)": float(np.ptp(ok["COT (J/kg/m)"].astype(float))) if len(ok) else np.nan}
     return pd.DataFrame.from_dict(rows, orient="index").rename_axis("class")
 
 
@@ -1145,6 +1146,14 @@ def restart_findings(best: pd.DataFrame, terms: pd.DataFrame, cot_best: pd.DataF
     else:
         out.append(f"No restart ({n_runs} solved) ends any class's problem lower than the study's own run: "
                    f"each of its {len(ok)} valid points is the best of its starts.")
+    spread = best["COT spread (J/kg/m)"].astype(float).dropna()
+    if len(spread) and len(terms_best) > 1:
+        c = spread.idxmax()
+        rng = float(np.ptp(terms_best["total"].astype(float)))
+        out.append(f"Across a class's valid starts the COT spans up to {spread[c]:.2f} J kg⁻¹ m⁻¹ ({c}: "
+                   f"{best.loc[c, 'COT over valid starts (J/kg/m)']}), against {rng:.2f} between the highest and the "
+                   "lowest point of the best starts' curve" + (": which optimum a run ends in moves a point as much as "
+                                                                "the speed does." if spread[c] >= rng else "."))
     if len(terms) and len(terms_best):
         old = terms["total"].astype(float).idxmin()
         out += cot_curve_findings(cot_best, terms_best, name="The curve of the best starts")
