@@ -1323,6 +1323,27 @@ class _Runs:
         self.solutions = {k: s for k, s in runs.items() if s is not None}
 
 
+def _starts_clause(bases: dict, nm: dict, gaits: dict) -> str:
+    """The card's clause on the Ch 7 start experiment (:func:`gaitlib.studies.predictive.
+    data_start_study`: the NMSK runs from data-based starts, the class's own data among them),
+    read from the store; empty when a run is not stored. ``nm``: the chapter's NMSK runs
+    (reruns standing in), ``gaits``: class → GaitData."""
+    base = bases.get("NMSK")
+    if base is None:
+        return ""
+    specs = pr.ch7_specs("NMSK", base, pr.CH7_CLASSES, reading="book", **pr.default_params())
+    studies = {pr.CH7_OWN_START: _Runs(nm)}
+    for st in pr.DATA_STARTS:
+        sp, guesses = pr.data_start_runs(specs, st)
+        sols = {k: stored_gait(gait_ocp.cache_dir(s, guess=guesses.get(k))) for k, s in sp.items()}
+        if any(v is None for v in sols.values()):
+            return ""
+        studies[st] = _Runs(sols)
+    text = pr.start_findings(pr.start_table(studies, gaits), pr.CH7_OWN_START)
+    where = _anchor("ch07_speed", "Accuracy against each class's own (untracked) data — thesis Figs 7.1–7.4")
+    return text[-1].replace("**", "") + f" [{where}]"
+
+
 def _ch7_pin(bases: dict, runs: dict, c5: dict | None = None, c5_notes: dict | None = None) -> Row:
     """Thesis Secs 7.2–7.3: the predictions approach the speed classes' own (untracked) data.
     Ours: the NMSK cells (class × kind) closer to the class data than the time-scaled Free
@@ -1350,9 +1371,11 @@ def _ch7_pin(bases: dict, runs: dict, c5: dict | None = None, c5_notes: dict | N
                                       + "".join(_rerun_note(c5_notes or {}, k) for k in sorted(c5_notes or {}))
                                       + f": closer in {k5} of {n5} "
                                       f"cells [{_anchor('ch07_speed', 'With our Ch 5 activation parameters')}]") if x)
+    starts = _starts_clause(bases, nm, gaits)
     legs = _legs_clause("cells")
-    if legs:
-        cause = "; ".join(x for x in (cause if cause != "unknown" else "", legs) if x)
+    for x in (starts, legs):
+        if x:
+            cause = "; ".join(y for y in (cause if cause != "unknown" else "", x) if y)
     valid = _joint({k: gate(s, k) for k, s in nm.items() if s is not None and not marks_mod.failure_label(s)})
     return Row(7, item, "closer", f"{closer} of {n} unmarked cells", "", cause, "Ch 7 NMSK, 4 runs",
                valid or "valid", holds=closer > n / 2)
