@@ -1316,13 +1316,6 @@ def _ch7_uses(item: str, run: str) -> bool:
     return model == "NMSK" and ("U-shaped" in item or "predictions closer" in item)
 
 
-class _Runs:
-    """The ``solutions`` of a study, as :func:`gaitlib.studies.predictive.input_pull` reads them."""
-
-    def __init__(self, runs: dict):
-        self.solutions = {k: s for k, s in runs.items() if s is not None}
-
-
 def _starts_clause(bases: dict, nm: dict, gaits: dict) -> str:
     """The card's clause on the Ch 7 start experiment (:func:`gaitlib.studies.predictive.
     data_start_study`: the NMSK runs from data-based starts, the class's own data among them),
@@ -1332,13 +1325,13 @@ def _starts_clause(bases: dict, nm: dict, gaits: dict) -> str:
     if base is None:
         return ""
     specs = pr.ch7_specs("NMSK", base, pr.CH7_CLASSES, reading="book", **pr.default_params())
-    studies = {pr.CH7_OWN_START: _Runs(nm)}
+    studies = {pr.CH7_OWN_START: pr.Runs(nm)}
     for st in pr.DATA_STARTS:
         sp, guesses = pr.data_start_runs(specs, st)
         sols = {k: stored_gait(gait_ocp.cache_dir(s, guess=guesses.get(k))) for k, s in sp.items()}
         if any(v is None for v in sols.values()):
             return ""
-        studies[st] = _Runs(sols)
+        studies[st] = pr.Runs(sols)
     text = pr.start_findings(pr.start_table(studies, gaits), pr.CH7_OWN_START)
     where = _anchor("ch07_speed", "Accuracy against each class's own (untracked) data — thesis Figs 7.1–7.4")
     return text[-1].replace("**", "") + f" [{where}]"
@@ -1355,17 +1348,17 @@ def _ch7_pin(bases: dict, runs: dict, c5: dict | None = None, c5_notes: dict | N
     nm = {k: s for k, s in runs.items() if k.startswith("NMSK ")}
     if not all(s is not None for s in nm.values()):
         return Row(7, item, "closer", np.nan, "", "unknown", "", "")
-    pull = pr.input_pull(_Runs(nm), gaits)
+    pull = pr.input_pull(pr.Runs(nm), gaits)
     closer, n = pr.closer_cells(pull)
     loose = _runs({m: b for m, b in bases.items() if m == "NMSK"}, "ch7", "book", weights=pr.LOOSE_TRACKING)
     cause = "unknown"
     if all(s is not None for s in loose.values()):
-        lines = pr.pin_findings(pull, pr.input_pull(_Runs(loose), gaits))
+        lines = pr.pin_findings(pull, pr.input_pull(pr.Runs(loose), gaits))
         where = _anchor("ch07_speed", "Accuracy against each class's own (untracked) data — thesis Figs 7.1–7.4")
         if lines:
             cause = lines[-1].lstrip("- ") + f" [{where}]"
     if c5 and len(c5) == len(nm):
-        k5, n5 = pr.closer_cells(pr.input_pull(_Runs(c5), gaits))
+        k5, n5 = pr.closer_cells(pr.input_pull(pr.Runs(c5), gaits))
         cause = "; ".join(x for x in (cause if cause != "unknown" else "",
                                       f"with our Ch 5 activation parameters in the NMSK runs"
                                       + "".join(_rerun_note(c5_notes or {}, k) for k in sorted(c5_notes or {}))

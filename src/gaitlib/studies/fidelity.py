@@ -1089,8 +1089,7 @@ def best_curve(restarts: dict, best: pd.DataFrame) -> tuple[pd.DataFrame, pd.Dat
     """The curve of the lowest-objective valid start of each class (``best``: :func:`best_starts`
     of ``restarts``): its :func:`gaitlib.studies.predictive.cot_table` and :func:`cot_terms`."""
     sols = {f"NMSK {c}": restarts[c][r["best start"]] for c, r in best.iterrows() if r["best start"]}
-    study = type("BestOfStarts", (), {"solutions": sols})()
-    cot = pr.cot_table(study)
+    cot = pr.cot_table(pr.Runs(sols))
     return cot, cot_terms(cot, sols)
 
 

@@ -53,7 +53,8 @@ __all__ = ["CH6_COSTS", "CH7_CLASSES", "THESIS_CLASS", "THESIS_HOURS_TABLE_6_3",
            "THESIS_TORQUE_GAIN_PCT_CH7", "BASELINE_COST", "GUESS_POLICY", "GUESS_POLICY_CH7", "START_COLUMNS", "solve_row", "thesis_guess_runs", "baseline", "default_params", "thesis_guess", "run_guess", "ch6_specs", "ch7_specs",
            "score", "excitation_score", "StudyResult", "cost_function_study", "speed_study", "cot_table", "u_breaks",
            "times_table", "guess_lines", "SDT3_ENOUGH_FACTOR", "COT_CURVE_MIN_POINTS", "kind_nrmse", "mean_nrmse", "ch6_findings",
-           "ch7_findings", "cot_figure"]
+           "ch7_findings", "cot_figure", "Runs", "DATA_STARTS", "CH7_OWN_START", "data_start_runs",
+           "data_start_study", "start_table", "start_findings"]
 
 CH6_COSTS = ("DT", "SDT1", "SDT2", "SDT3", "SP1", "SP2", "SP3", "FP")
 CH7_CLASSES = ("VerySlow", "Slow", "Fast", "VeryFast")
@@ -558,6 +559,15 @@ def ch5_activation_speed_study(**kw) -> StudyResult:
 LOOSE_TRACKING = (("Trq", 1 / 40), ("Ang", 1 / 40), ("GRF", 1 / 40))
 
 
+class Runs:
+    """Solutions by run name as a study's ``solutions`` (what :func:`input_pull` and
+    :func:`cot_table` read), for runs gathered outside a :class:`StudyResult`; None values
+    (runs that raised or are not stored) left out."""
+
+    def __init__(self, runs: dict):
+        self.solutions = {k: s for k, s in runs.items() if s is not None}
+
+
 def input_pull(res: StudyResult, gaits: dict) -> pd.DataFrame:
     """Where each Ch 7 prediction sits between what it tracked and what it should predict:
     per run and kind (angles, torques, GRFs; mean NRMSE over the kind's channels), its NRMSE
@@ -686,7 +696,7 @@ def start_table(studies: Mapping[str, StudyResult], gaits: dict) -> pd.DataFrame
     rows = {}
     for lab, st in studies.items():
         nm = {k: v for k, v in st.solutions.items() if k.startswith("NMSK ")}
-        pull = input_pull(type("Runs", (), {"solutions": nm})(), gaits)
+        pull = input_pull(Runs(nm), gaits)
         for name, sol in nm.items():
             p = pull.loc[name]
             rows[(sol.spec.speed_class, lab)] = {
