@@ -275,3 +275,86 @@ def test_round_findings_by_hand():
     t2 = t.drop(index=("Slow", "Free" + r2))
     assert fidelity.round_findings(t2)[0].startswith("Round 2 (1 restarts, 0 converged and valid) lowers no class's")
     assert fidelity.round_findings(t2[~t2.index.get_level_values("start").str.endswith(r2)]) == []
+
+
+def test_marked_restarts_stand_in_only_for_marked_points(monkeypatch):
+    """fidelity.marked_restarts starts only the marked classes, and only from valid classes'
+    solutions; with_restarts hands the lowest-objective converged, valid restart to
+    with_reruns (a marked restart's lower objective never counts); stand_in_findings names it."""
+    own = fidelity.OWN_START
+
+    class Sol:
+        def __init__(self, name, mark="", cot=4.0):
+            self.name, self.mark, self.stats = name, mark, {"COT": cot}
+
+    class Study:
+        def __init__(self, sols, rerun_used=()):
+            self.solutions, self.records, self.rerun_used = sols, {k: None for k in sols}, rerun_used
+
+        def with_reruns(self, reruns):
+            got.append(reruns)
+            return Study({**self.solutions, **reruns}, self.rerun_used + tuple(reruns))
+
+    got, calls = [], []
+    slow = Sol("slow", "NOT CONVERGED: Maximum_Iterations_Exceeded")
+    res = Study({"NMSK Slow": slow, "NMSK Free": Sol("free"), "NMSK Fast": Sol("fast", "INVALID: x")})
+    r_free, r_fast = Sol("slow<-free", cot=3.5), Sol("slow<-fast", "INVALID: y")
+    fast = res.solutions["NMSK Fast"]
+    restarts = {"Slow": {own: slow, "Free": r_free, "Fast": r_fast}, "Fast": {own: fast, "Free": Sol("fast<-free", "x")}}
+
+    def fake_curve_restarts(r, classes=None, *, starts=None, **kw):
+        calls.append((classes, starts))
+        return restarts
+
+    monkeypatch.setattr(fidelity.marks, "failure_label", lambda s: s.mark or None)
+    monkeypatch.setattr(fidelity, "curve_restarts", fake_curve_restarts)
+    monkeypatch.setattr(fidelity, "restart_table", lambda rs: pd.DataFrame(
+        [["NOT CONVERGED: …", 0.5], ["", 0.3], ["INVALID: y", 0.1], ["INVALID: x", 0.2], ["x", 0.1]],
+        columns=["mark", "objective"], index=pd.MultiIndex.from_tuples(
+            [("Slow", own), ("Slow", "Free"), ("Slow", "Fast"), ("Fast", own), ("Fast", "Free")], names=["class", "start"])
+    ).assign(**{"COT (J/kg/m)": [5.0, 3.5, 1.0, 2.0, 2.0]}))
+    assert fidelity.marked_restarts(res) is restarts
+    assert calls == [(["Slow", "Fast"], {"Free": res.solutions["NMSK Free"]})]  # marked classes; valid starts only
+    assert fidelity.best_starts(fidelity.restart_table(restarts)).loc["Fast", "best start"] is None  # not NaN
+    used = fidelity.with_restarts(res, restarts)
+    assert got == [{"NMSK Slow": r_free}] and used.rerun_used == ("NMSK Slow",)
+    out = fidelity.stand_in_findings(res, used, restarts)
+    assert out[0] == ("**Slow** (its own run NOT CONVERGED: Maximum_Iterations_Exceeded): 1 of 2 starts from the other "
+                      "classes' solutions converge to a valid gait; the lowest objective, from Free's solution (COT "
+                      "3.50 J kg⁻¹ m⁻¹), stands in for it — the same problem, another start (labelled).")
+    assert out[1].startswith("**Fast** (its own run INVALID: x): none of its 1 starts")
+    assert fidelity.with_restarts(res, {}) is res and fidelity.stand_in_findings(res, res, {}) == []
+    assert fidelity.marked_restarts(Study({"NMSK Free": Sol("free")})) == {}
+
+
+def test_stop_table_and_findings_by_hand():
+    """fidelity.stop_table: the forward-speed change over the cycle and the cycle means of the
+    fore-aft GRF and R_x (trapezoidal, by hand) of the runs that did not converge only;
+    stop_findings reads the infeasible ones."""
+    from types import SimpleNamespace as NS
+    t = pd.Index([0.0, 0.5, 1.0])
+
+    def run(success, status, dv=-0.1, grf_l=(-1.0, -3.0, -1.0)):
+        states = pd.DataFrame({"qd_pelvis_tx": [1.0, 1.0 + dv / 2, 1.0 + dv]}, index=t)
+        return NS(stats={"success": success, "status": status},
+                  solution=NS(states=states, worst_constraint="cycle/periodic", max_violation=abs(dv)),
+                  grf=pd.DataFrame({"grf_x_r": [-2.0] * 3, "grf_x_l": list(grf_l)}, index=t),
+                  residuals=pd.DataFrame({"R_x": [1.0] * 3}, index=t))
+
+    inf = "Infeasible_Problem_Detected"
+    restarts = {"Free": {fidelity.OWN_START: run(True, "Solve_Succeeded"), "Slow": run(False, inf), "Fast": None},
+                "Fast": {"Free": run(False, inf, dv=-0.1002), "Slow": run(False, "Maximum_Iterations_Exceeded")}}
+    st = fidelity.stop_table(restarts)
+    assert list(st.index) == [("Free", "Slow"), ("Fast", "Free"), ("Fast", "Slow")]  # converged and raised left out
+    r = st.loc[("Free", "Slow")]
+    assert r["forward speed change (m/s)"] == pytest.approx(-0.1)
+    assert r["mean fore-aft acceleration (m/s²)"] == pytest.approx(-0.1)  # over a 1 s cycle
+    # right −2 throughout; left (−1 −3)/2·0.5 + (−3 −1)/2·0.5 = −2 → −4 N; R_x 1 N
+    assert r["mean fore-aft GRF (N)"] == pytest.approx(-4.0) and r["mean R_x (N)"] == pytest.approx(1.0)
+    out = fidelity.stop_findings(st)
+    assert out[0].startswith("**2 of the 3 restarts that did not converge stop as locally infeasible** (IPOPT's "
+                             "restoration phase fails; 2 classes: Free, Fast), the largest violation at cycle/periodic in 2")
+    assert "ends -0.100 m/s off" in out[0] and "-0.1002 … -0.1000 m s⁻²" in out[0]
+    assert "the feet brake on average and the residual pushes forward at its bound" in out[0]
+    assert "within 0.2 % of its mean" in out[0]
+    assert fidelity.stop_findings(st.drop(index=[("Free", "Slow"), ("Fast", "Free")])) == []

@@ -1423,14 +1423,20 @@ def _f0_clause() -> str:
         _, _, res = fidelity.stored_consistent_study("the runs with Bhargava's F0", isometric_torque="bhargava")
     except cache.NotCached:
         return ""
-    cot, terms, _ = fidelity.curve_tables(res)
+    try:
+        _, used = fidelity.stored_restarts(res, "the restarts of the marked points with Bhargava's F0")
+    except cache.NotCached:
+        used = res
+    stand_ins = [k.split()[-1] for k in used.rerun_used if k not in res.rerun_used]
+    cot, terms, _ = fidelity.curve_tables(used)
     where = _anchor("ch07_speed", "With Bhargava's reading of Eq 5.47's F0")
     if len(terms) < 3:
         return f"with Bhargava's F0 re-optimised only {len(terms)} of {len(cot)} speeds are valid [{where}]"
     at = terms["total"].astype(float).idxmin()
     pts = ", ".join(f"{c} {v:.2f}" for c, v in terms["total"].items())
-    return (f"with Bhargava's F0 in Eq 5.47 re-optimised at every speed ({len(terms)} of {len(cot)} valid): {pts}, "
-            f"minimum at {at} [{where}]")
+    return (f"with Bhargava's F0 in Eq 5.47 re-optimised at every speed ({len(terms)} of {len(cot)} valid"
+            + "".join(f"; {c} from another class's solution" for c in stand_ins)
+            + f"): {pts}, minimum at {at} [{where}]")
 
 
 #: The Ch 7 page's section of the consistent curve on longer legs (the card links to it).

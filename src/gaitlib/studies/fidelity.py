@@ -30,6 +30,7 @@ from .. import contact as contact_mod
 from .. import conventions as cv
 from .. import data as data_mod
 from .. import kinematics
+from .. import marks
 from .. import params as params_mod
 from .. import validity
 from ..model import ChildModel
@@ -1016,8 +1017,74 @@ def curve_restarts(res, classes=None, *, starts: dict | None = None, label: str 
     return out
 
 
-#: The rounds of :func:`multistart` the Ch 7 page and the card read (round 2 not yet stored).
-CH7_ROUNDS = 1
+def _marked_classes(res) -> list[str]:
+    """The classes of a consistent study ``res`` whose run is marked (did not converge, raised
+    or fails the validity gates), in speed order."""
+    return [c for c in cv.SPEED_CLASSES if f"NMSK {c}" in res.records
+            and marks.failure_label(res.solutions.get(f"NMSK {c}", res.records[f"NMSK {c}"]))]
+
+
+def marked_restarts(res, **kw) -> dict:
+    """:func:`curve_restarts` for the marked points of a consistent study only (``res``, e.g.
+    with its 3000-iteration reruns standing in): each such class's problem (spec unchanged)
+    started from every *valid* class's solution. ``kw``: :func:`curve_restarts`'s options.
+    Returns class → {start → solution}; empty when every point is valid."""
+    bad = _marked_classes(res)
+    if not bad:
+        return {}
+    good = {c: s for c in cv.SPEED_CLASSES if c not in bad and (s := res.solutions.get(f"NMSK {c}")) is not None}
+    return curve_restarts(res, classes=bad, starts=good, **kw)
+
+
+def with_restarts(res, restarts: dict):
+    """The study ``res`` with each marked run replaced by the lowest-objective converged, valid
+    start of ``restarts`` (:func:`marked_restarts`; :func:`best_starts` decides) —
+    :meth:`~gaitlib.studies.predictive.StudyResult.with_reruns`, so :attr:`rerun_used` names
+    it (every use labelled by the caller). ``res`` itself when none is usable."""
+    if not restarts:
+        return res
+    best = best_starts(restart_table(restarts))
+    return res.with_reruns({f"NMSK {c}": restarts[c][r["best start"]] for c, r in best.iterrows()
+                            if r["best start"] not in (None, OWN_START)})
+
+
+def stored_restarts(res, what: str):
+    """:func:`marked_restarts` of ``res`` read from the store only and :func:`with_restarts`:
+    ``(restarts, used)``. Raises :class:`gaitlib.cache.NotCached` naming ``what`` when a
+    restart is not stored."""
+    with cache.only(f"{what} are read from the store (fidelity.marked_restarts solves them)"):
+        restarts = marked_restarts(res, progress=False)
+    return restarts, with_restarts(res, restarts)
+
+
+def stand_in_findings(res, used, restarts: dict) -> list[str]:
+    """The sentence on the marked points of a consistent curve started from the other classes'
+    solutions (``res``: the study, ``used``: :func:`with_restarts` of it, ``restarts``:
+    :func:`marked_restarts`): per marked class how many starts converged to a valid gait and
+    which one stands in, with its COT (J kg⁻¹ m⁻¹) — or that none does."""
+    if not restarts:
+        return []
+    table = restart_table(restarts)
+    out = []
+    for c in [c for c in _marked_classes(res) if c in restarts]:
+        t = table.loc[c].drop(index=OWN_START, errors="ignore")
+        ok = t[t["mark"] == ""]
+        own = marks.failure_label(res.solutions.get(f"NMSK {c}", res.records[f"NMSK {c}"]))
+        if f"NMSK {c}" in used.rerun_used and f"NMSK {c}" not in res.rerun_used:
+            s = used.solutions[f"NMSK {c}"]
+            src = next(k for k, v in restarts[c].items() if v is s)
+            out.append(f"**{c}** (its own run {own}): {len(ok)} of {len(t)} starts from the other classes' solutions "
+                       f"converge to a valid gait; the lowest objective, from {src}'s solution (COT "
+                       f"{s.stats['COT']:.2f} J kg⁻¹ m⁻¹), stands in for it — the same problem, another start "
+                       "(labelled).")
+        else:
+            out.append(f"**{c}** (its own run {own}): none of its {len(t)} starts from the other classes' solutions "
+                       "converges to a valid gait — the point stays out of the curve.")
+    return out
+
+
+#: The rounds of :func:`multistart` the Ch 7 page and the card read.
+CH7_ROUNDS = 2
 #: The label of the second round's starts in :func:`multistart`.
 ROUND_2 = " (round 2)"
 
@@ -1062,6 +1129,69 @@ def restart_table(restarts: dict) -> pd.DataFrame:
     return pd.DataFrame.from_dict(rows, orient="index").rename_axis(["class", "start"])
 
 
+def stop_table(restarts: dict) -> pd.DataFrame:
+    """Where the runs of :func:`curve_restarts` that did not converge stop, one row per such
+    run (class, start): IPOPT's status, the constraint block with the largest violation and
+    that violation, the pelvis's forward velocity at the end minus at the start of the cycle
+    (m/s; 0 on a periodic cycle), that change over the cycle time (the mean fore-aft
+    acceleration, m s⁻²), and the cycle means of the fore-aft GRF of both feet and of the
+    pelvis's horizontal residual R_x (N; bounded ±1 N, Eq 4.8) — the two horizontal forces
+    whose sum, over the body's mass, is that mean acceleration."""
+    rows = {}
+    for c, sols in restarts.items():
+        for k, s in sols.items():
+            if s is None or s.stats.get("success"):
+                continue
+            st = s.solution.states
+            t = st.index.to_numpy()
+            dv = float(st["qd_pelvis_tx"].iloc[-1] - st["qd_pelvis_tx"].iloc[0])
+            g = s.grf.reindex(st.index, method="nearest")
+            rows[(c, k)] = {"status": s.stats["status"], "worst constraint": s.solution.worst_constraint,
+                            "max violation": s.solution.max_violation, "forward speed change (m/s)": dv,
+                            "mean fore-aft acceleration (m/s²)": dv / (t[-1] - t[0]),
+                            "mean fore-aft GRF (N)": _cycle_mean(g["grf_x_r"] + g["grf_x_l"]),
+                            "mean R_x (N)": _cycle_mean(s.residuals["R_x"])}
+    return pd.DataFrame.from_dict(rows, orient="index").rename_axis(["class", "start"])
+
+
+def _cycle_mean(y: pd.Series) -> float:
+    """The time mean of a series on its (time) index over its span (trapezoidal)."""
+    t = y.index.to_numpy(dtype=float)
+    return float(np.trapezoid(y.to_numpy(dtype=float), t) / (t[-1] - t[0]))
+
+
+def stop_findings(stops: pd.DataFrame, residual_bound: float = 1.0) -> list[str]:
+    """The sentence on :func:`stop_table`: how many of the runs that did not converge IPOPT
+    declares locally infeasible, at which constraint, and with what forward-speed change, mean
+    fore-aft GRF and residual R_x (ranges over those runs; ``residual_bound``: R_x's bound, N)."""
+    inf = stops[stops["status"] == "Infeasible_Problem_Detected"] if len(stops) else stops
+    if not len(inf):
+        return []
+
+    def span(col, fmt=".2f"):
+        v = inf[col].astype(float)
+        lo, hi = f"{v.min():{fmt}}", f"{v.max():{fmt}}"
+        return lo if lo == hi else f"{lo} … {hi}"
+
+    where = inf["worst constraint"].value_counts()
+    acc = inf["mean fore-aft acceleration (m/s²)"].astype(float)
+    grf, rx = inf["mean fore-aft GRF (N)"].astype(float), inf["mean R_x (N)"].astype(float)
+    classes = inf.index.get_level_values("class").unique()
+    spread = float(np.ptp(acc) / abs(acc.mean())) if acc.mean() else np.inf
+    text = (f"**{len(inf)} of the {len(stops)} restarts that did not converge stop as locally infeasible** "
+            f"(IPOPT's restoration phase fails; {len(classes)} classes: {', '.join(classes)}), the largest violation "
+            + "; ".join(f"at {w} in {n}" for w, n in where.items())
+            + f": the cycle ends {span('forward speed change (m/s)', '+.3f')} m/s off its starting forward speed "
+            f"(mean fore-aft acceleration {span('mean fore-aft acceleration (m/s²)', '+.4f')} m s⁻²), with the feet's "
+            f"mean fore-aft GRF {span('mean fore-aft GRF (N)', '+.2f')} N and the pelvis residual's mean R_x "
+            f"{span('mean R_x (N)', '+.2f')} N (bound ±{residual_bound:g} N)")
+    if (grf < 0).all() and (rx >= 0.99 * residual_bound).all():
+        text += ": the feet brake on average and the residual pushes forward at its bound, short of offsetting them"
+    if spread < 0.05:
+        text += f" — the same stop from every one of these starts (the acceleration within {100 * spread:.1f} % of its mean)"
+    return [text + "."]
+
+
 def best_starts(table: pd.DataFrame) -> pd.DataFrame:
     """Per class of a :func:`restart_table`: the study's own run (its objective and COT, or its
     mark) beside the lowest-objective start among the converged, valid ones, the objective's
@@ -1082,7 +1212,10 @@ def best_starts(table: pd.DataFrame) -> pd.DataFrame:
                    "COT over valid starts (J/kg/m)": (f"{ok['COT (J/kg/m)'].min():.2f}–{ok['COT (J/kg/m)'].max():.2f}"
                                                       if len(ok) else ""),
                    "COT spread (J/kg/m)": float(np.ptp(ok["COT (J/kg/m)"].astype(float))) if len(ok) else np.nan}
-    return pd.DataFrame.from_dict(rows, orient="index").rename_axis("class")
+    out = pd.DataFrame.from_dict(rows, orient="index").rename_axis("class")
+    if len(out):  # a class without a valid start: None (pandas reads it as NaN, which is truthy)
+        out["best start"] = out["best start"].astype(object).where(out["best start"].notna(), None)
+    return out
 
 
 def best_curve(restarts: dict, best: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
