@@ -336,9 +336,12 @@ def test_stop_table_and_findings_by_hand():
 
     def run(success, status, dv=-0.1, grf_l=(-1.0, -3.0, -1.0)):
         states = pd.DataFrame({"qd_pelvis_tx": [1.0, 1.0 + dv / 2, 1.0 + dv]}, index=t)
+        grf = pd.DataFrame({"grf_x_r": [-2.0] * 3, "grf_x_l": list(grf_l), "grf_y_r": [200.0] * 3,
+                            "grf_y_l": [200.0] * 3}, index=t)
+        ell = pd.DataFrame({"fx_ball_r": grf["grf_x_r"], "fx_ball_l": grf["grf_x_l"]}, index=t)
         return NS(stats={"success": success, "status": status},
                   solution=NS(states=states, worst_constraint="cycle/periodic", max_violation=abs(dv)),
-                  grf=pd.DataFrame({"grf_x_r": [-2.0] * 3, "grf_x_l": list(grf_l)}, index=t),
+                  spec=NS(contact_params="default", friction_floor=None), grf=grf, ellipsoids=ell,
                   residuals=pd.DataFrame({"R_x": [1.0] * 3}, index=t))
 
     inf = "Infeasible_Problem_Detected"
@@ -351,10 +354,14 @@ def test_stop_table_and_findings_by_hand():
     assert r["mean fore-aft acceleration (m/s²)"] == pytest.approx(-0.1)  # over a 1 s cycle
     # right −2 throughout; left (−1 −3)/2·0.5 + (−3 −1)/2·0.5 = −2 → −4 N; R_x 1 N
     assert r["mean fore-aft GRF (N)"] == pytest.approx(-4.0) and r["mean R_x (N)"] == pytest.approx(1.0)
+    # all of it on the balls; Table 4.18's ball μ_d 0.01 × 400 N normal load = 4 N → −1
+    assert r["ball's share of it"] == pytest.approx(1.0) and r["μ_d(ball)"] == pytest.approx(0.01)
+    assert r["GRF / (μ_d(ball) × normal load)"] == pytest.approx(-1.0)
     out = fidelity.stop_findings(st)
     assert out[0].startswith("**2 of the 3 restarts that did not converge stop as locally infeasible** (IPOPT's "
                              "restoration phase fails; 2 classes: Free, Fast), the largest violation at cycle/periodic in 2")
     assert "ends -0.100 m/s off" in out[0] and "-0.1002 … -0.1000 m s⁻²" in out[0]
     assert "the feet brake on average and the residual pushes forward at its bound" in out[0]
     assert "within 0.2 % of its mean" in out[0]
+    assert "from the ball ellipsoids alone (share 1.0000) at -1.000 × μ_d(ball) = 0.0100 times" in out[0]
     assert fidelity.stop_findings(st.drop(index=[("Free", "Slow"), ("Fast", "Free")])) == []

@@ -389,7 +389,9 @@ if restarts is not None:
 # constraint block with the largest violation, how far the cycle's end forward speed is from
 # its start (the periodicity of the pelvis's velocity), and the cycle means of the two
 # horizontal forces that set it — the feet's fore-aft GRF and the pelvis residual $R_x$
-# (bounded ±1 N, Eq 4.8) (`fidelity.stop_table`).
+# (bounded ±1 N, Eq 4.8) — then the ball ellipsoids' share of that GRF and the GRF over its
+# friction limit on the ball, $\mu_d$(ball) × the feet's mean normal load (−1: both feet
+# sliding forward on the balls whenever loaded) (`fidelity.stop_table`).
 
 # %%
 if restarts is not None:

@@ -1136,7 +1136,10 @@ def stop_table(restarts: dict) -> pd.DataFrame:
     (m/s; 0 on a periodic cycle), that change over the cycle time (the mean fore-aft
     acceleration, m s⁻²), and the cycle means of the fore-aft GRF of both feet and of the
     pelvis's horizontal residual R_x (N; bounded ±1 N, Eq 4.8) — the two horizontal forces
-    whose sum, over the body's mass, is that mean acceleration."""
+    whose sum, over the body's mass, is that mean acceleration — then the ball ellipsoids'
+    share of that GRF and the GRF over its friction limit on the ball, μ_d(ball) × the feet's
+    mean normal load (μ_d of the run's contact set, at least its friction floor; −1: both feet
+    sliding forward on the balls the whole cycle)."""
     rows = {}
     for c, sols in restarts.items():
         for k, s in sols.items():
@@ -1145,12 +1148,15 @@ def stop_table(restarts: dict) -> pd.DataFrame:
             st = s.solution.states
             t = st.index.to_numpy()
             dv = float(st["qd_pelvis_tx"].iloc[-1] - st["qd_pelvis_tx"].iloc[0])
-            g = s.grf.reindex(st.index, method="nearest")
+            g, e = s.grf, s.ellipsoids
+            fx = _cycle_mean(g["grf_x_r"] + g["grf_x_l"])
+            mu = max(ball_friction(s.spec.contact_params)[1], s.spec.friction_floor or 0.0)
             rows[(c, k)] = {"status": s.stats["status"], "worst constraint": s.solution.worst_constraint,
                             "max violation": s.solution.max_violation, "forward speed change (m/s)": dv,
                             "mean fore-aft acceleration (m/s²)": dv / (t[-1] - t[0]),
-                            "mean fore-aft GRF (N)": _cycle_mean(g["grf_x_r"] + g["grf_x_l"]),
-                            "mean R_x (N)": _cycle_mean(s.residuals["R_x"])}
+                            "mean fore-aft GRF (N)": fx, "mean R_x (N)": _cycle_mean(s.residuals["R_x"]),
+                            "ball's share of it": _cycle_mean(e["fx_ball_r"] + e["fx_ball_l"]) / fx if fx else np.nan,
+                            "μ_d(ball)": mu, "GRF / (μ_d(ball) × normal load)": fx / (mu * _cycle_mean(g["grf_y_r"] + g["grf_y_l"]))}
     return pd.DataFrame.from_dict(rows, orient="index").rename_axis(["class", "start"])
 
 
@@ -1187,6 +1193,13 @@ def stop_findings(stops: pd.DataFrame, residual_bound: float = 1.0) -> list[str]
             f"{span('mean R_x (N)', '+.2f')} N (bound ±{residual_bound:g} N)")
     if (grf < 0).all() and (rx >= 0.99 * residual_bound).all():
         text += ": the feet brake on average and the residual pushes forward at its bound, short of offsetting them"
+        share, lim = inf["ball's share of it"].astype(float), inf["GRF / (μ_d(ball) × normal load)"].astype(float)
+        if (share > 0.99).all() and (abs(lim + 1) < 0.02).all():
+            text += (f". That braking comes from the ball ellipsoids alone (share {span(share.name, '.4f')}) "
+                     f"at {span('GRF / (μ_d(ball) × normal load)', '.3f')} × μ_d(ball) = "
+                     f"{span('μ_d(ball)', '.4f')} times the feet's mean normal load: both feet slide forward on "
+                     "the balls whenever loaded, braking at the ball's friction limit — a point IPOPT's restoration "
+                     "phase does not leave")
     if spread < 0.05:
         text += f" — the same stop from every one of these starts (the acceleration within {100 * spread:.1f} % of its mean)"
     return [text + "."]
