@@ -4,6 +4,7 @@ divides as Eq 5.57 says. No solve: a hand-built state set and a stand-in solutio
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from types import SimpleNamespace
 
@@ -287,13 +288,19 @@ def test_marked_restarts_stand_in_only_for_marked_points(monkeypatch):
         def __init__(self, name, mark="", cot=4.0):
             self.name, self.mark, self.stats = name, mark, {"COT": cot}
 
+    @dataclasses.dataclass
     class Study:
-        def __init__(self, sols, rerun_used=()):
-            self.solutions, self.records, self.rerun_used = sols, {k: None for k in sols}, rerun_used
+        solutions: dict
+        rerun_used: tuple = ()
+        restart_used: tuple = ()
+
+        @property
+        def records(self):
+            return {k: None for k in self.solutions}
 
         def with_reruns(self, reruns):
             got.append(reruns)
-            return Study({**self.solutions, **reruns}, self.rerun_used + tuple(reruns))
+            return Study({**self.solutions, **reruns}, self.rerun_used + tuple(reruns), self.restart_used)
 
     got, calls = [], []
     slow = Sol("slow", "NOT CONVERGED: Maximum_Iterations_Exceeded")
@@ -317,7 +324,8 @@ def test_marked_restarts_stand_in_only_for_marked_points(monkeypatch):
     assert calls == [(["Slow", "Fast"], {"Free": res.solutions["NMSK Free"]})]  # marked classes; valid starts only
     assert fidelity.best_starts(fidelity.restart_table(restarts)).loc["Fast", "best start"] is None  # not NaN
     used = fidelity.with_restarts(res, restarts)
-    assert got == [{"NMSK Slow": r_free}] and used.rerun_used == ("NMSK Slow",)
+    assert got == [{"NMSK Slow": r_free}] and used.solutions["NMSK Slow"] is r_free
+    assert used.restart_used == ("NMSK Slow",) and used.rerun_used == ()  # not a 3000-iteration rerun
     out = fidelity.stand_in_findings(res, used, restarts)
     assert out[0] == ("**Slow** (its own run NOT CONVERGED: Maximum_Iterations_Exceeded): 1 of 2 starts from the other "
                       "classes' solutions converge to a valid gait; the lowest objective, from Free's solution (COT "
@@ -331,7 +339,7 @@ def test_stop_table_and_findings_by_hand():
     """fidelity.stop_table: the forward-speed change over the cycle and the cycle means of the
     fore-aft GRF and R_x (trapezoidal, by hand) of the runs that did not converge only;
     stop_findings reads the infeasible ones."""
-    from types import SimpleNamespace as NS
+    NS = SimpleNamespace
     t = pd.Index([0.0, 0.5, 1.0])
 
     def run(success, status, dv=-0.1, grf_l=(-1.0, -3.0, -1.0)):
@@ -365,3 +373,39 @@ def test_stop_table_and_findings_by_hand():
     assert "within 0.2 % of its mean" in out[0]
     assert "from the ball ellipsoids alone (share 1.0000) at -1.000 × μ_d(ball) = 0.0100 times" in out[0]
     assert fidelity.stop_findings(st.drop(index=[("Free", "Slow"), ("Fast", "Free")])) == []
+
+
+def test_restart_pairs_and_floor_stop_findings(monkeypatch):
+    """fidelity.infeasible_pairs keeps the first round's infeasible restarts; restart_pairs
+    starts each class only from a valid, solved (not stood-in) run of its start class, one
+    sweep per start, the study's own runs left out; floor_stop_findings counts the valid ones."""
+    own, inf = fidelity.OWN_START, "Infeasible_Problem_Detected"
+    stops = pd.DataFrame({"status": [inf, inf, "Maximum_Iterations_Exceeded", inf]}, index=pd.MultiIndex.from_tuples(
+        [("Free", "VerySlow"), ("VeryFast", "Fast"), ("Fast", "Slow"), ("Fast", "Slow" + fidelity.ROUND_2)],
+        names=["class", "start"]))
+    assert fidelity.infeasible_pairs(stops) == [("Free", "VerySlow"), ("VeryFast", "Fast")]
+
+    class Sol:
+        def __init__(self, mark="", cot=3.0):
+            self.mark, self.stats = mark, {"COT": cot}
+
+    calls = []
+
+    def fake(res, classes=None, *, starts=None, **kw):
+        calls.append((classes, sorted(starts)))
+        return {c: {own: "own", **{k: Sol(cot=2.5) for k in starts}} for c in classes}
+
+    monkeypatch.setattr(fidelity.marks, "failure_label", lambda s: s.mark or None)
+    monkeypatch.setattr(fidelity, "curve_restarts", fake)
+    res = SimpleNamespace(solutions={"NMSK VerySlow": Sol(), "NMSK Fast": Sol()}, restart_used=("NMSK Fast",))
+    out = fidelity.restart_pairs(res, fidelity.infeasible_pairs(stops) + [("Fast", "VerySlow")])
+    assert calls == [(["Free", "Fast"], ["VerySlow"])]  # Fast's run is a stand-in: no start
+    assert set(out) == {"Free", "Fast"} and set(out["Free"]) == {"VerySlow"}
+    text = fidelity.floor_stop_findings(stops, out, 0.2819)[0]
+    assert text.startswith("**With every ellipsoid's friction at least 0.2819** (the problem of the friction-floor "
+                           "section above; its own runs as starts), the same 1 restarts: 1 of 1 converge")
+    assert "Free from VerySlow: converged, valid (COT 2.50)" in text and "it is the ball's μ_d" in text
+    out["Free"]["VerySlow"] = Sol("INVALID: x")
+    text = fidelity.floor_stop_findings(stops, out, 0.2819)[0]
+    assert "0 of 1 converge" in text and "Free from VerySlow: INVALID: x" in text and "ball's μ_d" not in text
+    assert fidelity.floor_stop_findings(stops, {}, 0.2819) == []

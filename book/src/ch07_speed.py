@@ -253,8 +253,10 @@ display(Markdown("\n\n".join(fidelity.cot_curve_findings(cot_u, terms_u))))
 # %%
 slip_u = fidelity.slip_table({s.spec.speed_class: s for s in res_u.solutions.values()})
 ref_u = {s.spec.speed_class: gait.reference_slip(s.spec) for s in res_u.solutions.values()}
-def stored_consistent(what, **kw):
-    """The consistent study with ``kw`` from the store, its reruns shown; None if not stored."""
+def stored_consistent(what, restart=False, **kw):
+    """The consistent study with ``kw`` from the store, its reruns shown; with ``restart``, a
+    point still marked then stood in for by its best restart from the other classes'
+    solutions (shown). None if not stored."""
     try:
         res0, inv, res = fidelity.stored_consistent_study(what, **kw)
     except cache.NotCached as e:
@@ -264,7 +266,17 @@ def stored_consistent(what, **kw):
         print("stopped at the 1000-iteration limit, rerun with 3000 (from the same start):")
         display(res0.rerun_table(inv))
         print("reruns standing in:", ", ".join(res.rerun_used) or "none")
-    return res
+    if not restart:
+        return res
+    try:
+        restarts, used = fidelity.stored_restarts(res, f"the restarts of the marked points ({what})")
+    except cache.NotCached as e:
+        print(f"Not stored yet: {e}")
+        return res
+    if restarts:
+        display(fidelity.restart_table(restarts))
+        display(Markdown("\n\n".join(fidelity.stand_in_findings(res, used, restarts))))
+    return used
 
 
 res_f = stored_consistent("the runs with the friction floor", friction_floor=fidelity.FRICTION_FLOOR)
@@ -337,22 +349,13 @@ if res7_c5 is not None:
 # another start; the lowest-objective converged, valid one stands in for it, labelled.
 
 # %%
-res_b = stored_consistent("the runs with Bhargava's F0", isometric_torque="bhargava")
+res_b = stored_consistent("the runs with Bhargava's F0", restart=True, isometric_torque="bhargava")
 if res_b is not None:
-    try:
-        restarts_b, used_b = fidelity.stored_restarts(res_b, "the restarts of the marked points with Bhargava's F0")
-    except cache.NotCached as e:
-        restarts_b, used_b = {}, res_b
-        print(f"Not stored yet: {e}")
-    if restarts_b:
-        display(fidelity.restart_table(restarts_b))
-    stand_ins = [k.split()[-1] for k in used_b.rerun_used if k not in res_b.rerun_used]
-    cot_b, terms_b, _ = fidelity.curve_tables(used_b)
+    cot_b, terms_b, _ = fidelity.curve_tables(res_b)
     fig = pr.cot_figure(cot_b, label="ours: one problem, Bhargava's F0 (converged, valid"
-                        + "".join(f"; {c} from another class's solution" for c in stand_ins) + ")")
+                        + "".join(f"; {c} from another class's solution" for c in (k.split()[-1] for k in res_b.restart_used)) + ")")
     display(cot_b, terms_b)
-    display(Markdown("\n\n".join(fidelity.stand_in_findings(res_b, used_b, restarts_b)
-                                  + fidelity.cot_curve_findings(cot_b, terms_b, name="The curve with Bhargava's F0"))))
+    display(Markdown("\n\n".join(fidelity.cot_curve_findings(cot_b, terms_b, name="The curve with Bhargava's F0"))))
 
 # %% [markdown]
 # ### Is each point a local optimum? Every run from every other run's solution
@@ -398,6 +401,25 @@ if restarts is not None:
     stops = fidelity.stop_table(restarts)
     display(stops)
     display(Markdown("\n\n".join(fidelity.stop_findings(stops))))
+
+# %% [markdown]
+# One change tests that reading: the restarts that stopped as locally infeasible, solved again
+# in the problem with the friction floor of the section above (every ellipsoid's friction
+# at least the toe's μ_d, so the ball grips), each from that problem's own run of the same
+# start class where that run converged to a valid gait (`fidelity.restart_pairs`).
+
+# %%
+if restarts is not None and res_f is not None:
+    try:
+        with cache.only("the infeasible restarts with the friction floor are read from the store "
+                        "(fidelity.restart_pairs solves them)"):
+            floor_r = fidelity.restart_pairs(res_f, fidelity.infeasible_pairs(stops), progress=False)
+    except cache.NotCached as e:
+        floor_r = None
+        print(f"Not stored yet: {e}")
+    if floor_r:
+        display(fidelity.restart_table(floor_r))
+        display(Markdown("\n\n".join(fidelity.floor_stop_findings(stops, floor_r, fidelity.FRICTION_FLOOR))))
 
 # %% [markdown]
 # ### On longer legs with the contact identified on them (a probe)

@@ -1427,7 +1427,7 @@ def _f0_clause() -> str:
         _, used = fidelity.stored_restarts(res, "the restarts of the marked points with Bhargava's F0")
     except cache.NotCached:
         used = res
-    stand_ins = [k.split()[-1] for k in used.rerun_used if k not in res.rerun_used]
+    stand_ins = [k.split()[-1] for k in used.restart_used]
     cot, terms, _ = fidelity.curve_tables(used)
     where = _anchor("ch07_speed", "With Bhargava's reading of Eq 5.47's F0")
     if len(terms) < 3:

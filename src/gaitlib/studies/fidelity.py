@@ -1038,14 +1038,17 @@ def marked_restarts(res, **kw) -> dict:
 
 def with_restarts(res, restarts: dict):
     """The study ``res`` with each marked run replaced by the lowest-objective converged, valid
-    start of ``restarts`` (:func:`marked_restarts`; :func:`best_starts` decides) —
-    :meth:`~gaitlib.studies.predictive.StudyResult.with_reruns`, so :attr:`rerun_used` names
-    it (every use labelled by the caller). ``res`` itself when none is usable."""
+    start of ``restarts`` (:func:`marked_restarts`; :func:`best_starts` decides) through
+    :meth:`~gaitlib.studies.predictive.StudyResult.with_reruns`; ``restart_used`` names the
+    replaced runs (``rerun_used`` stays the 3000-iteration reruns'; every use labelled by the
+    caller). ``res`` itself when none is usable."""
     if not restarts:
         return res
     best = best_starts(restart_table(restarts))
-    return res.with_reruns({f"NMSK {c}": restarts[c][r["best start"]] for c, r in best.iterrows()
+    used = res.with_reruns({f"NMSK {c}": restarts[c][r["best start"]] for c, r in best.iterrows()
                             if r["best start"] not in (None, OWN_START)})
+    new = tuple(k for k in used.rerun_used if k not in res.rerun_used)
+    return replace(used, rerun_used=res.rerun_used, restart_used=tuple(res.restart_used) + new) if new else res
 
 
 def stored_restarts(res, what: str):
@@ -1070,7 +1073,7 @@ def stand_in_findings(res, used, restarts: dict) -> list[str]:
         t = table.loc[c].drop(index=OWN_START, errors="ignore")
         ok = t[t["mark"] == ""]
         own = marks.failure_label(res.solutions.get(f"NMSK {c}", res.records[f"NMSK {c}"]))
-        if f"NMSK {c}" in used.rerun_used and f"NMSK {c}" not in res.rerun_used:
+        if f"NMSK {c}" in used.restart_used:
             s = used.solutions[f"NMSK {c}"]
             src = next(k for k, v in restarts[c].items() if v is s)
             out.append(f"**{c}** (its own run {own}): {len(ok)} of {len(t)} starts from the other classes' solutions "
@@ -1158,6 +1161,55 @@ def stop_table(restarts: dict) -> pd.DataFrame:
                             "ball's share of it": _cycle_mean(e["fx_ball_r"] + e["fx_ball_l"]) / fx if fx else np.nan,
                             "μ_d(ball)": mu, "GRF / (μ_d(ball) × normal load)": fx / (mu * _cycle_mean(g["grf_y_r"] + g["grf_y_l"]))}
     return pd.DataFrame.from_dict(rows, orient="index").rename_axis(["class", "start"])
+
+
+def infeasible_pairs(stops: pd.DataFrame) -> list[tuple[str, str]]:
+    """The (class, start) pairs of a :func:`stop_table` whose first-round restart (a start
+    named by a class, not :data:`ROUND_2`) IPOPT declared locally infeasible."""
+    return [(c, k) for (c, k), r in stops.iterrows()
+            if r["status"] == "Infeasible_Problem_Detected" and k in cv.SPEED_CLASSES]
+
+
+def restart_pairs(res, pairs, **kw) -> dict:
+    """:func:`curve_restarts` of the consistent study ``res`` for just these (class, start)
+    pairs, each from ``res``'s own run of the start class where that run converged to a valid
+    gait as solved (not a stand-in); one sweep per start class. ``kw``:
+    :func:`curve_restarts`'s options. Returns class → {start → solution} (the study's own runs
+    left out)."""
+    by_start: dict[str, list[str]] = {}
+    for c, k in pairs:
+        by_start.setdefault(k, []).append(c)
+    out: dict = {}
+    for k, classes in by_start.items():
+        s = res.solutions.get(f"NMSK {k}")
+        if s is None or marks.failure_label(s) or f"NMSK {k}" in getattr(res, "restart_used", ()):
+            continue
+        for c, sols in curve_restarts(res, classes=classes, starts={k: s}, **kw).items():
+            out.setdefault(c, {}).update({src: v for src, v in sols.items() if src != OWN_START})
+    return out
+
+
+def floor_stop_findings(stops: pd.DataFrame, floor_restarts: dict, floor: float) -> list[str]:
+    """The sentence on the infeasible restarts of :func:`stop_table` (``stops``) solved again in
+    the problem with the friction floor (``floor_restarts``: :func:`restart_pairs` of that
+    study for :func:`infeasible_pairs`; ``floor``: its μ floor): per pair, whether it now
+    converges to a valid gait."""
+    pairs = [(c, k) for c, k in infeasible_pairs(stops) if k in floor_restarts.get(c, {})]
+    if not pairs:
+        return []
+    res_of = {p: floor_restarts[p[0]][p[1]] for p in pairs}
+    ok = [p for p, s in res_of.items() if s is not None and not marks.failure_label(s)]
+    each = "; ".join(f"{c} from {k}: " + ("converged, valid (COT " f"{res_of[(c, k)].stats['COT']:.2f})" if (c, k) in ok
+                                         else (marks.failure_label(res_of[(c, k)]) if res_of[(c, k)] is not None
+                                               else "raised")) for c, k in pairs)
+    text = (f"**With every ellipsoid's friction at least {floor:g}** (the problem of the friction-floor section "
+            f"above; its own runs as starts), the same {len(pairs)} restarts: {len(ok)} of {len(pairs)} converge to a "
+            f"valid gait ({each}).")
+    if len(ok) == len(pairs):
+        text += (" The stop at the ball's friction limit does not occur once the ball grips: it is the ball's μ_d of "
+                 "Table 4.18 that makes these restarts fail (measured on the floor problem, whose start solutions "
+                 "are its own).")
+    return [text]
 
 
 def _cycle_mean(y: pd.Series) -> float:
