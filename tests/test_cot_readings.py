@@ -405,7 +405,11 @@ def test_restart_pairs_and_floor_stop_findings(monkeypatch):
     assert text.startswith("**With every ellipsoid's friction at least 0.2819** (the problem of the friction-floor "
                            "section above; its own runs as starts), the same 1 restarts: 1 of 1 converge")
     assert "Free from VerySlow: converged, valid (COT 2.50)" in text and "it is the ball's μ_d" in text
-    out["Free"]["VerySlow"] = Sol("INVALID: x")
+    out["Free"]["VerySlow"] = Sol("NOT CONVERGED: Maximum_Iterations_Exceeded")
+    out["Free"]["VerySlow"].stats["status"] = "Maximum_Iterations_Exceeded"
     text = fidelity.floor_stop_findings(stops, out, 0.2819)[0]
-    assert "0 of 1 converge" in text and "Free from VerySlow: INVALID: x" in text and "ball's μ_d" not in text
+    assert "0 of 1 converge" in text and "Free from VerySlow: NOT CONVERGED: Maximum_Iterations_Exceeded" in text
+    assert "ball's μ_d" not in text and "None stops as locally infeasible any more" in text
+    out["Free"]["VerySlow"].stats["status"] = "Infeasible_Problem_Detected"
+    assert fidelity.floor_stop_findings(stops, out, 0.2819)[0].endswith("1 of 1 stop as locally infeasible again.")
     assert fidelity.floor_stop_findings(stops, {}, 0.2819) == []

@@ -1498,6 +1498,10 @@ def _skating_cause(cot: pd.DataFrame, res) -> str:
                                                        friction_floor=fidelity.FRICTION_FLOOR)
     except cache.NotCached:
         return text + " — the same problem with friction not stored"
+    try:
+        _, res_f = fidelity.stored_restarts(res_f, "the restarts of the marked points with the friction floor")
+    except cache.NotCached:
+        pass  # the study as solved: its marked points stay out
     cot_f = pr.cot_table(res_f)
     ok = [c for c in cot_f.index if not cot_f.loc[c, "mark"]]
     where = _anchor("ch07_speed", "The feet skate: the same problem with friction")
@@ -1508,6 +1512,7 @@ def _skating_cause(cot: pd.DataFrame, res) -> str:
     used = (f"; {', '.join(res_f.rerun_used)} through "
             f"{'its 3000-iteration rerun' if len(res_f.rerun_used) == 1 else 'their 3000-iteration reruns'}"
             if res_f.rerun_used else "")
+    used += "".join(f"; {k} from another class's solution" for k in res_f.restart_used)
     return (text + f"; with every ellipsoid's friction ≥ {fidelity.FRICTION_FLOOR:g} ({len(ok)} of {len(cot_f)} runs "
             f"converged and valid{used}, slip {slip_f.loc[ok, col].min():.2f}–{slip_f.loc[ok, col].max():.2f} m/s): "
             + ", ".join(f"{c} {cot_f.loc[c, 'COT (J/kg/m)']:.2f}" for c in ok) + f", minimum at {at} [{where}]")

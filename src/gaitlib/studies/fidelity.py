@@ -1205,10 +1205,17 @@ def floor_stop_findings(stops: pd.DataFrame, floor_restarts: dict, floor: float)
     text = (f"**With every ellipsoid's friction at least {floor:g}** (the problem of the friction-floor section "
             f"above; its own runs as starts), the same {len(pairs)} restarts: {len(ok)} of {len(pairs)} converge to a "
             f"valid gait ({each}).")
+    again = [p for p, s in res_of.items() if s is not None and s.stats.get("status") == "Infeasible_Problem_Detected"]
     if len(ok) == len(pairs):
         text += (" The stop at the ball's friction limit does not occur once the ball grips: it is the ball's μ_d of "
                  "Table 4.18 that makes these restarts fail (measured on the floor problem, whose start solutions "
                  "are its own).")
+    elif not again:
+        text += (" None stops as locally infeasible any more: with the ball gripping, the stop at its friction limit "
+                 f"is gone, but {len(pairs) - len(ok)} of {len(pairs)} still do not converge — the floor removes the "
+                 "stop, not every difficulty of these starts.")
+    else:
+        text += f" {len(again)} of {len(pairs)} stop as locally infeasible again."
     return [text]
 
 
