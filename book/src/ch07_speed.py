@@ -356,7 +356,7 @@ res_b = stored_consistent("the runs with Bhargava's F0", restart=True, isometric
 if res_b is not None:
     cot_b, terms_b, _ = fidelity.curve_tables(res_b)
     fig = pr.cot_figure(cot_b, label="ours: one problem, Bhargava's F0 (converged, valid"
-                        + "".join(f"; {c} from another class's solution" for c in (k.split()[-1] for k in res_b.restart_used)) + ")")
+                        + "".join(f"; {k.split()[-1]} from another class's solution" for k in res_b.restart_used) + ")")
     display(cot_b, terms_b)
     display(Markdown("\n\n".join(fidelity.cot_curve_findings(cot_b, terms_b, name="The curve with Bhargava's F0"))))
 

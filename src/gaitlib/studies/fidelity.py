@@ -1142,7 +1142,7 @@ def stop_table(restarts: dict) -> pd.DataFrame:
     whose sum, over the body's mass, is that mean acceleration — then the ball ellipsoids'
     share of that GRF and the GRF over its friction limit on the ball, μ_d(ball) × the feet's
     mean normal load (μ_d of the run's contact set, at least its friction floor; −1: both feet
-    sliding forward on the balls the whole cycle)."""
+    sliding forward on the balls whenever loaded)."""
     rows = {}
     for c, sols in restarts.items():
         for k, s in sols.items():
@@ -1182,7 +1182,7 @@ def restart_pairs(res, pairs, **kw) -> dict:
     out: dict = {}
     for k, classes in by_start.items():
         s = res.solutions.get(f"NMSK {k}")
-        if s is None or marks.failure_label(s) or f"NMSK {k}" in getattr(res, "restart_used", ()):
+        if s is None or marks.failure_label(s) or f"NMSK {k}" in res.restart_used:
             continue
         for c, sols in curve_restarts(res, classes=classes, starts={k: s}, **kw).items():
             out.setdefault(c, {}).update({src: v for src, v in sols.items() if src != OWN_START})
