@@ -360,7 +360,7 @@ def test_stop_table_and_findings_by_hand():
     r = st.loc[("Free", "Slow")]
     assert r["forward speed change (m/s)"] == pytest.approx(-0.1)
     assert r["mean fore-aft acceleration (m/s²)"] == pytest.approx(-0.1)  # over a 1 s cycle
-    # right −2 throughout; left (−1 −3)/2·0.5 + (−3 −1)/2·0.5 = −2 → −4 N; R_x 1 N
+    # node shares of the cycle 0.5, 0.5, 0 (the last node at t_f): right −2; left −1·0.5 − 3·0.5 = −2 → −4 N; R_x 1 N
     assert r["mean fore-aft GRF (N)"] == pytest.approx(-4.0) and r["mean R_x (N)"] == pytest.approx(1.0)
     # all of it on the balls; Table 4.18's ball μ_d 0.01 × 400 N normal load = 4 N → −1
     assert r["ball's share of it"] == pytest.approx(1.0) and r["μ_d(ball)"] == pytest.approx(0.01)

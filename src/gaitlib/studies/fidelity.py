@@ -1151,15 +1151,15 @@ def stop_table(restarts: dict) -> pd.DataFrame:
             st = s.solution.states
             t = st.index.to_numpy()
             dv = float(st["qd_pelvis_tx"].iloc[-1] - st["qd_pelvis_tx"].iloc[0])
-            g, e = s.grf, s.ellipsoids
-            fx = _cycle_mean(g["grf_x_r"] + g["grf_x_l"])
+            g, e, tf = s.grf, s.ellipsoids, float(s.stats.get("tf_s", t[-1]))
+            fx = _cycle_mean(g["grf_x_r"] + g["grf_x_l"], tf)
             mu = max(ball_friction(s.spec.contact_params)[1], s.spec.friction_floor or 0.0)
             rows[(c, k)] = {"status": s.stats["status"], "worst constraint": s.solution.worst_constraint,
                             "max violation": s.solution.max_violation, "forward speed change (m/s)": dv,
                             "mean fore-aft acceleration (m/s²)": dv / (t[-1] - t[0]),
-                            "mean fore-aft GRF (N)": fx, "mean R_x (N)": _cycle_mean(s.residuals["R_x"]),
-                            "ball's share of it": _cycle_mean(e["fx_ball_r"] + e["fx_ball_l"]) / fx if fx else np.nan,
-                            "μ_d(ball)": mu, "GRF / (μ_d(ball) × normal load)": fx / (mu * _cycle_mean(g["grf_y_r"] + g["grf_y_l"]))}
+                            "mean fore-aft GRF (N)": fx, "mean R_x (N)": _cycle_mean(s.residuals["R_x"], tf),
+                            "ball's share of it": _cycle_mean(e["fx_ball_r"] + e["fx_ball_l"], tf) / fx if fx else np.nan,
+                            "μ_d(ball)": mu, "GRF / (μ_d(ball) × normal load)": fx / (mu * _cycle_mean(g["grf_y_r"] + g["grf_y_l"], tf))}
     return pd.DataFrame.from_dict(rows, orient="index").rename_axis(["class", "start"])
 
 
@@ -1219,10 +1219,9 @@ def floor_stop_findings(stops: pd.DataFrame, floor_restarts: dict, floor: float)
     return [text]
 
 
-def _cycle_mean(y: pd.Series) -> float:
-    """The time mean of a series on its (time) index over its span (trapezoidal)."""
-    t = y.index.to_numpy(dtype=float)
-    return float(np.trapezoid(y.to_numpy(dtype=float), t) / (t[-1] - t[0]))
+def _cycle_mean(y: pd.Series, tf: float) -> float:
+    """The cycle mean of a node-indexed series (:func:`gaitlib.studies.gait.cycle_weights`)."""
+    return float((gait_study.cycle_weights(y.index, tf) * y.to_numpy(dtype=float)).sum())
 
 
 def stop_findings(stops: pd.DataFrame, residual_bound: float = 1.0) -> list[str]:

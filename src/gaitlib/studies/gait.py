@@ -182,6 +182,14 @@ SLIP_V = contact_mod.Smoothing.v_transition
 SLIP_COLUMN = "foot slip (m/s)"
 
 
+def cycle_weights(t, tf: float) -> np.ndarray:
+    """Each node's share of the cycle [t₀, t_f] (s → 1): the interval to the next node, the
+    last node's to ``tf`` (collocation nodes may stop short of t_f). Weights of a time mean
+    over a solution's node-indexed frames."""
+    t = np.asarray(t, float)
+    return np.diff(np.append(t, tf)) / (tf - t[0])
+
+
 def foot_slip(sol, v: float = SLIP_V) -> dict:
     """How fast a gait solution's loaded feet slide (a measurement, not a validity gate).
 
@@ -200,8 +208,7 @@ def foot_slip(sol, v: float = SLIP_V) -> dict:
     fn = np.clip(e[["fn_" + c[3:] for c in cols]].to_numpy(float), 0.0, None)
     vs = np.abs(e[cols].to_numpy(float))
     t = e.index.to_numpy(float)
-    tf = float(sol.stats.get("tf_s", t[-1]))
-    w = (np.diff(np.append(t, tf)) / (tf - t[0]))[:, None]
+    w = cycle_weights(t, float(sol.stats.get("tf_s", t[-1])))[:, None]
     load = float((w * fn).sum())
     gd = gait_ocp.spec_gait_data(sol.spec)[0] if getattr(sol.spec, "leg_scale", None) is not None else \
         data_mod.load_gait_data(sol.spec.speed_class, sol.spec.source)
