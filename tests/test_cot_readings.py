@@ -335,11 +335,12 @@ def test_marked_restarts_stand_in_only_for_marked_points(monkeypatch):
     assert fidelity.marked_restarts(Study({"NMSK Free": Sol("free")})) == {}
 
 
-def test_stop_table_and_findings_by_hand():
+def test_stop_table_and_findings_by_hand(monkeypatch):
     """fidelity.stop_table: the forward-speed change over the cycle and the cycle means of the
-    fore-aft GRF and R_x (trapezoidal, by hand) of the runs that did not converge only;
-    stop_findings reads the infeasible ones."""
+    fore-aft GRF and R_x (each node's share of the cycle, by hand) of the runs that did not
+    converge only, and their sum over the body's mass; stop_findings reads the infeasible ones."""
     NS = SimpleNamespace
+    monkeypatch.setattr(fidelity.gait_ocp, "spec_mass", lambda spec: 30.0)  # (−4 + 1) N / 30 kg = −0.1 m s⁻²
     t = pd.Index([0.0, 0.5, 1.0])
 
     def run(success, status, dv=-0.1, grf_l=(-1.0, -3.0, -1.0)):
@@ -365,12 +366,15 @@ def test_stop_table_and_findings_by_hand():
     # all of it on the balls; Table 4.18's ball μ_d 0.01 × 400 N normal load = 4 N → −1
     assert r["ball's share of it"] == pytest.approx(1.0) and r["μ_d(ball)"] == pytest.approx(0.01)
     assert r["GRF / (μ_d(ball) × normal load)"] == pytest.approx(-1.0)
+    assert r["(GRF + R_x) / mass (m/s²)"] == pytest.approx(-0.1)
     out = fidelity.stop_findings(st)
     assert out[0].startswith("**2 of the 3 restarts that did not converge stop as locally infeasible** (IPOPT's "
                              "restoration phase fails; 2 classes: Free, Fast), the largest violation at cycle/periodic in 2")
     assert "ends -0.100 m/s off" in out[0] and "-0.1002 … -0.1000 m s⁻²" in out[0]
     assert "the feet brake on average and the residual pushes forward at its bound" in out[0]
     assert "within 0.2 % of its mean" in out[0]
+    # Newton: −0.1 m s⁻² from the forces against −0.1002 and −0.1 from the velocity change → 0.2 % at most
+    assert "their sum over the body's mass, -0.1000 m s⁻², is that acceleration within 0.2 %" in out[0]
     assert "from the ball ellipsoids alone (share 1.0000) at -1.000 × μ_d(ball) = 0.0100 times" in out[0]
     assert fidelity.stop_findings(st.drop(index=[("Free", "Slow"), ("Fast", "Free")])) == []
 

@@ -75,6 +75,19 @@ def test_leg_scale_spec_keeps_old_keys_validates_and_builds_its_model():
             replace(spec, leg_scale=bad)
 
 
+def test_spec_mass_is_the_mass_matrix_translational_entry():
+    """spec_mass against the mass matrix's pelvis_tx diagonal (a translation moves every
+    segment: Σ m), at a bent pose, for the thesis's body and the longer legs' identified one."""
+    q = np.linspace(-0.4, 0.5, len(cv.COORDS))
+    i = cv.COORDS.index("pelvis_tx")
+    for spec in (gait_ocp.GaitSpec(model="MSK", cost="Eq5.33"),
+                 gait_ocp.GaitSpec(model="MSK", cost="Eq5.33", leg_scale=1.1, body_params="ch4_legs")):
+        m = gait_ocp.spec_model(spec)
+        M = np.asarray(m.mass_matrix(q, params.body_params(spec.body_params, m)))
+        assert gait_ocp.spec_mass(spec) == pytest.approx(M[i, i], rel=1e-12)
+        assert 25.0 < gait_ocp.spec_mass(spec) < 60.0  # a child of the data's size
+
+
 def test_leg_scale_slip_at_one_is_the_reference_slip_and_the_hip_rises_with_the_legs():
     spec = gait_ocp.GaitSpec(model="MSK", cost="Eq5.33", contact_params="ch4", body_params="ch4")
     tab = gait_study.leg_scale_slip(spec, scales=(1.0, 1.1))

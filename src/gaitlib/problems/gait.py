@@ -1051,6 +1051,13 @@ def spec_model(spec: GaitSpec) -> ChildModel:
     return ChildModel() if spec.leg_scale is None else ChildModel(leg_scale=float(spec.leg_scale))
 
 
+def spec_mass(spec: GaitSpec) -> float:
+    """The body mass a spec is solved with (kg): :func:`spec_model`'s segment masses with the
+    spec's body parameters (both legs)."""
+    model = spec_model(spec)
+    return model.total_mass(params_mod.body_params(spec.body_params, model))
+
+
 def build(spec: GaitSpec) -> GaitProblem:
     """Turn a :class:`GaitSpec` into an :class:`ocp.Problem` with mesh, options, guess."""
     model = spec_model(spec)

@@ -1139,7 +1139,10 @@ def stop_table(restarts: dict) -> pd.DataFrame:
     (m/s; 0 on a periodic cycle), that change over the cycle time (the mean fore-aft
     acceleration, m s⁻²), and the cycle means of the fore-aft GRF of both feet and of the
     pelvis's horizontal residual R_x (N; bounded ±1 N, Eq 4.8) — the two horizontal forces
-    whose sum, over the body's mass, is that mean acceleration — then the ball ellipsoids'
+    whose sum, over the body's mass, is that mean acceleration: the table gives that quotient
+    (m s⁻², the run's :func:`gaitlib.problems.gait.spec_mass`) beside the acceleration, a
+    check of Newton's second law for the whole body's COM (the pelvis's velocity change
+    stands in for the COM's; they differ little) — then the ball ellipsoids'
     share of that GRF and the GRF over its friction limit on the ball, μ_d(ball) × the feet's
     mean normal load (μ_d of the run's contact set, at least its friction floor; −1: both feet
     sliding forward on the balls whenever loaded)."""
@@ -1154,10 +1157,12 @@ def stop_table(restarts: dict) -> pd.DataFrame:
             g, e, tf = s.grf, s.ellipsoids, float(s.stats.get("tf_s", t[-1]))
             fx = _cycle_mean(g["grf_x_r"] + g["grf_x_l"], tf)
             mu = max(ball_friction(s.spec.contact_params)[1], s.spec.friction_floor or 0.0)
+            rx = _cycle_mean(s.residuals["R_x"], tf)
             rows[(c, k)] = {"status": s.stats["status"], "worst constraint": s.solution.worst_constraint,
                             "max violation": s.solution.max_violation, "forward speed change (m/s)": dv,
                             "mean fore-aft acceleration (m/s²)": dv / (t[-1] - t[0]),
-                            "mean fore-aft GRF (N)": fx, "mean R_x (N)": _cycle_mean(s.residuals["R_x"], tf),
+                            "mean fore-aft GRF (N)": fx, "mean R_x (N)": rx,
+                            "(GRF + R_x) / mass (m/s²)": (fx + rx) / gait_ocp.spec_mass(s.spec),
                             "ball's share of it": _cycle_mean(e["fx_ball_r"] + e["fx_ball_l"], tf) / fx if fx else np.nan,
                             "μ_d(ball)": mu, "GRF / (μ_d(ball) × normal load)": fx / (mu * _cycle_mean(g["grf_y_r"] + g["grf_y_l"], tf))}
     return pd.DataFrame.from_dict(rows, orient="index").rename_axis(["class", "start"])
@@ -1249,6 +1254,11 @@ def stop_findings(stops: pd.DataFrame, residual_bound: float = 1.0) -> list[str]
             f"(mean fore-aft acceleration {span('mean fore-aft acceleration (m/s²)', '+.4f')} m s⁻²), with the feet's "
             f"mean fore-aft GRF {span('mean fore-aft GRF (N)', '+.2f')} N and the pelvis residual's mean R_x "
             f"{span('mean R_x (N)', '+.2f')} N (bound ±{residual_bound:g} N)")
+    newton = inf["(GRF + R_x) / mass (m/s²)"].astype(float)
+    off = float((abs(newton - acc) / abs(acc)).max()) if (acc != 0).all() else np.inf
+    if off < 0.02:
+        text += (f" — their sum over the body's mass, {span(newton.name, '+.4f')} m s⁻², is that acceleration within "
+                 f"{100 * off:.1f} % (Newton's second law for the whole body, checked: no other horizontal force)")
     if (grf < 0).all() and (rx >= 0.99 * residual_bound).all():
         text += ": the feet brake on average and the residual pushes forward at its bound, short of offsetting them"
         share, lim = inf["ball's share of it"].astype(float), inf["GRF / (μ_d(ball) × normal load)"].astype(float)

@@ -1136,6 +1136,7 @@ def cot_figure(cot: pd.DataFrame, ch5_row: str | None = None,
     ax.plot(th["speed"], th["COT"], "s--", color="0.5", label="thesis, Fig 7.5 (different data)")
     for name, r in curve.iterrows():
         ax.annotate(name, (r["speed (m/s)"], r["COT (J/kg/m)"]), fontsize=7, textcoords="offset points", xytext=(4, 4))
+    ax.margins(x=0.1, y=0.1)  # room inside the axes for the class names beside the outermost points
     ax.set_xlabel("walking speed (m/s)")
     ax.set_ylabel("COT (J kg⁻¹ m⁻¹)")
     ax.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.01, 0.5))
