@@ -197,6 +197,8 @@ def test_card_clauses_on_the_stored_legs_curve():
     assert f"{len(g['ok'])} of {len(g['cot'])} runs converged and valid" in s
     for c in g["ok"]:
         assert f"{c} {g['cot'].loc[c, 'COT (J/kg/m)']:.2f}" in s
+    for k in g["restarted"]:  # a marked point's restart standing in is named
+        assert f"{k.split()[-1]} from another class's solution" in s
     assert f"minimum at {g['at']}" in s and card.CH7_LEGS_HEADING.split(" (")[0].lower().replace(" ", "-") in s
     assert f"closer in {g['closer']} of {g['n']} cells" in card._legs_clause("cells")
     # the Free run tracks its own data: its cells are not counted

@@ -8,6 +8,7 @@ import pytest
 
 from gaitlib import data
 from gaitlib.problems import gait as gait_ocp
+from gaitlib.studies import fidelity
 from gaitlib.studies import gait as sg
 from gaitlib.studies import predictive as pr
 
@@ -202,6 +203,32 @@ def test_fp_may_be_timed_by_the_data_swing_but_not_with_a_free_final_time():
     assert s.swing_load_max == b and "Ang" not in s.term_weights and "Trq" not in s.term_weights
     with pytest.raises(ValueError, match="fixed final time"):
         gait_ocp.GaitSpec(model="MSK", cost="FP", swing_load_max=b, tf_bounds=(0.8, 1.2))
+
+
+def test_own_data_probe_tracks_each_class_and_keeps_the_baseline(monkeypatch):
+    """consistent_speed_study(own_data=True): every class's run tracks its own data
+    (track_class ""), the Ch 5 start is the one of the Free-input study (track_class never
+    reaches the baseline), and the default study keeps tracking Free scaled in time."""
+    pr_mod = pr
+    seen = []
+
+    def fake_baseline(model, **kw):
+        seen.append(("baseline", kw))
+        return None
+
+    monkeypatch.setattr(pr_mod, "baseline", fake_baseline)
+    monkeypatch.setattr(pr_mod, "run_guess", lambda *a, **kw: None)
+    monkeypatch.setattr(pr_mod, "_run", lambda specs, guesses, **kw: (seen.append(("runs", specs)) or ({}, {})))
+    monkeypatch.setattr(pr_mod, "_scores", lambda *a, **kw: None)
+    monkeypatch.setattr(pr_mod.gait_ocp, "hat_reference_of", lambda base: ())
+    fidelity.consistent_speed_study(own_data=True, progress=False)
+    fidelity.consistent_speed_study(progress=False)
+    (_, b_own), (_, own), (_, b_free), (_, free) = seen
+    assert b_own == b_free and "track_class" not in b_own  # one Ch 5 start for both
+    assert {k: s.track_class for k, s in own.items()} == {f"NMSK {c}": "" for c in pr_mod.cv.SPEED_CLASSES}
+    assert {s.track_class for s in free.values()} == {"Free"}
+    for k in own:  # the one change: the tracked data
+        assert dataclasses.replace(own[k], track_class="Free") == free[k]
 
 
 def test_ch7_runs_carry_activation_params_but_their_ch5_baseline_does_not(monkeypatch):

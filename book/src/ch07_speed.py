@@ -395,9 +395,11 @@ if restarts is not None:
 # constraint block with the largest violation, how far the cycle's end forward speed is from
 # its start (the periodicity of the pelvis's velocity), and the cycle means of the two
 # horizontal forces that set it — the feet's fore-aft GRF and the pelvis residual $R_x$
-# (bounded ±1 N, Eq 4.8) — then the ball ellipsoids' share of that GRF and the GRF over its
-# friction limit on the ball, $\mu_d$(ball) × the feet's mean normal load (−1: both feet
-# sliding forward on the balls whenever loaded) (`fidelity.stop_table`).
+# (bounded ±1 N, Eq 4.8), and their sum over the body's mass beside the mean acceleration
+# (Newton's second law for the whole body: a check that no other horizontal force acts) —
+# then the ball ellipsoids' share of that GRF and the GRF over its friction limit on the
+# ball, $\mu_d$(ball) × the feet's mean normal load (−1: both feet sliding forward on the
+# balls whenever loaded) (`fidelity.stop_table`).
 
 # %%
 if restarts is not None:
@@ -435,13 +437,16 @@ if restarts is not None and res_f is not None:
 # and cycle time of each class follow the longer leg through the data's dimensionless values;
 # the Ch 5 start solved on them too) — a probe, not a body the book adopts. A run that
 # stopped at the 1000-iteration limit counts through its converged, valid 3000-iteration
-# rerun. The cells against the class data leave *Free* out (it tracks its own data).
+# rerun; a point still marked then, through its best converged, valid restart from the other
+# classes' solutions (`fidelity.marked_restarts`, labelled). The cells against the class data
+# leave *Free* out (it tracks its own data).
 
 # %%
-res_l = stored_consistent("the runs on longer legs", legs=True)
+res_l = stored_consistent("the runs on longer legs", restart=True, legs=True)
 if res_l is not None:
     cot_l, terms_l, slip_l = fidelity.curve_tables(res_l)
-    fig = pr.cot_figure(cot_l, label=f"ours: one problem, legs ×{fidelity.LEG_SCALE:g} + Ch 4 (c) on them (converged, valid)")
+    fig = pr.cot_figure(cot_l, label=f"ours: one problem, legs ×{fidelity.LEG_SCALE:g} + Ch 4 (c) on them (converged, valid"
+                        + "".join(f"; {k.split()[-1]} from another class's solution" for k in res_l.restart_used) + ")")
     display(marks.mark_table(pd.concat({"book's legs": slip_u, f"legs ×{fidelity.LEG_SCALE:g} + set": slip_l}, axis=1),
                              {c: m for c, m in cot_l["mark"].items() if m}, column=f"mark (legs ×{fidelity.LEG_SCALE:g})"),
             cot_l, terms_l)
@@ -455,14 +460,15 @@ if res_l is not None:
 # %% [markdown]
 # The same probe with every ellipsoid's friction at least `fidelity.FRICTION_FLOOR` too (the
 # change of "The feet skate" above; **our change**, labelled): longer legs, the contact
-# identified on them, and no skating ball.
+# identified on them, and no skating ball; marked points restarted as above.
 
 # %%
-res_lf = stored_consistent("the runs on longer legs with the friction floor", legs=True,
+res_lf = stored_consistent("the runs on longer legs with the friction floor", restart=True, legs=True,
                            friction_floor=fidelity.FRICTION_FLOOR)
 if res_lf is not None:
     cot_lf, terms_lf, slip_lf = fidelity.curve_tables(res_lf)
-    fig = pr.cot_figure(cot_lf, label=f"ours: legs ×{fidelity.LEG_SCALE:g} + set + friction ≥ {fidelity.FRICTION_FLOOR:g}")
+    fig = pr.cot_figure(cot_lf, label=f"ours: legs ×{fidelity.LEG_SCALE:g} + set + friction ≥ {fidelity.FRICTION_FLOOR:g}"
+                        + "".join(f"; {k.split()[-1]} from another class's solution" for k in res_lf.restart_used))
     display(marks.mark_table(slip_lf, {c: m for c, m in cot_lf["mark"].items() if m}), cot_lf, terms_lf)
     pull_lf = pr.input_pull(res_lf, gaits).drop(index="NMSK Free", level="run", errors="ignore")
     name_lf = f"legs ×{fidelity.LEG_SCALE:g}, the contact identified on them and friction ≥ {fidelity.FRICTION_FLOOR:g}"

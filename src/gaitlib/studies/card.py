@@ -1448,12 +1448,17 @@ def _legs_curve() -> dict | None:
     contact identified on them (Ch 7, :data:`CH7_LEGS_HEADING`), from the store: ``ok`` (the
     classes of converged, valid runs), ``cot``, ``terms``, ``slip``, ``at`` (the class of the
     lowest COT among ``ok``, or None), ``closer``/``n`` (:func:`gaitlib.studies.predictive.
-    closer_cells` of its non-Free runs) and ``used`` (the 3000-iteration reruns standing in);
-    None when not stored."""
+    closer_cells` of its non-Free runs), ``used`` (the 3000-iteration reruns standing in) and
+    ``restarted`` (the marked points' restarts standing in, :func:`gaitlib.studies.fidelity.
+    stored_restarts`, where stored); None when not stored."""
     try:
         _, _, res = fidelity.stored_consistent_study("the runs on longer legs", legs=True)
     except cache.NotCached:
         return None
+    try:
+        _, res = fidelity.stored_restarts(res, "the restarts of the marked points on longer legs")
+    except cache.NotCached:
+        pass  # the study as solved: its marked points stay out
     cot, terms, slip = fidelity.curve_tables(res)
     ok = [c for c in cot.index if not cot.loc[c, "mark"]]
     gaits = {c: data_mod.load_gait_data(c) for c in cv.SPEED_CLASSES}
@@ -1461,7 +1466,7 @@ def _legs_curve() -> dict | None:
     closer, n = pr.closer_cells(pull)
     at = cot.loc[ok, "COT (J/kg/m)"].astype(float).idxmin() if ok else None
     return {"ok": ok, "cot": cot, "terms": terms, "slip": slip, "at": at, "closer": closer, "n": n,
-            "used": tuple(res.rerun_used)}
+            "used": tuple(res.rerun_used), "restarted": tuple(res.restart_used)}
 
 
 def _legs_clause(what: str) -> str:
@@ -1477,6 +1482,7 @@ def _legs_clause(what: str) -> str:
         return f"{head}) no run is a converged, valid gait [{where}]"
     used = (f", {', '.join(g['used'])} through {'its 3000-iteration rerun' if len(g['used']) == 1 else 'their 3000-iteration reruns'}"
             if g["used"] else "")
+    used += "".join(f", {k.split()[-1]} from another class's solution" for k in g["restarted"])
     col = "slip, force-weighted (m/s)"
     if what == "cells":
         return f"{head}; {len(g['ok'])} of {len(g['cot'])} runs converged and valid{used}): closer in {g['closer']} of {g['n']} cells [{where}]"

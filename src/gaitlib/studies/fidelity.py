@@ -892,7 +892,7 @@ FRICTION_FLOOR = gait_study.FRICTION_FLOOR
 
 
 def consistent_speed_study(friction_floor: float | None = None, legs: bool = False,
-                           isometric_torque: str | None = None, **kw):
+                           isometric_torque: str | None = None, own_data: bool = False, **kw):
     """Thesis Ch 7's NMSK DT problem at **every** speed class, *Free* included (same cost,
     activation parameters and parameter sets at each speed; Free data scaled in time), with
     the swing foot unloaded (:func:`swing_bound`), warm-started from the swing-unloaded
@@ -902,8 +902,14 @@ def consistent_speed_study(friction_floor: float | None = None, legs: bool = Fal
     probe of :data:`LEG_SET_ROW` at every speed — thigh and shank × :data:`LEG_SCALE` with the
     contact and body set identified on them (``ch4_legs``), the Ch 5 start solved on them too.
     ``isometric_torque``: ``"bhargava"`` — the metabolic rate every run (and the Ch 5 start)
-    minimises reads Eq 5.47's F0 as Bhargava's (:attr:`GaitSpec.isometric_torque`)."""
+    minimises reads Eq 5.47's F0 as Bhargava's (:attr:`GaitSpec.isometric_torque`).
+    ``own_data``: every class tracks its **own** data (``track_class=""``, Free included) instead
+    of the Free data scaled in time — the children's gait at each speed put on the model, so
+    the curve's COT is the model's cost of that gait (a probe of the input, not a prediction;
+    the same start, cost and parameters otherwise)."""
     params = {**pr.default_params(), "swing_load_max": swing_bound()}
+    if own_data:
+        params["track_class"] = ""
     if friction_floor is not None:
         params["friction_floor"] = float(friction_floor)
     if isometric_torque is not None:

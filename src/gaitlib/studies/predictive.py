@@ -280,13 +280,14 @@ def ch6_specs(model: str, base: gait_ocp.GaitSolution, costs=CH6_COSTS, *, n_int
 
 
 def ch7_specs(model: str, base: gait_ocp.GaitSolution, classes=CH7_CLASSES, *, n_intervals: int = 20, degree: int = 5,
-              reading: str = "thesis", **kw) -> dict[str, gait_ocp.GaitSpec]:
+              reading: str = "thesis", track_class: str = "Free", **kw) -> dict[str, gait_ocp.GaitSpec]:
     """The Ch 7 problems of ``model``: DT (Eqs 7.1–7.2, Table 7.1) per speed class on the
     Free data scaled in time; HAT reference = ``base``'s HAT on normalised time; in
-    ``reading`` (:func:`reading_fields`)."""
+    ``reading`` (:func:`reading_fields`). ``track_class``: ``""`` — each class tracks its own
+    data instead (:attr:`GaitSpec.track_class`; not the thesis's Ch 7, a probe)."""
     hat = gait_ocp.hat_reference_of(base)
     extra = {"excitation_guess": "emg"} if model == "NMSK" else {}
-    return {f"{model} {c}": gait_ocp.GaitSpec(model=model, cost="DT", speed_class=c, track_class="Free",
+    return {f"{model} {c}": gait_ocp.GaitSpec(model=model, cost="DT", speed_class=c, track_class=track_class,
                                         hat_reference=hat, **_mesh(n_intervals, degree), **extra,
                                         **{**reading_fields(reading, "DT"), **kw})
             for c in classes}
@@ -544,7 +545,7 @@ def speed_study(models=("MSK", "NMSK"), classes=CH7_CLASSES, *, n_intervals: int
 
 #: ``params`` of :func:`speed_study` that set the runs only, not the Ch 5 baseline they start
 #: from (the baseline identifies its own activation parameters, Eq 5.55).
-_RUN_ONLY = ("weights", "activation_params")
+_RUN_ONLY = ("weights", "activation_params", "track_class")
 
 
 def ch5_activation_speed_study(**kw) -> StudyResult:
