@@ -417,3 +417,33 @@ def test_restart_pairs_and_floor_stop_findings(monkeypatch):
     out["Free"]["VerySlow"].stats["status"] = "Infeasible_Problem_Detected"
     assert fidelity.floor_stop_findings(stops, out, 0.2819)[0].endswith("1 of 1 stop as locally infeasible again.")
     assert fidelity.floor_stop_findings(stops, {}, 0.2819) == []
+
+
+def test_own_data_findings_by_hand():
+    """fidelity.own_data_findings: each input's minimum over its valid points, and the verdict on
+    the one change (the tracked data) — moved to Free, not moved, moved elsewhere, too few."""
+    classes = ["VerySlow", "Slow", "Free", "Fast", "VeryFast"]
+    col = "worst angle RMSE vs class data, deg ({})"
+
+    def table(cot_in, cot_own, marks_own=("",) * 5):
+        t = pd.DataFrame({"mark (Free scaled in time)": [""] * 5, "COT (Free scaled in time)": cot_in,
+                          col.format("Free scaled in time"): [6.0, 5.0, 1.0, 7.0, 9.0],
+                          "mark (own data)": list(marks_own), "COT (own data)": cot_own,
+                          col.format("own data"): [1.5, 1.2, 1.0, 1.4, 2.0]}, index=classes)
+        return t.rename_axis("class")
+
+    up = fidelity.own_data_findings(table([3.3, 5.6, 4.9, 2.5, 2.2], [5.0, 4.0, 3.0, 3.5, 4.2]))[0]
+    assert "(5 of 5 speeds valid; COT in J kg⁻¹ m⁻¹: VerySlow 5.00, Slow 4.00, Free 3.00, Fast 3.50, VeryFast 4.20)" in up
+    assert "the minimum is at **Free**; on Free's data scaled in time it is at VeryFast. The input moves the minimum" in up
+    assert "off by 1.0–2.0° in the own-data runs and 1.0–9.0° in the Free-input runs (5 classes" in up
+    same = fidelity.own_data_findings(table([3.3, 5.6, 4.9, 2.5, 2.2], [5.0, 4.0, 3.0, 3.5, 2.9]))[0]
+    assert "The input is not what moves the minimum" in same and "still lowest at VeryFast" in same
+    other = fidelity.own_data_findings(table([3.3, 5.6, 4.9, 2.5, 2.2], [5.0, 4.0, 3.0, 2.0, 2.9]))[0]
+    assert "The input moves the minimum (VeryFast → Fast) but not to the natural speed" in other
+    # a marked point is left out: VeryFast's 1.0 does not count
+    marked = fidelity.own_data_findings(table([3.3, 5.6, 4.9, 2.5, 2.2], [5.0, 4.0, 3.0, 3.5, 1.0],
+                                              ("", "", "", "", "NOT CONVERGED: x")))[0]
+    assert "(4 of 5 speeds valid" in marked and "minimum is at **Free**" in marked and "(4 classes" in marked
+    few = fidelity.own_data_findings(table([3.3, 5.6, 4.9, 2.5, 2.2], [5.0, 4.0, 3.0, 3.5, 1.0],
+                                           ("x", "x", "x", "", "")))[0]
+    assert few.startswith("**Tracking each class's own data** only 2 of 5 speeds converge")

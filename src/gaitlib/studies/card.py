@@ -1395,8 +1395,8 @@ def _ch7_consistent() -> list[Row]:
     where = _anchor("ch07_speed", "One consistent problem on valid gaits")
     cause = f"{cause} [{where}]" if cause else ""
     skate = _skating_cause(cot, res)
-    cause = "; ".join(x for x in (cause, skate, _restart_clause(res, terms), _legs_clause("cot"), _f0_clause())
-                      if x) or "unknown"
+    cause = "; ".join(x for x in (cause, skate, _restart_clause(res, terms), _legs_clause("cot"), _f0_clause(),
+                                  _own_data_clause(res)) if x) or "unknown"
     return [Row(7, item, "U, minimum at natural speed", ours, "", cause,
                 "Ch 7 NMSK DT, swing unloaded", _joint(valid), holds=at == "Free")]
 
@@ -1437,6 +1437,22 @@ def _f0_clause() -> str:
     return (f"with Bhargava's F0 in Eq 5.47 re-optimised at every speed ({len(terms)} of {len(cot)} valid"
             + "".join(f"; {c} from another class's solution" for c in stand_ins)
             + f"): {pts}, minimum at {at} [{where}]")
+
+
+#: The Ch 7 page's section of the consistent problem tracking each class's own data.
+CH7_OWN_DATA_HEADING = "Each class's own data tracked: the children's gaits on the model (a probe)"
+
+
+def _own_data_clause(res) -> str:
+    """The card's clause on the consistent problem with each class tracking its own data
+    (Ch 7, :data:`CH7_OWN_DATA_HEADING`; ``res``: the study on Free's data scaled in time):
+    :func:`gaitlib.studies.fidelity.own_data_findings`; empty when not stored."""
+    try:
+        _, _, own = fidelity.stored_consistent_study("the runs tracking each class's own data", own_data=True)
+    except cache.NotCached:
+        return ""
+    text = fidelity.own_data_findings(fidelity.own_data_table(res, own))
+    return " ".join(x.replace("**", "") for x in text) + f" [{_anchor('ch07_speed', CH7_OWN_DATA_HEADING)}]"
 
 
 #: The Ch 7 page's section of the consistent curve on longer legs (the card links to it).
