@@ -435,9 +435,13 @@ def test_own_data_findings_by_hand():
     up = fidelity.own_data_findings(table([3.3, 5.6, 4.9, 2.5, 2.2], [5.0, 4.0, 3.0, 3.5, 4.2]))[0]
     assert "(5 of 5 speeds valid; COT in J kg⁻¹ m⁻¹: VerySlow 5.00, Slow 4.00, Free 3.00, Fast 3.50, VeryFast 4.20)" in up
     assert "the minimum is at **Free**; on Free's data scaled in time it is at VeryFast. The input moves the minimum" in up
-    assert "off by 1.0–2.0° in the own-data runs and 1.0–9.0° in the Free-input runs (5 classes" in up
+    assert "off by 1.0–2.0° in the own-data runs and 1.0–9.0° in the Free-input runs (5 classes where both are valid)." in up
     same = fidelity.own_data_findings(table([3.3, 5.6, 4.9, 2.5, 2.2], [5.0, 4.0, 3.0, 3.5, 2.9]))[0]
     assert "The input is not what moves the minimum" in same and "still lowest at VeryFast" in same
+    t = table([3.3, 5.6, 4.9, 2.5, 2.2], [5.0, 4.0, 3.0, 3.5, 2.9])
+    t[col.format("own data")] += 10.0  # 11–12° off the class data: the runs do not walk as the children
+    assert "11.0–12.0° in the own-data runs" in fidelity.own_data_findings(t)[0]
+    assert "the runs do not walk as the children walk" in fidelity.own_data_findings(t)[0]
     other = fidelity.own_data_findings(table([3.3, 5.6, 4.9, 2.5, 2.2], [5.0, 4.0, 3.0, 2.0, 2.9]))[0]
     assert "The input moves the minimum (VeryFast → Fast) but not to the natural speed" in other
     # a marked point is left out: VeryFast's 1.0 does not count

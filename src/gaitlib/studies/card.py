@@ -1396,7 +1396,7 @@ def _ch7_consistent() -> list[Row]:
     cause = f"{cause} [{where}]" if cause else ""
     skate = _skating_cause(cot, res)
     cause = "; ".join(x for x in (cause, skate, _restart_clause(res, terms), _legs_clause("cot"), _f0_clause(),
-                                  _own_data_clause(res)) if x) or "unknown"
+                                  _own_data_clause()) if x) or "unknown"
     return [Row(7, item, "U, minimum at natural speed", ours, "", cause,
                 "Ch 7 NMSK DT, swing unloaded", _joint(valid), holds=at == "Free")]
 
@@ -1443,15 +1443,20 @@ def _f0_clause() -> str:
 CH7_OWN_DATA_HEADING = "Each class's own data tracked: the children's gaits on the model (a probe)"
 
 
-def _own_data_clause(res) -> str:
+def _own_data_clause() -> str:
     """The card's clause on the consistent problem with each class tracking its own data
-    (Ch 7, :data:`CH7_OWN_DATA_HEADING`; ``res``: the study on Free's data scaled in time):
-    :func:`gaitlib.studies.fidelity.own_data_findings`; empty when not stored."""
-    try:
-        _, _, own = fidelity.stored_consistent_study("the runs tracking each class's own data", own_data=True)
-    except cache.NotCached:
+    (Ch 7, :data:`CH7_OWN_DATA_HEADING`): :func:`gaitlib.studies.fidelity.own_data_findings`
+    of every stored probe of :data:`gaitlib.studies.fidelity.OWN_DATA_VARIANTS`; empty when
+    none is stored."""
+    text = []
+    for variant in fidelity.OWN_DATA_VARIANTS:
+        try:
+            base, own = fidelity.stored_own_data(variant)
+        except cache.NotCached:
+            continue
+        text += fidelity.own_data_findings(fidelity.own_data_table(base, own), variant=variant)
+    if not text:
         return ""
-    text = fidelity.own_data_findings(fidelity.own_data_table(res, own))
     return " ".join(x.replace("**", "") for x in text) + f" [{_anchor('ch07_speed', CH7_OWN_DATA_HEADING)}]"
 
 

@@ -1499,10 +1499,38 @@ def own_data_table(res_in, res_own) -> pd.DataFrame:
     return pd.DataFrame.from_dict(rows, orient="index").rename_axis("class")
 
 
-def own_data_findings(table: pd.DataFrame, min_points: int = 3) -> list[str]:
+#: The own-data probes of :func:`stored_own_data`: name → :func:`consistent_speed_study`'s
+#: options besides ``own_data`` (the thesis's contact; the friction floor; longer legs with the
+#: contact identified on them and the floor).
+OWN_DATA_VARIANTS = {
+    "": {},
+    " with the friction floor": {"friction_floor": FRICTION_FLOOR},
+    f" on legs ×{LEG_SCALE:g} with the contact identified on them and the friction floor":
+        {"legs": True, "friction_floor": FRICTION_FLOOR},
+}
+
+
+def stored_own_data(variant: str = "") -> tuple:
+    """One own-data probe of :data:`OWN_DATA_VARIANTS` from the store: ``(base, own)`` — the
+    consistent study on Free's data scaled in time with the same options (its 3000-iteration
+    reruns and, where stored, its marked points' restarts standing in, as its section above
+    shows it) and the study tracking each class's own data (its reruns standing in). Raises
+    :class:`gaitlib.cache.NotCached` when either is not stored."""
+    kw = OWN_DATA_VARIANTS[variant]
+    _, _, base = stored_consistent_study(f"the runs on Free's data scaled in time{variant}", **kw)
+    try:
+        _, base = stored_restarts(base, f"the restarts of the marked points{variant}")
+    except cache.NotCached:
+        pass  # the study as solved: its marked points stay out
+    _, _, own = stored_consistent_study(f"the runs tracking each class's own data{variant}", own_data=True, **kw)
+    return base, own
+
+
+def own_data_findings(table: pd.DataFrame, min_points: int = 3, variant: str = "") -> list[str]:
     """The sentence on :func:`own_data_table`: where each input's curve (its converged, valid
     points) has its minimum, and whether tracking each class's own data instead of Free's data
-    scaled in time moves it (one change, measured); the angle fit to the class data of both."""
+    scaled in time moves it (one change, measured); the angle fit to the class data of both.
+    ``variant``: the probe's name in :data:`OWN_DATA_VARIANTS`."""
     lows, ok = {}, {}
     for lab in ("Free scaled in time", "own data"):
         good = table[table[f"mark ({lab})"] == ""]
@@ -1510,31 +1538,31 @@ def own_data_findings(table: pd.DataFrame, min_points: int = 3) -> list[str]:
         lows[lab] = good[f"COT ({lab})"].astype(float).idxmin() if len(good) >= min_points else None
     a, b = lows["Free scaled in time"], lows["own data"]
     if b is None:
-        return [f"**Tracking each class's own data** only {len(ok['own data'])} of {len(table)} speeds converge to a "
+        return [f"**Tracking each class's own data{variant}** only {len(ok['own data'])} of {len(table)} speeds converge to a "
                 "valid gait: too few for a curve, the input's effect on the minimum is not measured."]
     pts = ", ".join(f"{c} {r['COT (own data)']:.2f}" for c, r in ok["own data"].iterrows())
-    text = (f"**Tracking each class's own data** ({len(ok['own data'])} of {len(table)} speeds valid; COT in "
+    text = (f"**Tracking each class's own data{variant}** ({len(ok['own data'])} of {len(table)} speeds valid; COT in "
             f"J kg⁻¹ m⁻¹: {pts}) the minimum is at **{b}**; on Free's data scaled in time it is at {a or '— (too few points)'}. ")
     if a is None:
         pass
     elif b == "Free" and a != "Free":
-        text += (f"The input moves the minimum: walking as the children walk at each speed, the model's cost per metre is "
-                 f"lowest at the natural speed; Free's angles scaled in time over the other classes' strides are what put "
+        text += (f"The input moves the minimum: with each class's own data as its input, the model's cost per metre is "
+                 f"lowest at the natural speed; Free's data scaled in time over the other classes' strides are what put "
                  f"the consistent curve's minimum at {a} (one change, measured).")
     elif b == a:
-        text += (f"The input is not what moves the minimum: walking as the children walk at each speed, the model's "
-                 f"cost per metre is still lowest at {b} — the metabolic model (Eqs 5.38–5.50) on these gaits puts it "
-                 "there.")
+        text += (f"The input is not what moves the minimum: with each class's own data as its input, the model's cost "
+                 f"per metre is still lowest at {b}.")
     else:
-        text += (f"The input moves the minimum ({a} → {b}) but not to the natural speed: on the children's own gaits the "
-                 f"model's cost per metre is lowest at {b}.")
+        text += (f"The input moves the minimum ({a} → {b}) but not to the natural speed: with each class's own data as "
+                 f"its input the model's cost per metre is lowest at {b}.")
     both = table[(table["mark (own data)"] == "") & (table["mark (Free scaled in time)"] == "")]
     if len(both):
         col = "worst angle RMSE vs class data, deg ({})"
         o, f = both[col.format("own data")].astype(float), both[col.format("Free scaled in time")].astype(float)
         text += (f" Against each class's data the worst joint angle is off by {o.min():.1f}–{o.max():.1f}° in the "
                  f"own-data runs and {f.min():.1f}–{f.max():.1f}° in the Free-input runs ({len(both)} classes where both "
-                 "are valid).")
+                 "are valid)" + (": at these weights the runs do not walk as the children walk — the input changes, the "
+                                 "gait stays about as far from the class data." if o.min() > 5.0 else "."))
     return [text]
 
 
