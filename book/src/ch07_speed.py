@@ -485,14 +485,12 @@ if res_lf is not None:
 # that one change: each class tracks its **own** data (`fidelity.consistent_speed_study(
 # own_data=True)`; *Free* included, the same start, cost, weights and parameter sets) — the
 # children's gait at each speed as the input instead of one gait stretched in time (our
-# probe, not a prediction; how close the runs come to that gait is in the tables). Three times:
-# with the thesis's contact, with the friction floor of "The feet skate", and on the longer
-# legs with the contact identified on them and the floor (`fidelity.OWN_DATA_VARIANTS`), each
-# beside the same problem on Free's data scaled in time (as its section above shows it). A
-# run that stops at the 1000-iteration limit counts through its converged, valid
-# 3000-iteration rerun (named). The tables set both inputs side by side per class, with each
-# run's worst joint-angle RMSE against the class's own data, then the own-data runs' COT by
-# term and how fast their loaded feet slide.
+# probe, not a prediction; how close the runs come to that gait is in the table), with the
+# thesis's contact (`fidelity.OWN_DATA_VARIANTS`), beside the same problem on Free's data
+# scaled in time (the consistent curve above). A run that stops at the 1000-iteration limit
+# counts through its converged, valid 3000-iteration rerun (named). The table sets both
+# inputs side by side per class, with each run's worst joint-angle RMSE against the class's
+# own data, then the own-data runs' COT by term and how fast their loaded feet slide.
 
 # %%
 for variant in fidelity.OWN_DATA_VARIANTS:

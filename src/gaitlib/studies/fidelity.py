@@ -1499,15 +1499,10 @@ def own_data_table(res_in, res_own) -> pd.DataFrame:
     return pd.DataFrame.from_dict(rows, orient="index").rename_axis("class")
 
 
-#: The own-data probes of :func:`stored_own_data`: name → :func:`consistent_speed_study`'s
-#: options besides ``own_data`` (the thesis's contact; the friction floor; longer legs with the
-#: contact identified on them and the floor).
-OWN_DATA_VARIANTS = {
-    "": {},
-    " with the friction floor": {"friction_floor": FRICTION_FLOOR},
-    f" on legs ×{LEG_SCALE:g} with the contact identified on them and the friction floor":
-        {"legs": True, "friction_floor": FRICTION_FLOOR},
-}
+#: The own-data probes the book shows (:func:`stored_own_data`): name (appended to "each
+#: class's own data") → :func:`consistent_speed_study`'s options besides ``own_data``, e.g.
+#: ``{"friction_floor": FRICTION_FLOOR}``; the thesis's contact only so far.
+OWN_DATA_VARIANTS = {"": {}}
 
 
 def stored_own_data(variant: str = "") -> tuple:
