@@ -451,3 +451,18 @@ def test_own_data_findings_by_hand():
     few = fidelity.own_data_findings(table([3.3, 5.6, 4.9, 2.5, 2.2], [5.0, 4.0, 3.0, 3.5, 1.0],
                                            ("x", "x", "x", "", "")))[0]
     assert few.startswith("**Tracking each class's own data** only 2 of 5 speeds converge")
+
+
+def test_hat_reference_drift_and_its_caveat():
+    """fidelity.hat_reference_drift: the largest rise of dx = pelvis_tx − stride·τ over a
+    study's HAT references (by hand); the caveat only beyond HAT_DRIFT_TOL."""
+    tau = tuple(k / 4 for k in range(4))
+    ok = SimpleNamespace(hat_reference=(tau, (0.0, 0.01, -0.01, 0.00005), (0.7,) * 4, (0.0,) * 4))
+    bad = SimpleNamespace(hat_reference=(tau, (0.0, 0.03, 0.06, 0.09), (0.7,) * 4, (0.0,) * 4))
+    none = SimpleNamespace(hat_reference=())
+    assert fidelity.hat_reference_drift(SimpleNamespace(specs={"a": ok, "b": none})) == pytest.approx(0.00005)
+    assert fidelity.hat_reference_drift(SimpleNamespace(specs={"a": ok, "b": bad})) == pytest.approx(0.09)
+    assert fidelity.hat_reference_drift(SimpleNamespace(specs={"b": none})) == 0.0
+    assert fidelity.hat_drift_caveat(0.00005, 0.00005) == []
+    text = fidelity.hat_drift_caveat(0.09, 0.00005)[0]
+    assert "rises 0.090 m over the cycle (the book's-legs runs: 0.00005 m)" in text

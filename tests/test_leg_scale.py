@@ -4,6 +4,7 @@ inertias, the data's speed and the reference's slip, checked by hand calculation
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 from dataclasses import replace
 
 import numpy as np
@@ -19,6 +20,7 @@ from gaitlib.studies import card
 from gaitlib.studies import contact_id as ci
 from gaitlib.studies import fidelity
 from gaitlib.studies import gait as gait_study
+from gaitlib.studies import msk
 
 BH = cv.BODY_HEIGHT
 IDX = {n: i for i, n in enumerate(P_BODY_NAMES)}
@@ -73,6 +75,18 @@ def test_leg_scale_spec_keeps_old_keys_validates_and_builds_its_model():
     for bad in (0.5, 1.5, "1.1", True):
         with pytest.raises(ValueError, match="leg_scale"):
             replace(spec, leg_scale=bad)
+
+
+def test_cot_breakdown_divides_by_the_stride_the_nlp_walks():
+    """The COT by term (msk.cot_breakdown) reads Eq 5.57's distance as the NLP does: the spec's
+    class data on the spec's legs (speed and cycle time × √(L1/L0), the stride × L1/L0)."""
+    spec = gait_ocp.GaitSpec(model="NMSK", cost="DT", speed_class="Fast", track_class="Free")
+    ls = replace(spec, leg_scale=1.1, body_params="ch4_legs", contact_params="ch4_legs")
+    g0, g1 = data_mod.load_gait_data("Fast"), data_mod.load_gait_data("Fast", leg_scale=1.1)
+    assert msk._stride(SimpleNamespace(spec=spec)) == pytest.approx(g0.speed * g0.cycle_time, rel=1e-12)
+    assert msk._stride(SimpleNamespace(spec=ls)) == pytest.approx(g1.speed * g1.cycle_time, rel=1e-12)
+    L0, L1 = cv.leg_length(BH), cv.leg_length(BH, 1.1)
+    assert msk._stride(SimpleNamespace(spec=ls)) / msk._stride(SimpleNamespace(spec=spec)) == pytest.approx(L1 / L0)
 
 
 def test_spec_mass_is_the_mass_matrix_translational_entry():
@@ -197,6 +211,7 @@ def test_card_clauses_on_the_stored_legs_curve():
     assert f"{len(g['ok'])} of {len(g['cot'])} runs converged and valid" in s
     for c in g["ok"]:
         assert f"{c} {g['cot'].loc[c, 'COT (J/kg/m)']:.2f}" in s
+    assert ("mis-built" in s) == (abs(g["drift"]) > fidelity.HAT_DRIFT_TOL)  # the HAT reference's caveat
     for k in g["restarted"]:  # a marked point's restart standing in is named
         assert f"{k.split()[-1]} from another class's solution" in s
     assert f"minimum at {g['at']}" in s and card.CH7_LEGS_HEADING.split(" (")[0].lower().replace(" ", "-") in s

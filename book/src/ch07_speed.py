@@ -452,7 +452,9 @@ if res_l is not None:
             cot_l, terms_l)
     pull_l = pr.input_pull(res_l, gaits).drop(index="NMSK Free", level="run", errors="ignore")
     display(pull_l)
-    display(Markdown("\n\n".join(fidelity.legs_curve_findings(slip_u, cot_u, slip_l, cot_l) + fidelity.cot_curve_findings(
+    display(Markdown("\n\n".join(fidelity.hat_drift_caveat(fidelity.hat_reference_drift(res_l),
+                                                           fidelity.hat_reference_drift(res_u))
+                                  + fidelity.legs_curve_findings(slip_u, cot_u, slip_l, cot_l) + fidelity.cot_curve_findings(
         cot_l, terms_l, name=f"The curve on legs ×{fidelity.LEG_SCALE:g} with the contact identified on them")
         + [f"**Against the class data**, on legs ×{fidelity.LEG_SCALE:g} with the contact identified on them: "
            + x.lstrip("- ") for x in pr.pin_findings(pull_l)])))
@@ -472,7 +474,9 @@ if res_lf is not None:
     display(marks.mark_table(slip_lf, {c: m for c, m in cot_lf["mark"].items() if m}), cot_lf, terms_lf)
     pull_lf = pr.input_pull(res_lf, gaits).drop(index="NMSK Free", level="run", errors="ignore")
     name_lf = f"legs ×{fidelity.LEG_SCALE:g}, the contact identified on them and friction ≥ {fidelity.FRICTION_FLOOR:g}"
-    display(Markdown("\n\n".join(fidelity.cot_curve_findings(cot_lf, terms_lf, name=f"The curve on {name_lf}")
+    display(Markdown("\n\n".join(fidelity.hat_drift_caveat(fidelity.hat_reference_drift(res_lf),
+                                                           fidelity.hat_reference_drift(res_u))
+                                  + fidelity.cot_curve_findings(cot_lf, terms_lf, name=f"The curve on {name_lf}")
                                   + [f"**Against the class data**, on {name_lf}: " + x.lstrip("- ")
                                      for x in pr.pin_findings(pull_lf)])))
 

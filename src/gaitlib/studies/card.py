@@ -1487,7 +1487,8 @@ def _legs_curve() -> dict | None:
     closer, n = pr.closer_cells(pull)
     at = cot.loc[ok, "COT (J/kg/m)"].astype(float).idxmin() if ok else None
     return {"ok": ok, "cot": cot, "terms": terms, "slip": slip, "at": at, "closer": closer, "n": n,
-            "used": tuple(res.rerun_used), "restarted": tuple(res.restart_used)}
+            "used": tuple(res.rerun_used), "restarted": tuple(res.restart_used),
+            "drift": fidelity.hat_reference_drift(res)}
 
 
 def _legs_clause(what: str) -> str:
@@ -1504,6 +1505,9 @@ def _legs_clause(what: str) -> str:
     used = (f", {', '.join(g['used'])} through {'its 3000-iteration rerun' if len(g['used']) == 1 else 'their 3000-iteration reruns'}"
             if g["used"] else "")
     used += "".join(f", {k.split()[-1]} from another class's solution" for k in g["restarted"])
+    if abs(g["drift"]) > fidelity.HAT_DRIFT_TOL:
+        used += (f"; caveat: their HAT reference is mis-built (it drifts {g['drift']:.3f} m over the cycle: "
+                 "a bug, the runs not yet solved again)")
     col = "slip, force-weighted (m/s)"
     if what == "cells":
         return f"{head}; {len(g['ok'])} of {len(g['cot'])} runs converged and valid{used}): closer in {g['closer']} of {g['n']} cells [{where}]"

@@ -940,6 +940,33 @@ def curve_tables(res) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
     return cot, cot_terms(cot, res.solutions), slip_table({s.spec.speed_class: s for s in res.solutions.values()})
 
 
+def hat_reference_drift(res) -> float:
+    """How far a consistent study's HAT reference (:attr:`GaitSpec.hat_reference`, built by
+    :func:`gaitlib.problems.gait.hat_reference_of` from its Ch 5 start) is from periodic: the
+    largest rise of its ``dx`` = pelvis_tx − stride·τ from τ = 0 to its last sample (m; ≈ 0 when
+    the stride subtracted is the one the start walked)."""
+    out = [float(sp.hat_reference[1][-1] - sp.hat_reference[1][0]) for sp in res.specs.values() if sp.hat_reference]
+    return max(out, key=abs) if out else 0.0
+
+
+#: A HAT reference drifting more than this over the cycle (m, :func:`hat_reference_drift`) is
+#: flagged: periodic references drift by rounding only (≈ 1e-4 m).
+HAT_DRIFT_TOL = 0.01
+
+
+def hat_drift_caveat(drift: float, periodic: float) -> list[str]:
+    """The caveat on a study whose HAT reference drifts (``drift``, m, :func:`hat_reference_drift`)
+    beside a study whose reference is periodic (``periodic``, m); empty within
+    :data:`HAT_DRIFT_TOL`."""
+    if abs(drift) <= HAT_DRIFT_TOL:
+        return []
+    return [f"**Caveat — a bug found, these runs not yet solved again:** the HAT reference these runs track "
+            "(`gait.hat_reference_of` of their Ch 5 start on the longer legs) subtracts the book's legs' stride from "
+            f"the start's pelvis path, not the longer legs' own: its pelvis_tx − stride·τ rises {drift:.3f} m over "
+            f"the cycle (the book's-legs runs: {periodic:.5f} m) and jumps back at its end — a sawtooth no periodic "
+            "gait can follow. Every number of these runs comes from that mis-built reference."]
+
+
 def legs_curve_findings(slip_u: pd.DataFrame, cot_u: pd.DataFrame, slip_l: pd.DataFrame,
                         cot_l: pd.DataFrame) -> list[str]:
     """The consistent curve on legs × :data:`LEG_SCALE` with the contact identified on them

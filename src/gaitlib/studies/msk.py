@@ -398,8 +398,10 @@ def _recompute_edot(sol: gait_ocp.GaitSolution, **kw) -> dict:
 
 
 def _stride(sol) -> float:
-    """The data's stride D = speed × cycle time, m (the distance of Eq 5.57 the NLP uses)."""
-    g = data_mod.load_gait_data(sol.spec.speed_class, sol.spec.source)
+    """The data's stride D = speed × cycle time, m (the distance of Eq 5.57 the NLP uses: the
+    spec's speed class's data as the spec reads it, :func:`gaitlib.problems.gait.spec_gait_data`
+    — on longer legs their speed and cycle time)."""
+    g = gait_ocp.spec_gait_data(sol.spec)[0]
     return g.speed * g.cycle_time
 
 
@@ -548,8 +550,7 @@ def mtb_scale_table(sol: gait_ocp.GaitSolution) -> pd.DataFrame:
     normalising range Ė_max − Ė_min, the factor t_f⁶/(BM² D⁴) with D the stride (our
     reading of the thesis's "d") and with d = 50 ms (the delay, the other symbol named d),
     and the resulting weighted term beside the objective."""
-    g = data_mod.load_gait_data(sol.spec.speed_class, sol.spec.source)
-    D = g.speed * g.cycle_time
+    D = _stride(sol)
     tf = float(sol.stats["tf_s"])
     ebar = float(sol.stats["mean_metabolic_rate_W"])
     de = gait_ocp.MTB_COT_N * (gait_ocp.MTB_BM_MAX - gait_ocp.MTB_BM_MIN) * D / tf
