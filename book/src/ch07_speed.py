@@ -481,7 +481,7 @@ if res_lf is not None:
                                      for x in pr.pin_findings(pull_lf)])))
 
 # %% [markdown]
-# ### Each class's own data tracked: the children's gaits on the model (a probe)
+# ### Each class's own data tracked (a probe of the input)
 #
 # Every curve above tracks Free's data scaled in time at each speed (thesis Sec 7.1): the
 # same joint angles, torques and forces over each class's cycle time and stride. Is it that

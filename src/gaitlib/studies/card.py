@@ -1440,7 +1440,7 @@ def _f0_clause() -> str:
 
 
 #: The Ch 7 page's section of the consistent problem tracking each class's own data.
-CH7_OWN_DATA_HEADING = "Each class's own data tracked: the children's gaits on the model (a probe)"
+CH7_OWN_DATA_HEADING = "Each class's own data tracked (a probe of the input)"
 
 
 def _own_data_clause() -> str:

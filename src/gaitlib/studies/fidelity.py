@@ -904,9 +904,10 @@ def consistent_speed_study(friction_floor: float | None = None, legs: bool = Fal
     ``isometric_torque``: ``"bhargava"`` — the metabolic rate every run (and the Ch 5 start)
     minimises reads Eq 5.47's F0 as Bhargava's (:attr:`GaitSpec.isometric_torque`).
     ``own_data``: every class tracks its **own** data (``track_class=""``, Free included) instead
-    of the Free data scaled in time — the children's gait at each speed put on the model, so
-    the curve's COT is the model's cost of that gait (a probe of the input, not a prediction;
-    the same start, cost and parameters otherwise)."""
+    of the Free data scaled in time — the children's gait at each speed as the input instead of
+    one gait stretched in time (a probe of the input, not a prediction; the same start, cost
+    and parameters otherwise; how close the runs come to the class data:
+    :func:`own_data_table`)."""
     params = {**pr.default_params(), "swing_load_max": swing_bound()}
     if own_data:
         params["track_class"] = ""
@@ -1511,11 +1512,12 @@ def own_data_table(res_in, res_own) -> pd.DataFrame:
         sols = {lab: r.solutions.get(f"NMSK {c}") for lab, r in cols.items()}
         if all(v is None for v in sols.values()):
             continue
-        g = data_mod.load_gait_data(c)
+        spec = next(r.specs[f"NMSK {c}"] for r in cols.values() if f"NMSK {c}" in r.specs)
+        g = gait_ocp.spec_gait_data(spec)[0]  # the class's data as the runs read it (on their legs)
         row = {"speed (m/s)": g.speed, "cycle time (s)": g.cycle_time, "stride (m)": g.speed * g.cycle_time}
         for lab, sol in sols.items():
-            rec = cols[lab].records.get(f"NMSK {c}")
-            mark = marks.failure_label(sol if sol is not None else rec) if (sol or rec) is not None else "not run"
+            run = sol if sol is not None else cols[lab].records.get(f"NMSK {c}")
+            mark = marks.failure_label(run) if run is not None else "not run"
             cot = float(sol.stats.get("COT", np.nan)) if sol is not None else np.nan
             sc = pr.score(sol, g) if sol is not None else None
             row.update({f"mark ({lab})": mark or "", f"COT ({lab})": cot,

@@ -785,7 +785,7 @@ def cot_table(ch7: StudyResult, natural=None) -> pd.DataFrame:
         items.append(("Free", f"{natural.spec.model} {natural.spec.cost}", natural))
     for row, src, s in items:
         cls = s.spec.speed_class
-        g = data_mod.load_gait_data(cls, s.spec.source)
+        g = gait_ocp.spec_gait_data(s.spec)[0]  # the speed the run walks (on longer legs, theirs)
         tc = THESIS_CLASS[cls]
         rows.append({"class": row, "speed (m/s)": g.speed, "source": src,
                      "mark": marks.failure_label(s) or "", "converged": bool(s.stats.get("success")),
