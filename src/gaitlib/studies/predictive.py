@@ -32,6 +32,7 @@ in-process) and the solution cache, so a rerun only reloads.
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
@@ -1114,7 +1115,8 @@ def cot_figure(cot: pd.DataFrame, ch5_row: str | None = None,
     curve = cot.drop(index=ch5_row, errors="ignore") if ch5_row else cot
     fig, ax = plt.subplots(figsize=(8.0, 3.6), layout="constrained")
     okc = curve[curve["mark"] == ""]
-    ax.plot(okc["speed (m/s)"], okc["COT (J/kg/m)"], "o-", color="C1", label=label)
+    wrap = lambda s: textwrap.fill(s, 52)  # noqa: E731 (a long legend entry would squeeze the axes)
+    ax.plot(okc["speed (m/s)"], okc["COT (J/kg/m)"], "o-", color="C1", label=wrap(label))
     bad = curve[curve["mark"] != ""]
     if len(bad):
         ax.plot(bad["speed (m/s)"], bad["COT (J/kg/m)"], "x", color=marks.MARK_COLOR, ms=9, mew=2,
@@ -1132,7 +1134,7 @@ def cot_figure(cot: pd.DataFrame, ch5_row: str | None = None,
                 label=marks.run_label("Ch 5 NMSK Eq 5.55 (own activation params)", r5["mark"]))
     for i, (lab, other) in enumerate((others or {}).items()):
         ok_o = other[other["mark"] == ""]
-        ax.plot(ok_o["speed (m/s)"], ok_o["COT (J/kg/m)"], "o:", color=f"C{4 + i}", mfc="none", label=lab)
+        ax.plot(ok_o["speed (m/s)"], ok_o["COT (J/kg/m)"], "o:", color=f"C{4 + i}", mfc="none", label=wrap(lab))
     th = pd.DataFrame(THESIS_COT_FIG_7_5, columns=["class", "speed", "COT"])
     ax.plot(th["speed"], th["COT"], "s--", color="0.5", label="thesis, Fig 7.5 (different data)")
     for name, r in curve.iterrows():
