@@ -754,7 +754,7 @@ def hat_reference_of(sol: "GaitSolution", n: int = 100) -> tuple:
 
     X = sol.solution.phase("cycle").states
     tf = float(sol.stats["tf_s"])
-    g = data_mod.load_gait_data(sol.spec.speed_class, sol.spec.source)
+    g = spec_gait_data(sol.spec)[0]  # the class's data on the spec's legs (its stride)
     stride = g.speed * g.cycle_time  # the periodic pelvis offset (build)
     t = X.index.to_numpy(dtype=float)
     x0 = X.iloc[0]

@@ -1506,8 +1506,8 @@ def _legs_clause(what: str) -> str:
             if g["used"] else "")
     used += "".join(f", {k.split()[-1]} from another class's solution" for k in g["restarted"])
     if abs(g["drift"]) > fidelity.HAT_DRIFT_TOL:
-        used += (f"; caveat: their HAT reference is mis-built (it drifts {g['drift']:.3f} m over the cycle: "
-                 "a bug, the runs not yet solved again)")
+        used += (f"; caveat: their HAT reference is not periodic (it drifts {g['drift']:.3f} m over the cycle, "
+                 "a sawtooth no periodic gait can follow)")
     col = "slip, force-weighted (m/s)"
     if what == "cells":
         return f"{head}; {len(g['ok'])} of {len(g['cot'])} runs converged and valid{used}): closer in {g['closer']} of {g['n']} cells [{where}]"

