@@ -66,6 +66,18 @@ def test_time_scaled_guess_is_a_consistent_trajectory(base):
     np.testing.assert_allclose(x - x.iloc[0], (src["pelvis_tx"] - src["pelvis_tx"].iloc[0]) * stride / s0)
 
 
+def test_guess_of_a_longer_legs_start_rescales_from_the_stride_it_walked(base):
+    """A start solved on legs × 1.1 walks the longer legs' stride (speed and cycle time follow
+    √(L1/L0), data.load_gait_data(leg_scale=)): rescaled to that same stride its pelvis path is
+    unchanged (ratio 1), not stretched by the ratio to the book's legs' stride (≈ 1.1)."""
+    legs = dataclasses.replace(base, spec=dataclasses.replace(base.spec, leg_scale=1.1))
+    g = data.load_gait_data(base.spec.speed_class, leg_scale=1.1)
+    src = base.solution.phase("cycle").states
+    ph = pr.run_guess(legs, "ch5", stride=g.speed * g.cycle_time).phase("cycle")
+    np.testing.assert_allclose(ph.states["pelvis_tx"], src["pelvis_tx"], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(ph.states["qd_pelvis_tx"], src["qd_pelvis_tx"], rtol=0, atol=1e-12)
+
+
 def test_full_guess_scales_every_state_and_control_consistently(base):
     """run_guess(…, "ch5"): all of the Ch 5 solution; in scaled time t' = k t the jerks are
     ÷ k³ (the horizontal pelvis jerk also × stride ratio), torques and activations unchanged."""
