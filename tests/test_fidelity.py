@@ -219,6 +219,28 @@ def test_cot_curve_findings_locate_the_minimum_and_the_term_that_moves_it():
     terms.loc["Free", "shortening"] = 0.5  # now Free is lowest
     terms["total"] = terms[["activation", "maintenance", "shortening", "basal", "work"]].sum(axis=1)
     assert "the natural speed, as the thesis" in " ".join(fidelity.cot_curve_findings(cot, terms))
+    assert fidelity.minimum_phrase(cot, "Free") == "minimum at Free"
+
+
+def test_a_lowest_point_at_the_end_of_the_valid_speeds_is_not_a_located_minimum():
+    """Valid VerySlow, Slow, Free falling to Free, Fast and VeryFast marked: Free is only the
+    lowest valid point — the curve is still falling where it stops, so no minimum is claimed
+    (nor "the natural speed"); a lowest VeryFast ends the classes measured: a minimum there."""
+    import pandas as pd
+    bad = "NOT CONVERGED: Maximum_Iterations_Exceeded"
+    cot = pd.DataFrame({"mark": ["", "", "", bad, bad], "speed (m/s)": [0.5, 0.9, 1.2, 1.5, 1.8]},
+                       index=["VerySlow", "Slow", "Free", "Fast", "VeryFast"])
+    terms = pd.DataFrame({"speed (m/s)": [0.5, 0.9, 1.2], "total": [6.6, 6.7, 5.6]}, index=["VerySlow", "Slow", "Free"])
+    assert fidelity.unlocated_beyond(cot, "Free") == ["Fast", "VeryFast"]
+    text = " ".join(fidelity.cot_curve_findings(cot, terms))
+    assert "is lowest at **Free**, its fastest valid speed: Fast, VeryFast are left out" in text
+    assert "minimum at" not in text and "as the thesis" not in text
+    assert fidelity.minimum_phrase(cot, "Free") == ("lowest at Free, its fastest valid speed (Fast, VeryFast marked: "
+                                                    "the minimum not located)")
+    rev = cot.assign(mark=["", bad, "", "", ""])  # Slow marked: VerySlow and Free bracket it, nothing beyond
+    assert fidelity.unlocated_beyond(rev, "VeryFast") == [] and fidelity.unlocated_beyond(rev, "Free") == []
+    low = cot.assign(mark=[bad, "", "", "", ""])  # the slowest valid point lowest, VerySlow marked
+    assert fidelity.minimum_phrase(low, "Slow").startswith("lowest at Slow, its slowest valid speed (VerySlow marked")
 
 
 def test_metatarsal_findings_read_the_knees_from_the_ablation_and_the_floor():

@@ -238,7 +238,7 @@ def test_card_clauses_on_the_stored_legs_curve():
     assert ("not periodic" in s) == (abs(g["drift"]) > fidelity.HAT_DRIFT_TOL)  # the HAT reference's caveat
     for k in g["restarted"]:  # a marked point's restart standing in is named
         assert f"{k.split()[-1]} from another class's solution" in s
-    assert f"minimum at {g['at']}" in s and card.CH7_LEGS_HEADING.split(" (")[0].lower().replace(" ", "-") in s
+    assert fidelity.minimum_phrase(g["cot"], g["at"]) in s and card.CH7_LEGS_HEADING.split(" (")[0].lower().replace(" ", "-") in s
     assert f"closer in {g['closer']} of {g['n']} cells" in card._legs_clause("cells")
     # the Free run tracks its own data: its cells are not counted
     assert g["n"] == 3 * len([c for c in g["ok"] if c != "Free"])

@@ -1436,7 +1436,7 @@ def _f0_clause() -> str:
     pts = ", ".join(f"{c} {v:.2f}" for c, v in terms["total"].items())
     return (f"with Bhargava's F0 in Eq 5.47 re-optimised at every speed ({len(terms)} of {len(cot)} valid"
             + "".join(f"; {c} from another class's solution" for c in stand_ins)
-            + f"): {pts}, minimum at {at} [{where}]")
+            + f"): {pts}, {fidelity.minimum_phrase(cot, at)} [{where}]")
 
 
 #: The Ch 7 page's section of the consistent problem tracking each class's own data.
@@ -1514,7 +1514,7 @@ def _legs_clause(what: str) -> str:
     cot = g["cot"]
     return (f"{head}; {len(g['ok'])} of {len(cot)} runs converged and valid{used}, feet sliding "
             f"{g['slip'].loc[g['ok'], col].min():.2f}–{g['slip'].loc[g['ok'], col].max():.2f} m/s): "
-            + ", ".join(f"{c} {cot.loc[c, 'COT (J/kg/m)']:.2f}" for c in g["ok"]) + f", minimum at {g['at']} [{where}]")
+            + ", ".join(f"{c} {cot.loc[c, 'COT (J/kg/m)']:.2f}" for c in g["ok"]) + f", {fidelity.minimum_phrase(cot, g['at'])} [{where}]")
 
 
 def _skating_cause(cot: pd.DataFrame, res) -> str:
@@ -1546,7 +1546,7 @@ def _skating_cause(cot: pd.DataFrame, res) -> str:
     used += "".join(f"; {k} from another class's solution" for k in res_f.restart_used)
     return (text + f"; with every ellipsoid's friction ≥ {fidelity.FRICTION_FLOOR:g} ({len(ok)} of {len(cot_f)} runs "
             f"converged and valid{used}, slip {slip_f.loc[ok, col].min():.2f}–{slip_f.loc[ok, col].max():.2f} m/s): "
-            + ", ".join(f"{c} {cot_f.loc[c, 'COT (J/kg/m)']:.2f}" for c in ok) + f", minimum at {at} [{where}]")
+            + ", ".join(f"{c} {cot_f.loc[c, 'COT (J/kg/m)']:.2f}" for c in ok) + f", {fidelity.minimum_phrase(cot_f, at)} [{where}]")
 
 
 # ======================================================================================

@@ -1465,6 +1465,32 @@ def skating_findings(cot: pd.DataFrame, slip: pd.DataFrame, cot_f: pd.DataFrame,
     return out
 
 
+def unlocated_beyond(cot: pd.DataFrame, at: str) -> list[str]:
+    """The classes of a COT curve (``cot``: :func:`gaitlib.studies.predictive.cot_table`, rows
+    by class, ``mark`` empty on valid points) beyond its lowest valid point ``at`` when ``at``
+    is the fastest (or the slowest) valid point and marked classes lie beyond it: the curve
+    is still falling there, so its minimum is not located. Empty when ``at`` is bracketed by
+    valid points or is the end of the classes measured."""
+    order = [c for c in cv.SPEED_CLASSES if c in cot.index]
+    ok = [c for c in order if not cot.loc[c, "mark"]]
+    i = order.index(at)
+    if at == ok[-1] and order[i + 1:]:
+        return order[i + 1:]
+    if at == ok[0] and order[:i]:
+        return order[:i]
+    return []
+
+
+def minimum_phrase(cot: pd.DataFrame, at: str) -> str:
+    """``"minimum at <at>"``, or — when marked classes lie beyond the curve's lowest valid
+    point (:func:`unlocated_beyond`) — that it is only the lowest point, not a located minimum."""
+    beyond = unlocated_beyond(cot, at)
+    if not beyond:
+        return f"minimum at {at}"
+    end = "fastest" if cv.SPEED_CLASSES.index(beyond[0]) > cv.SPEED_CLASSES.index(at) else "slowest"
+    return f"lowest at {at}, its {end} valid speed ({', '.join(beyond)} marked: the minimum not located)"
+
+
 def cot_curve_findings(cot: pd.DataFrame, terms: pd.DataFrame, min_points: int = 3,
                        name: str = "The consistent curve") -> list[str]:
     """Where the curve (``name``, e.g. the consistent one) has its minimum, and — if not at
@@ -1479,9 +1505,16 @@ def cot_curve_findings(cot: pd.DataFrame, terms: pd.DataFrame, min_points: int =
         return out
     at = terms["total"].astype(float).idxmin()
     pts = ", ".join(f"{c} {r['total']:.2f} at {r['speed (m/s)']:.2f} m/s" for c, r in terms.iterrows())
-    head = (f"**{name}** ({len(terms)} of {len(cot)} speeds valid; COT in J kg⁻¹ m⁻¹: {pts}) has its "
-            f"minimum at **{at}**" + (" — the natural speed, as the thesis and walking physiology say." if at == "Free"
-                                       else ", not at the natural speed."))
+    beyond = unlocated_beyond(cot, at)
+    if beyond:
+        end = "fastest" if cv.SPEED_CLASSES.index(beyond[0]) > cv.SPEED_CLASSES.index(at) else "slowest"
+        head = (f"**{name}** ({len(terms)} of {len(cot)} speeds valid; COT in J kg⁻¹ m⁻¹: {pts}) is lowest at "
+                f"**{at}**, its {end} valid speed: {', '.join(beyond)} {'is' if len(beyond) == 1 else 'are'} left out "
+                "(marked), so the curve's minimum is not located — whether it lies at the natural speed is not measured.")
+    else:
+        head = (f"**{name}** ({len(terms)} of {len(cot)} speeds valid; COT in J kg⁻¹ m⁻¹: {pts}) has its "
+                f"minimum at **{at}**" + (" — the natural speed, as the thesis and walking physiology say." if at == "Free"
+                                           else ", not at the natural speed."))
     out.insert(0, head)
     if at != "Free" and "Free" in terms.index:
         names = [t for t in ("activation", "maintenance", "shortening", "basal", "work") if t in terms.columns]
