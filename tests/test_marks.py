@@ -82,6 +82,14 @@ def no_gates():
     marks.use_validity_check(before)
 
 
+def test_mark_kinds_drop_the_reasons_of_an_invalid_run_with_several():
+    """An invalid run's reasons are joined by "; " like the kinds: only the kinds come back."""
+    label = ("NOT CONVERGED: Maximum_Iterations_Exceeded; INVALID: torque 87.1 N·m > 82.9 N·m (ankle_r peak); "
+             "angle 40.9 deg > 40 deg (ankle_r, thesis Table 3.5); GRF 42 N > 20 N (swing)")
+    assert marks.mark_kinds(label) == ["NOT CONVERGED", "INVALID"]
+    assert marks.mark_kinds("INVALID") == ["INVALID"] and marks.mark_kinds(None) == [] and marks.mark_kinds("") == []
+
+
 def test_a_validity_check_reaches_every_label():
     before = marks._validity_check
     try:

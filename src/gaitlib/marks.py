@@ -133,6 +133,13 @@ def failure_label(obj, valid=None) -> str | None:
     return "; ".join(reasons) or None
 
 
+def mark_kinds(label: str | None) -> list[str]:
+    """The kinds of a :func:`failure_label` in order (``"NOT CONVERGED"``, ``"INVALID"``), without
+    their reasons — an invalid run's reasons are themselves joined by ``"; "``."""
+    parts = [p.split(":")[0].strip() for p in (label or "").split(";")]
+    return list(dict.fromkeys(p for p in parts if p in ("NOT CONVERGED", "INVALID")))
+
+
 def run_label(name: str, label: str | None) -> str:
     """A run's name as shown in legends and tables: ``"NMSK SDT3 † NOT CONVERGED: …"``."""
     return f"{name} {DAGGER} {label}" if label else str(name)

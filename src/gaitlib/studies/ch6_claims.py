@@ -77,7 +77,7 @@ def _short(mark: str | None) -> str:
     """``"NOT CONVERGED: …; INVALID: …"`` → ``"not converged, invalid"``."""
     if not mark:
         return "no result"
-    return ", ".join(p.split(":")[0].strip().lower() for p in mark.split("; "))
+    return ", ".join(k.lower() for k in marks.mark_kinds(mark))
 
 
 def _by(pct: float, down: str, up: str) -> str:

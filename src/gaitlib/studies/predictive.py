@@ -1126,7 +1126,7 @@ def cot_figure(cot: pd.DataFrame, ch5_row: str | None = None,
         for name, r in bad.iterrows():
             # the kind of each mark (its first words; the table beside has the whole mark), kept out of the
             # layout: a long mark pushed left of the axes collapses a constrained layout
-            kinds = " + ".join(dict.fromkeys(m.split(":")[0].strip() for m in r["mark"].split(";")))
+            kinds = " + ".join(marks.mark_kinds(r["mark"]))
             ax.annotate(f"{marks.DAGGER} {kinds}", (r["speed (m/s)"], r["COT (J/kg/m)"]), fontsize=6,
                         color=marks.MARK_COLOR, textcoords="offset points", xytext=(-4, -12),
                         ha="right").set_in_layout(False)
