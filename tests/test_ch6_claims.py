@@ -77,6 +77,9 @@ def test_an_unusable_run_makes_its_claims_untested():
     t = cc.table_conclusions(_table(acc, exc), times, excluded={"NMSK SP3": mark})
     r = _row(t, "SP3: MSK more accurate")
     assert r["verdict"] == "not tested" and "NMSK SP3 (not converged, invalid)" in r["ours"]
+    # the card hands over the validity gates' own label: named the same, never "()"
+    t2 = cc.table_conclusions(_table(acc, exc), times, excluded={"NMSK SP3": "invalid: double support 96% > 40%"})
+    assert "NMSK SP3 (invalid)" in _row(t2, "SP3: MSK more accurate")["ours"]
     # every claim needing all NMSK runs is untested; the Ch 5 claim is absent without the Ch 5 run
     assert _row(t, "NMSK SDT3 predicts the most")["verdict"] == "not tested"
     assert not t["claim"].str.contains("Ch 5").any()

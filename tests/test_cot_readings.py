@@ -293,6 +293,7 @@ def test_marked_restarts_stand_in_only_for_marked_points(monkeypatch):
         solutions: dict
         rerun_used: tuple = ()
         restart_used: tuple = ()
+        restart_from: dict = dataclasses.field(default_factory=dict)
 
         @property
         def records(self):
@@ -326,6 +327,7 @@ def test_marked_restarts_stand_in_only_for_marked_points(monkeypatch):
     used = fidelity.with_restarts(res, restarts)
     assert got == [{"NMSK Slow": r_free}] and used.solutions["NMSK Slow"] is r_free
     assert used.restart_used == ("NMSK Slow",) and used.rerun_used == ()  # not a 3000-iteration rerun
+    assert used.restart_from == {"NMSK Slow": "Free"} and fidelity.stand_in_labels(used) == ["Slow from Free's solution"]
     out = fidelity.stand_in_findings(res, used, restarts)
     assert out[0] == ("**Slow** (its own run NOT CONVERGED: Maximum_Iterations_Exceeded): 1 of 2 starts from the other "
                       "classes' solutions converge to a valid gait; the lowest objective, from Free's solution (COT "
@@ -333,6 +335,41 @@ def test_marked_restarts_stand_in_only_for_marked_points(monkeypatch):
     assert out[1].startswith("**Fast** (its own run INVALID: x): none of its 1 starts")
     assert fidelity.with_restarts(res, {}) is res and fidelity.stand_in_findings(res, res, {}) == []
     assert fidelity.marked_restarts(Study({"NMSK Free": Sol("free")})) == {}
+
+
+def test_restart_runs_never_start_a_run_from_itself_but_from_another_problems_same_class(monkeypatch):
+    """fidelity.restart_runs: a class's run is never started from its own solution, but is from
+    the same class's solution of another problem; marked_restarts(also=…) adds the other
+    study's valid solutions as starts, named with its label, the problem solved still ``res``'s."""
+    spec = SimpleNamespace(leg_scale=None, source="x")
+    gd = SimpleNamespace(cycle_time=1.0, speed=1.2)
+    monkeypatch.setattr(fidelity.data_mod, "load_gait_data", lambda c, src, **kw: gd)
+    monkeypatch.setattr(fidelity.pr, "run_guess", lambda s, kind, **kw: ("guess", s, kw["stride"]))
+    mine = {"NMSK Slow": "slow", "NMSK Free": "free"}
+    res = SimpleNamespace(specs={k: spec for k in mine}, solutions=mine)
+    specs, guesses = fidelity.restart_runs(res)
+    assert sorted(specs) == ["NMSK Free from Slow", "NMSK Slow from Free"]
+    assert guesses["NMSK Slow from Free"] == ("guess", "free", 1.2)
+    specs, guesses = fidelity.restart_runs(res, ["Slow"], starts={"Slow": "slow'", "Free": "free'"})
+    assert sorted(specs) == ["NMSK Slow from Free", "NMSK Slow from Slow"] and specs["NMSK Slow from Slow"] is spec
+    assert guesses["NMSK Slow from Slow"][1] == "slow'"
+    assert list(fidelity.restart_runs(res, ["Slow"], starts={"Slow": "slow"})[0]) == []  # its own solution
+
+    calls = []
+
+    def fake(r, classes=None, *, starts=None, label="", **kw):
+        calls.append((r, classes, starts, label))
+        return {c: {fidelity.OWN_START: "own", **{k + label: f"{c}<-{k}{label}" for k in starts}} for c in classes}
+
+    monkeypatch.setattr(fidelity, "curve_restarts", fake)
+    monkeypatch.setattr(fidelity, "_marked_classes", lambda r: ["Slow"] if r is res else [])
+    other = SimpleNamespace(solutions={"NMSK Slow": "o-slow", "NMSK Fast": "o-fast"})
+    out = fidelity.marked_restarts(res, also={"floor": other})
+    assert [c[1:] for c in calls] == [(["Slow"], {"Free": "free"}, ""),
+                                      (["Slow"], {"Slow": "o-slow", "Fast": "o-fast"}, " (floor)")]
+    assert all(c[0] is res for c in calls)  # the problem solved is res's
+    assert out == {"Slow": {fidelity.OWN_START: "own", "Free": "Slow<-Free", "Slow (floor)": "Slow<-Slow (floor)",
+                            "Fast (floor)": "Slow<-Fast (floor)"}}
 
 
 def test_stop_table_and_findings_by_hand(monkeypatch):
@@ -434,7 +471,8 @@ def test_own_data_findings_by_hand():
 
     up = fidelity.own_data_findings(table([3.3, 5.6, 4.9, 2.5, 2.2], [5.0, 4.0, 3.0, 3.5, 4.2]))[0]
     assert "(5 of 5 speeds valid; COT in J kg⁻¹ m⁻¹: VerySlow 5.00, Slow 4.00, Free 3.00, Fast 3.50, VeryFast 4.20)" in up
-    assert "the minimum is at **Free**; on Free's data scaled in time it is at VeryFast. The input moves the minimum" in up
+    assert ("the curve: **minimum at Free**; on Free's data scaled in time: minimum at VeryFast. The input moves the "
+            "minimum") in up
     assert "off by 1.0–2.0° in the own-data runs and 1.0–9.0° in the Free-input runs (5 classes where both are valid)." in up
     same = fidelity.own_data_findings(table([3.3, 5.6, 4.9, 2.5, 2.2], [5.0, 4.0, 3.0, 3.5, 2.9]))[0]
     assert "The input is not what moves the minimum" in same and "still lowest at VeryFast" in same
@@ -447,7 +485,12 @@ def test_own_data_findings_by_hand():
     # a marked point is left out: VeryFast's 1.0 does not count
     marked = fidelity.own_data_findings(table([3.3, 5.6, 4.9, 2.5, 2.2], [5.0, 4.0, 3.0, 3.5, 1.0],
                                               ("", "", "", "", "NOT CONVERGED: x")))[0]
-    assert "(4 of 5 speeds valid" in marked and "minimum is at **Free**" in marked and "(4 classes" in marked
+    assert "(4 of 5 speeds valid" in marked and "**minimum at Free**" in marked and "(4 classes" in marked
+    # lowest at the end of the valid speeds with marked classes beyond: not a located minimum, no verdict
+    end = fidelity.own_data_findings(table([3.3, 5.6, 4.9, 2.5, 2.2], [5.0, 4.0, 3.0, 3.5, 1.0],
+                                           ("", "", "", "x", "x")))[0]
+    assert ("**lowest at Free, its fastest valid speed (Fast, VeryFast marked: the minimum not located)**" in end
+            and "Whether the input moves the minimum is not measured" in end and "The input" not in end)
     few = fidelity.own_data_findings(table([3.3, 5.6, 4.9, 2.5, 2.2], [5.0, 4.0, 3.0, 3.5, 1.0],
                                            ("x", "x", "x", "", "")))[0]
     assert few.startswith("**Tracking each class's own data** only 2 of 5 speeds converge")

@@ -88,6 +88,11 @@ def test_mark_kinds_drop_the_reasons_of_an_invalid_run_with_several():
              "angle 40.9 deg > 40 deg (ankle_r, thesis Table 3.5); GRF 42 N > 20 N (swing)")
     assert marks.mark_kinds(label) == ["NOT CONVERGED", "INVALID"]
     assert marks.mark_kinds("INVALID") == ["INVALID"] and marks.mark_kinds(None) == [] and marks.mark_kinds("") == []
+    # the validity gates' own label (the card's valid column) reads the same
+    assert marks.mark_kinds("not converged (Maximum_Iterations_Exceeded); invalid: double support 90% > 40%; "
+                            "swing load 55 N > 8 N") == ["NOT CONVERGED", "INVALID"]
+    assert marks.mark_kinds("invalid: double support 96% > 40% (of the cycle)") == ["INVALID"]
+    assert marks.mark_kinds("valid") == []
 
 
 def test_a_validity_check_reaches_every_label():

@@ -255,10 +255,10 @@ display(Markdown("\n\n".join(fidelity.cot_curve_findings(cot_u, terms_u))))
 # %%
 slip_u = fidelity.slip_table({s.spec.speed_class: s for s in res_u.solutions.values()})
 ref_u = {s.spec.speed_class: gait.reference_slip(s.spec) for s in res_u.solutions.values()}
-def stored_consistent(what, restart=False, **kw):
+def stored_consistent(what, restart=False, also=None, **kw):
     """The consistent study with ``kw`` from the store, its reruns shown; with ``restart``, a
     point still marked then stood in for by its best restart from the other classes'
-    solutions (shown). None if not stored."""
+    solutions (and ``also``'s: `fidelity.marked_restarts`; shown). None if not stored."""
     try:
         res0, inv, res = fidelity.stored_consistent_study(what, **kw)
     except cache.NotCached as e:
@@ -271,7 +271,7 @@ def stored_consistent(what, restart=False, **kw):
     if not restart:
         return res
     try:
-        restarts, used = fidelity.stored_restarts(res, f"the restarts of the marked points ({what})")
+        restarts, used = fidelity.stored_restarts(res, f"the restarts of the marked points ({what})", also=also)
     except cache.NotCached as e:
         print(f"Not stored yet: {e}")
         return res
@@ -285,7 +285,7 @@ res_f = stored_consistent("the runs with the friction floor", restart=True, fric
 if res_f is not None:
     cot_f, terms_f, slip_f = fidelity.curve_tables(res_f)
     fig = pr.cot_figure(cot_f, label=f"ours: one problem, friction ≥ {fidelity.FRICTION_FLOOR:g} (converged, valid"
-                        + "".join(f"; {k.split()[-1]} from another class's solution" for k in res_f.restart_used) + ")")
+                        + "".join(f"; {x}" for x in fidelity.stand_in_labels(res_f)) + ")")
     display(marks.mark_table(pd.concat({"as identified": slip_u, f"friction ≥ {fidelity.FRICTION_FLOOR:g}": slip_f},
                                        axis=1),
                              {c: m for c, m in cot_f["mark"].items() if m},
@@ -356,7 +356,7 @@ res_b = stored_consistent("the runs with Bhargava's F0", restart=True, isometric
 if res_b is not None:
     cot_b, terms_b, _ = fidelity.curve_tables(res_b)
     fig = pr.cot_figure(cot_b, label="ours: one problem, Bhargava's F0 (converged, valid"
-                        + "".join(f"; {k.split()[-1]} from another class's solution" for k in res_b.restart_used) + ")")
+                        + "".join(f"; {x}" for x in fidelity.stand_in_labels(res_b)) + ")")
     display(cot_b, terms_b)
     display(Markdown("\n\n".join(fidelity.cot_curve_findings(cot_b, terms_b, name="The curve with Bhargava's F0"))))
 
@@ -438,15 +438,19 @@ if restarts is not None and res_f is not None:
 # the Ch 5 start solved on them too) — a probe, not a body the book adopts. A run that
 # stopped at the 1000-iteration limit counts through its converged, valid 3000-iteration
 # rerun; a point still marked then, through its best converged, valid restart from the other
-# classes' solutions (`fidelity.marked_restarts`, labelled). The cells against the class data
-# leave *Free* out (it tracks its own data).
+# classes' solutions — and from the valid solutions of the same probe with the friction floor
+# below, the same class's included (same legs and contact: another problem's optimum as a
+# start, the problem solved still this one; `fidelity.marked_restarts(also=…)`, labelled
+# "(legs + floor)"). The cells against the class data leave *Free* out (it tracks its own
+# data).
 
 # %%
-res_l = stored_consistent("the runs on longer legs", restart=True, legs=True)
+res_l = stored_consistent("the runs on longer legs", restart=True, also=fidelity.legs_partner("legs"),
+                          **fidelity.LEGS_PROBES["legs"])
 if res_l is not None:
     cot_l, terms_l, slip_l = fidelity.curve_tables(res_l)
     fig = pr.cot_figure(cot_l, label=f"ours: one problem, legs ×{fidelity.LEG_SCALE:g} + Ch 4 (c) on them (converged, valid"
-                        + "".join(f"; {k.split()[-1]} from another class's solution" for k in res_l.restart_used) + ")")
+                        + "".join(f"; {x}" for x in fidelity.stand_in_labels(res_l)) + ")")
     display(marks.mark_table(pd.concat({"book's legs": slip_u, f"legs ×{fidelity.LEG_SCALE:g} + set": slip_l}, axis=1),
                              {c: m for c, m in cot_l["mark"].items() if m}, column=f"mark (legs ×{fidelity.LEG_SCALE:g})"),
             cot_l, terms_l)
@@ -462,15 +466,16 @@ if res_l is not None:
 # %% [markdown]
 # The same probe with every ellipsoid's friction at least `fidelity.FRICTION_FLOOR` too (the
 # change of "The feet skate" above; **our change**, labelled): longer legs, the contact
-# identified on them, and no skating ball; marked points restarted as above.
+# identified on them, and no skating ball; marked points restarted as above, from this
+# probe's valid solutions and from those of the probe above (labelled "(legs)").
 
 # %%
-res_lf = stored_consistent("the runs on longer legs with the friction floor", restart=True, legs=True,
-                           friction_floor=fidelity.FRICTION_FLOOR)
+res_lf = stored_consistent("the runs on longer legs with the friction floor", restart=True,
+                           also=fidelity.legs_partner("legs + floor"), **fidelity.LEGS_PROBES["legs + floor"])
 if res_lf is not None:
     cot_lf, terms_lf, slip_lf = fidelity.curve_tables(res_lf)
     fig = pr.cot_figure(cot_lf, label=f"ours: legs ×{fidelity.LEG_SCALE:g} + set + friction ≥ {fidelity.FRICTION_FLOOR:g}"
-                        + "".join(f"; {k.split()[-1]} from another class's solution" for k in res_lf.restart_used))
+                        + "".join(f"; {x}" for x in fidelity.stand_in_labels(res_lf)))
     display(marks.mark_table(slip_lf, {c: m for c, m in cot_lf["mark"].items() if m}), cot_lf, terms_lf)
     pull_lf = pr.input_pull(res_lf, gaits).drop(index="NMSK Free", level="run", errors="ignore")
     name_lf = f"legs ×{fidelity.LEG_SCALE:g}, the contact identified on them and friction ≥ {fidelity.FRICTION_FLOOR:g}"
@@ -508,7 +513,7 @@ for variant in fidelity.OWN_DATA_VARIANTS:
                         others={f"ours: Free's data scaled in time{variant}": pr.cot_table(base_v)})
     stand = [f"{k} (own data): its 3000-iteration rerun" for k in own_v.rerun_used]
     stand += [f"{k} (Free scaled in time): its 3000-iteration rerun" for k in base_v.rerun_used]
-    stand += [f"{k} (Free scaled in time): a restart from another class's solution" for k in base_v.restart_used]
+    stand += [f"{x} (Free scaled in time)" for x in fidelity.stand_in_labels(base_v)]
     print(f"own data{variant} — standing in: " + ("; ".join(stand) or "none"))
     own_t = fidelity.own_data_table(base_v, own_v)
     display(own_t, terms_o, slip_o)

@@ -135,8 +135,9 @@ def failure_label(obj, valid=None) -> str | None:
 
 def mark_kinds(label: str | None) -> list[str]:
     """The kinds of a :func:`failure_label` in order (``"NOT CONVERGED"``, ``"INVALID"``), without
-    their reasons — an invalid run's reasons are themselves joined by ``"; "``."""
-    parts = [p.split(":")[0].strip() for p in (label or "").split(";")]
+    their reasons — an invalid run's reasons are themselves joined by ``"; "``. A
+    :func:`gaitlib.validity.label` (``"not converged (…)"``, ``"invalid: …"``) reads the same."""
+    parts = [p.split(":")[0].split("(")[0].strip().upper() for p in (label or "").split(";")]
     return list(dict.fromkeys(p for p in parts if p in ("NOT CONVERGED", "INVALID")))
 
 

@@ -1427,7 +1427,6 @@ def _f0_clause() -> str:
         _, used = fidelity.stored_restarts(res, "the restarts of the marked points with Bhargava's F0")
     except cache.NotCached:
         used = res
-    stand_ins = [k.split()[-1] for k in used.restart_used]
     cot, terms, _ = fidelity.curve_tables(used)
     where = _anchor("ch07_speed", "With Bhargava's reading of Eq 5.47's F0")
     if len(terms) < 3:
@@ -1435,7 +1434,7 @@ def _f0_clause() -> str:
     at = terms["total"].astype(float).idxmin()
     pts = ", ".join(f"{c} {v:.2f}" for c, v in terms["total"].items())
     return (f"with Bhargava's F0 in Eq 5.47 re-optimised at every speed ({len(terms)} of {len(cot)} valid"
-            + "".join(f"; {c} from another class's solution" for c in stand_ins)
+            + "".join(f"; {x}" for x in fidelity.stand_in_labels(used))
             + f"): {pts}, {fidelity.minimum_phrase(cot, at)} [{where}]")
 
 
@@ -1473,11 +1472,12 @@ def _legs_curve() -> dict | None:
     ``restarted`` (the marked points' restarts standing in, :func:`gaitlib.studies.fidelity.
     stored_restarts`, where stored); None when not stored."""
     try:
-        _, _, res = fidelity.stored_consistent_study("the runs on longer legs", legs=True)
+        _, _, res = fidelity.stored_consistent_study("the runs on longer legs", **fidelity.LEGS_PROBES["legs"])
     except cache.NotCached:
         return None
     try:
-        _, res = fidelity.stored_restarts(res, "the restarts of the marked points on longer legs")
+        _, res = fidelity.stored_restarts(res, "the restarts of the marked points on longer legs",
+                                          also=fidelity.legs_partner("legs"))
     except cache.NotCached:
         pass  # the study as solved: its marked points stay out
     cot, terms, slip = fidelity.curve_tables(res)
@@ -1487,7 +1487,7 @@ def _legs_curve() -> dict | None:
     closer, n = pr.closer_cells(pull)
     at = cot.loc[ok, "COT (J/kg/m)"].astype(float).idxmin() if ok else None
     return {"ok": ok, "cot": cot, "terms": terms, "slip": slip, "at": at, "closer": closer, "n": n,
-            "used": tuple(res.rerun_used), "restarted": tuple(res.restart_used),
+            "used": tuple(res.rerun_used), "restarted": fidelity.stand_in_labels(res),
             "drift": fidelity.hat_reference_drift(res)}
 
 
@@ -1504,7 +1504,7 @@ def _legs_clause(what: str) -> str:
         return f"{head}) no run is a converged, valid gait [{where}]"
     used = (f", {', '.join(g['used'])} through {'its 3000-iteration rerun' if len(g['used']) == 1 else 'their 3000-iteration reruns'}"
             if g["used"] else "")
-    used += "".join(f", {k.split()[-1]} from another class's solution" for k in g["restarted"])
+    used += "".join(f", {x}" for x in g["restarted"])
     if abs(g["drift"]) > fidelity.HAT_DRIFT_TOL:
         used += (f"; caveat: their HAT reference is not periodic (it drifts {g['drift']:.3f} m over the cycle, "
                  "a sawtooth no periodic gait can follow)")
@@ -1543,7 +1543,7 @@ def _skating_cause(cot: pd.DataFrame, res) -> str:
     used = (f"; {', '.join(res_f.rerun_used)} through "
             f"{'its 3000-iteration rerun' if len(res_f.rerun_used) == 1 else 'their 3000-iteration reruns'}"
             if res_f.rerun_used else "")
-    used += "".join(f"; {k} from another class's solution" for k in res_f.restart_used)
+    used += "".join(f"; {x}" for x in fidelity.stand_in_labels(res_f))
     return (text + f"; with every ellipsoid's friction ≥ {fidelity.FRICTION_FLOOR:g} ({len(ok)} of {len(cot_f)} runs "
             f"converged and valid{used}, slip {slip_f.loc[ok, col].min():.2f}–{slip_f.loc[ok, col].max():.2f} m/s): "
             + ", ".join(f"{c} {cot_f.loc[c, 'COT (J/kg/m)']:.2f}" for c in ok) + f", {fidelity.minimum_phrase(cot_f, at)} [{where}]")

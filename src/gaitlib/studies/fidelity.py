@@ -933,6 +933,25 @@ def stored_consistent_study(what: str, **kw):
     return res0, inv, res0.with_reruns(inv)
 
 
+#: The two consistent probes on longer legs (Ch 7), label → :func:`consistent_speed_study`'s
+#: options: :data:`LEG_SET_CHANGE` alone and with :data:`FRICTION_FLOOR`. Each one's marked
+#: points are started from the other's valid solutions too (:func:`legs_partner`).
+LEGS_PROBES = {"legs": {"legs": True}, "legs + floor": {"legs": True, "friction_floor": FRICTION_FLOOR}}
+
+
+def legs_partner(name: str) -> dict:
+    """``also`` of :func:`marked_restarts` for the probe ``name`` of :data:`LEGS_PROBES`: the
+    other probe's study read from the store (its 3000-iteration reruns standing in), by its
+    label — the same legs and contact, so its optimum of a class is a start for this one's;
+    empty when it is not stored."""
+    (other,) = [k for k in LEGS_PROBES if k != name]
+    try:
+        _, _, res = stored_consistent_study(f"the runs on {other}", **LEGS_PROBES[other])
+    except cache.NotCached:
+        return {}
+    return {other: res}
+
+
 def curve_tables(res) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
     """The tables of a consistent study's curve: ``(cot, terms, slip)`` — its
     :func:`~gaitlib.studies.predictive.cot_table`, :func:`cot_terms` and :func:`slip_table`
@@ -1011,10 +1030,11 @@ OWN_START = "Ch 5 (the study's start)"
 def restart_runs(res, classes=None, starts: dict | None = None) -> tuple[dict, dict]:
     """The runs of :func:`curve_restarts`: each class's problem of the consistent study ``res``
     (its spec unchanged: same cost, parameters and data) started from every *other* class's
-    solution — ``starts`` (class → solution; default ``res``'s runs) — every state and control
-    scaled in time to the class's cycle and stride (:func:`gaitlib.studies.predictive.run_guess`).
-    ``classes``: default every class of ``res`` in speed order. Returns ``(specs, guesses)``
-    keyed ``"NMSK <class> from <source>"``."""
+    solution — ``starts`` (class → solution; default ``res``'s runs; a start may also be the
+    same class's solution of *another* problem, never a run's own solution) — every state and
+    control scaled in time to the class's cycle and stride
+    (:func:`gaitlib.studies.predictive.run_guess`). ``classes``: default every class of ``res``
+    in speed order. Returns ``(specs, guesses)`` keyed ``"NMSK <class> from <source>"``."""
     have = [c for c in cv.SPEED_CLASSES if f"NMSK {c}" in res.specs]
     classes = have if classes is None else list(classes)
     if starts is None:
@@ -1024,8 +1044,9 @@ def restart_runs(res, classes=None, starts: dict | None = None) -> tuple[dict, d
         spec = res.specs[f"NMSK {c}"]
         legs = {} if spec.leg_scale is None else {"leg_scale": spec.leg_scale}
         g = data_mod.load_gait_data(c, spec.source, **legs)
+        own = res.solutions.get(f"NMSK {c}")
         for src in have:
-            if src == c or starts.get(src) is None:
+            if starts.get(src) is None or (src == c and (own is None or starts[src] is own)):
                 continue
             k = f"NMSK {c} from {src}"
             specs[k] = spec
@@ -1057,16 +1078,30 @@ def _marked_classes(res) -> list[str]:
             and marks.failure_label(res.solutions.get(f"NMSK {c}", res.records[f"NMSK {c}"]))]
 
 
-def marked_restarts(res, **kw) -> dict:
+def valid_solutions(res) -> dict:
+    """Class → solution of every converged, valid run of a consistent study ``res`` (its
+    stand-ins included), in speed order."""
+    bad = _marked_classes(res)
+    return {c: s for c in cv.SPEED_CLASSES if c not in bad and (s := res.solutions.get(f"NMSK {c}")) is not None}
+
+
+def marked_restarts(res, also: dict | None = None, **kw) -> dict:
     """:func:`curve_restarts` for the marked points of a consistent study only (``res``, e.g.
     with its 3000-iteration reruns standing in): each such class's problem (spec unchanged)
-    started from every *valid* class's solution. ``kw``: :func:`curve_restarts`'s options.
+    started from every *valid* class's solution. ``also``: label → another consistent study
+    whose valid solutions (:func:`valid_solutions`, the same class's included) are started
+    from too — another problem's optimum as a start, the problem solved still ``res``'s; such
+    starts are named ``"<class> (<label>)"``. ``kw``: :func:`curve_restarts`'s options.
     Returns class → {start → solution}; empty when every point is valid."""
     bad = _marked_classes(res)
     if not bad:
         return {}
-    good = {c: s for c in cv.SPEED_CLASSES if c not in bad and (s := res.solutions.get(f"NMSK {c}")) is not None}
-    return curve_restarts(res, classes=bad, starts=good, **kw)
+    out = curve_restarts(res, classes=bad, starts=valid_solutions(res), **kw)
+    for label, other in (also or {}).items():
+        for c, sols in curve_restarts(res, classes=bad, starts=valid_solutions(other), label=f" ({label})",
+                                      **kw).items():
+            out.setdefault(c, {}).update(sols)
+    return out
 
 
 def with_restarts(res, restarts: dict):
@@ -1074,22 +1109,33 @@ def with_restarts(res, restarts: dict):
     start of ``restarts`` (:func:`marked_restarts`; :func:`best_starts` decides) through
     :meth:`~gaitlib.studies.predictive.StudyResult.with_reruns`; ``restart_used`` names the
     replaced runs (``rerun_used`` stays the 3000-iteration reruns'; every use labelled by the
-    caller). ``res`` itself when none is usable."""
+    caller, :func:`stand_in_labels`; ``restart_from``: replaced run → its start). ``res`` itself
+    when none is usable."""
     if not restarts:
         return res
     best = best_starts(restart_table(restarts))
-    used = res.with_reruns({f"NMSK {c}": restarts[c][r["best start"]] for c, r in best.iterrows()
-                            if r["best start"] not in (None, OWN_START)})
+    starts = {f"NMSK {c}": r["best start"] for c, r in best.iterrows() if r["best start"] not in (None, OWN_START)}
+    used = res.with_reruns({k: restarts[k.removeprefix("NMSK ")][v] for k, v in starts.items()})
     new = tuple(k for k in used.rerun_used if k not in res.rerun_used)
-    return replace(used, rerun_used=res.rerun_used, restart_used=tuple(res.restart_used) + new) if new else res
+    if not new:
+        return res
+    return replace(used, rerun_used=res.rerun_used, restart_used=tuple(res.restart_used) + new,
+                   restart_from={**res.restart_from, **{k: starts[k] for k in new}})
 
 
-def stored_restarts(res, what: str):
-    """:func:`marked_restarts` of ``res`` read from the store only and :func:`with_restarts`:
-    ``(restarts, used)``. Raises :class:`gaitlib.cache.NotCached` naming ``what`` when a
-    restart is not stored."""
+def stand_in_labels(res) -> list[str]:
+    """``"<class> from <start>'s solution"`` for every run of ``res`` a restart stands in for
+    (:func:`with_restarts`; the start a class, or ``"<class> (<label>)"`` of another problem)."""
+    return [f"{k.removeprefix('NMSK ')} from {res.restart_from.get(k, 'another run')}'s solution"
+            for k in res.restart_used]
+
+
+def stored_restarts(res, what: str, also: dict | None = None):
+    """:func:`marked_restarts` of ``res`` (``also``: its option) read from the store only and
+    :func:`with_restarts`: ``(restarts, used)``. Raises :class:`gaitlib.cache.NotCached` naming
+    ``what`` when a restart is not stored."""
     with cache.only(f"{what} are read from the store (fidelity.marked_restarts solves them)"):
-        restarts = marked_restarts(res, progress=False)
+        restarts = marked_restarts(res, also=also, progress=False)
     return restarts, with_restarts(res, restarts)
 
 
@@ -1106,15 +1152,17 @@ def stand_in_findings(res, used, restarts: dict) -> list[str]:
         t = table.loc[c].drop(index=OWN_START, errors="ignore")
         ok = t[t["mark"] == ""]
         own = marks.failure_label(res.solutions.get(f"NMSK {c}", res.records[f"NMSK {c}"]))
+        whence = "the other classes' solutions" + (
+            " and another problem's" if any(k not in cv.SPEED_CLASSES for k in t.index) else "")
         if f"NMSK {c}" in used.restart_used:
             s = used.solutions[f"NMSK {c}"]
             src = next(k for k, v in restarts[c].items() if v is s)
-            out.append(f"**{c}** (its own run {own}): {len(ok)} of {len(t)} starts from the other classes' solutions "
+            out.append(f"**{c}** (its own run {own}): {len(ok)} of {len(t)} starts from {whence} "
                        f"converge to a valid gait; the lowest objective, from {src}'s solution (COT "
                        f"{s.stats['COT']:.2f} J kg⁻¹ m⁻¹), stands in for it — the same problem, another start "
                        "(labelled).")
         else:
-            out.append(f"**{c}** (its own run {own}): none of its {len(t)} starts from the other classes' solutions "
+            out.append(f"**{c}** (its own run {own}): none of its {len(t)} starts from {whence} "
                        "converges to a valid gait — the point stays out of the curve.")
     return out
 
@@ -1487,8 +1535,12 @@ def minimum_phrase(cot: pd.DataFrame, at: str) -> str:
     beyond = unlocated_beyond(cot, at)
     if not beyond:
         return f"minimum at {at}"
-    end = "fastest" if cv.SPEED_CLASSES.index(beyond[0]) > cv.SPEED_CLASSES.index(at) else "slowest"
-    return f"lowest at {at}, its {end} valid speed ({', '.join(beyond)} marked: the minimum not located)"
+    return f"lowest at {at}, its {_end(beyond, at)} valid speed ({', '.join(beyond)} marked: the minimum not located)"
+
+
+def _end(beyond: list[str], at: str) -> str:
+    """Which end of the valid speeds ``at`` is, given the classes :func:`unlocated_beyond` it."""
+    return "fastest" if cv.SPEED_CLASSES.index(beyond[0]) > cv.SPEED_CLASSES.index(at) else "slowest"
 
 
 def cot_curve_findings(cot: pd.DataFrame, terms: pd.DataFrame, min_points: int = 3,
@@ -1507,9 +1559,8 @@ def cot_curve_findings(cot: pd.DataFrame, terms: pd.DataFrame, min_points: int =
     pts = ", ".join(f"{c} {r['total']:.2f} at {r['speed (m/s)']:.2f} m/s" for c, r in terms.iterrows())
     beyond = unlocated_beyond(cot, at)
     if beyond:
-        end = "fastest" if cv.SPEED_CLASSES.index(beyond[0]) > cv.SPEED_CLASSES.index(at) else "slowest"
         head = (f"**{name}** ({len(terms)} of {len(cot)} speeds valid; COT in J kg⁻¹ m⁻¹: {pts}) is lowest at "
-                f"**{at}**, its {end} valid speed: {', '.join(beyond)} {'is' if len(beyond) == 1 else 'are'} left out "
+                f"**{at}**, its {_end(beyond, at)} valid speed: {', '.join(beyond)} {'is' if len(beyond) == 1 else 'are'} left out "
                 "(marked), so the curve's minimum is not located — whether it lies at the natural speed is not measured.")
     else:
         head = (f"**{name}** ({len(terms)} of {len(cot)} speeds valid; COT in J kg⁻¹ m⁻¹: {pts}) has its "
@@ -1587,20 +1638,26 @@ def own_data_findings(table: pd.DataFrame, min_points: int = 3, variant: str = "
     points) has its minimum, and whether tracking each class's own data instead of Free's data
     scaled in time moves it (one change, measured); the angle fit to the class data of both.
     ``variant``: the probe's name in :data:`OWN_DATA_VARIANTS`."""
-    lows, ok = {}, {}
+    lows, ok, phrase = {}, {}, {}
     for lab in ("Free scaled in time", "own data"):
         good = table[table[f"mark ({lab})"] == ""]
         ok[lab] = good
         lows[lab] = good[f"COT ({lab})"].astype(float).idxmin() if len(good) >= min_points else None
+        if lows[lab] is not None:
+            phrase[lab] = minimum_phrase(table[[f"mark ({lab})"]].set_axis(["mark"], axis=1), lows[lab])
     a, b = lows["Free scaled in time"], lows["own data"]
     if b is None:
         return [f"**Tracking each class's own data{variant}** only {len(ok['own data'])} of {len(table)} speeds converge to a "
                 "valid gait: too few for a curve, the input's effect on the minimum is not measured."]
     pts = ", ".join(f"{c} {r['COT (own data)']:.2f}" for c, r in ok["own data"].iterrows())
+    located = [lab for lab in phrase if phrase[lab].startswith("minimum")]
     text = (f"**Tracking each class's own data{variant}** ({len(ok['own data'])} of {len(table)} speeds valid; COT in "
-            f"J kg⁻¹ m⁻¹: {pts}) the minimum is at **{b}**; on Free's data scaled in time it is at {a or '— (too few points)'}. ")
+            f"J kg⁻¹ m⁻¹: {pts}) the curve: **{phrase['own data']}**; on Free's data scaled in time: "
+            f"{phrase.get('Free scaled in time', 'too few points')}. ")
     if a is None:
         pass
+    elif len(located) < 2:
+        text += "Whether the input moves the minimum is not measured: a curve whose minimum is not located cannot say."
     elif b == "Free" and a != "Free":
         text += (f"The input moves the minimum: with each class's own data as its input, the model's cost per metre is "
                  f"lowest at the natural speed; Free's data scaled in time over the other classes' strides are what put "

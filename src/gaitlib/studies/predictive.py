@@ -371,6 +371,7 @@ class StudyResult:
     guesses: dict = field(default_factory=dict, repr=False)  # run → the initial guess used
     rerun_used: tuple = ()  # runs whose converged rerun stands in for them (:meth:`with_reruns`)
     restart_used: tuple = ()  # runs whose restart from another run's solution stands in (fidelity.with_restarts)
+    restart_from: dict = field(default_factory=dict)  # run of restart_used → the start whose solution stands in
 
     def rerun(self, name: str, *, root=None, progress: bool = False, **changes) -> gait_ocp.GaitSolution:
         """Run ``name`` again from the same initial guess with spec fields changed (e.g.
