@@ -456,6 +456,39 @@ def test_restart_pairs_and_floor_stop_findings(monkeypatch):
     assert fidelity.floor_stop_findings(stops, {}, 0.2819) == []
 
 
+def test_minimum_table_and_findings_by_hand():
+    """fidelity.minimum_table: per curve its valid points, where it is lowest (a reference row
+    is no point of the curve), and whether that is a located minimum at Free; too few points
+    and an unstored curve are said so / left out; minimum_findings counts them."""
+    classes = ["VerySlow", "Slow", "Free", "Fast", "VeryFast"]
+
+    def cot(values, marks=("",) * 5, extra=None):
+        t = pd.DataFrame({"mark": list(marks), "COT (J/kg/m)": values, "speed (m/s)": [0.5, 0.8, 1.2, 1.6, 2.0]},
+                         index=classes)
+        ref = pd.DataFrame({"mark": [""], "COT (J/kg/m)": [extra], "speed (m/s)": [1.1]}, index=["Free (ref)"])
+        return pd.concat([t, ref]) if extra else t
+
+    t = fidelity.minimum_table({
+        "U": cot([6.8, 6.7, 5.6, 5.9, 6.2], extra=1.0),  # the reference's 1.0 is not a point
+        "falls": cot([6.6, 6.7, 5.6, 0.1, 0.1], ("", "", "", "x", "x")),
+        "fast": cot([3.3, 5.6, 4.9, 2.5, 2.2]),
+        "few": cot([1.0, 2.0, 3.0, 4.0, 5.0], ("x", "x", "x", "", "")),
+        "not stored": None})
+    assert list(t.index) == ["U", "falls", "fast", "few"]
+    assert t.loc["U"].tolist() == ["5 of 5", "minimum at Free", 5.6, True, ""]
+    assert t.loc["falls", "where lowest"].startswith("lowest at Free, its fastest valid speed (Fast, VeryFast marked")
+    assert not t.loc["falls", "minimum at Free"] and t.loc["falls", "valid points"] == "3 of 5"
+    assert t.loc["fast", "where lowest"] == "minimum at VeryFast" and t.loc["fast", "COT there (J/kg/m)"] == 2.2
+    assert t.loc["few", "where lowest"] == "too few valid points" and math.isnan(t.loc["few", "COT there (J/kg/m)"])
+    assert fidelity.minimum_findings(t) == [
+        "**Of the 3 COT curves above with at least three valid points, 1 has a located minimum at Free** (U, a U); "
+        "elsewhere: fast (VeryFast); not located (lowest at the end of the valid speeds): falls."]
+    assert fidelity.minimum_findings(t.loc[["few"]]) == []
+    bump = fidelity.minimum_table({"bump": cot([6.5, 6.7, 5.6, 5.9, 6.2])})
+    assert bump.loc["bump", "steps the wrong way (not a U)"] == "VerySlow 6.50 → Slow 6.70"
+    assert "(bump, not a U: VerySlow 6.50 → Slow 6.70)" in fidelity.minimum_findings(bump)[0]
+
+
 def test_own_data_findings_by_hand():
     """fidelity.own_data_findings: each input's minimum over its valid points, and the verdict on
     the one change (the tracked data) — moved to Free, not moved, moved elsewhere, too few."""

@@ -218,8 +218,14 @@ def test_cot_curve_findings_locate_the_minimum_and_the_term_that_moves_it():
     assert "too few" in " ".join(fidelity.cot_curve_findings(cot, terms.iloc[:2]))
     terms.loc["Free", "shortening"] = 0.5  # now Free is lowest
     terms["total"] = terms[["activation", "maintenance", "shortening", "basal", "work"]].sum(axis=1)
-    assert "the natural speed, as the thesis" in " ".join(fidelity.cot_curve_findings(cot, terms))
+    text = " ".join(fidelity.cot_curve_findings(cot, terms))  # Slow 2.9, Free 2.1, Fast 3.4
+    assert "the natural speed, as the thesis and walking physiology say, a U-curve as the thesis reports." in text
     assert fidelity.minimum_phrase(cot, "Free") == "minimum at Free"
+    # a fourth valid point below its slower neighbour: the minimum at Free, but not a U
+    cot4 = cot.assign(mark="")
+    terms4 = pd.concat([terms, pd.DataFrame({"speed (m/s)": [1.7], "total": [3.0]}, index=["VeryFast"])])
+    text = " ".join(fidelity.cot_curve_findings(cot4, terms4))
+    assert "minimum at **Free**" in text and "not a U, though: the COT moves the wrong way between Fast 3.40 → VeryFast 3.00." in text
 
 
 def test_a_lowest_point_at_the_end_of_the_valid_speeds_is_not_a_located_minimum():

@@ -207,6 +207,7 @@ ch6_dt = pr.cost_function_study(("NMSK",), ("DT",), progress=False, reading="boo
 CH5_ROW = "Free (Ch 5 Eq 5.55)"
 cot = pr.cot_table(res_used, {"Free": ch6_dt, CH5_ROW: res.baselines.get("NMSK")})
 fig = pr.cot_figure(cot, CH5_ROW)
+curves = {"the thesis's problem (Free: Ch 6 DT)": cot}  # every curve of this page, for "What we found"
 cot
 
 # %% [markdown]
@@ -228,6 +229,7 @@ res_u = fidelity.consistent_speed_study(progress=False)
 cot_u = pr.cot_table(res_u)
 fig = pr.cot_figure(cot_u, label="ours: one problem, swing foot unloaded (converged, valid)")
 terms_u = fidelity.cot_terms(cot_u, res_u.solutions)
+curves["one consistent problem, swing foot unloaded"] = cot_u
 display(cot_u, terms_u)
 display(Markdown("\n\n".join(fidelity.cot_curve_findings(cot_u, terms_u))))
 
@@ -284,6 +286,7 @@ def stored_consistent(what, restart=False, also=None, **kw):
 res_f = stored_consistent("the runs with the friction floor", restart=True, friction_floor=fidelity.FRICTION_FLOOR)
 if res_f is not None:
     cot_f, terms_f, slip_f = fidelity.curve_tables(res_f)
+    curves[f"friction ≥ {fidelity.FRICTION_FLOOR:g}"] = cot_f
     fig = pr.cot_figure(cot_f, label=f"ours: one problem, friction ≥ {fidelity.FRICTION_FLOOR:g} (converged, valid"
                         + "".join(f"; {x}" for x in fidelity.stand_in_labels(res_f)) + ")")
     display(marks.mark_table(pd.concat({"as identified": slip_u, f"friction ≥ {fidelity.FRICTION_FLOOR:g}": slip_f},
@@ -326,6 +329,7 @@ if res7_c5 is not None:
         print("reruns standing in (our activation parameters):", ", ".join(used7_c5.rerun_used))
         display(res7_c5.rerun_table(inv7_c5))
     cot_c5 = pr.cot_table(used7_c5, {"Free": dt_c5})
+    curves["our Ch 5 activation parameters (Free: Ch 6 DT)"] = cot_c5
     fig = pr.cot_figure(cot_c5, label="ours: NMSK DT with our Ch 5 activation parameters (Free = Ch 6 DT)")
     terms_c5 = fidelity.cot_terms(cot_c5, {**used7_c5.solutions, "NMSK DT": dt_c5})
     display(cot_c5, terms_c5)
@@ -355,6 +359,7 @@ if res7_c5 is not None:
 res_b = stored_consistent("the runs with Bhargava's F0", restart=True, isometric_torque="bhargava")
 if res_b is not None:
     cot_b, terms_b, _ = fidelity.curve_tables(res_b)
+    curves["Bhargava's F0"] = cot_b
     fig = pr.cot_figure(cot_b, label="ours: one problem, Bhargava's F0 (converged, valid"
                         + "".join(f"; {x}" for x in fidelity.stand_in_labels(res_b)) + ")")
     display(cot_b, terms_b)
@@ -384,6 +389,7 @@ except cache.NotCached as e:
     print(f"Not stored yet: {e}")
 if restarts is not None:
     rt, best_u, cot_best, terms_best = fidelity.restart_curve(restarts)
+    curves["one consistent problem, best of its starts"] = cot_best
     fig = pr.cot_figure(cot_best, label="ours: one problem, best of its starts per speed (converged, valid)",
                         others={"ours: the same problem from the Ch 5 start (above)": cot_u})
     display(rt, best_u, terms_best)
@@ -449,6 +455,7 @@ res_l = stored_consistent("the runs on longer legs", restart=True, also=fidelity
                           **fidelity.LEGS_PROBES["legs"])
 if res_l is not None:
     cot_l, terms_l, slip_l = fidelity.curve_tables(res_l)
+    curves[f"legs ×{fidelity.LEG_SCALE:g} + Ch 4 (c) on them"] = cot_l
     fig = pr.cot_figure(cot_l, label=f"ours: one problem, legs ×{fidelity.LEG_SCALE:g} + Ch 4 (c) on them (converged, valid"
                         + "".join(f"; {x}" for x in fidelity.stand_in_labels(res_l)) + ")")
     display(marks.mark_table(pd.concat({"book's legs": slip_u, f"legs ×{fidelity.LEG_SCALE:g} + set": slip_l}, axis=1),
@@ -474,6 +481,7 @@ res_lf = stored_consistent("the runs on longer legs with the friction floor", re
                            also=fidelity.legs_partner("legs + floor"), **fidelity.LEGS_PROBES["legs + floor"])
 if res_lf is not None:
     cot_lf, terms_lf, slip_lf = fidelity.curve_tables(res_lf)
+    curves[f"legs ×{fidelity.LEG_SCALE:g} + Ch 4 (c) + friction ≥ {fidelity.FRICTION_FLOOR:g}"] = cot_lf
     fig = pr.cot_figure(cot_lf, label=f"ours: legs ×{fidelity.LEG_SCALE:g} + set + friction ≥ {fidelity.FRICTION_FLOOR:g}"
                         + "".join(f"; {x}" for x in fidelity.stand_in_labels(res_lf)))
     display(marks.mark_table(slip_lf, {c: m for c, m in cot_lf["mark"].items() if m}), cot_lf, terms_lf)
@@ -500,6 +508,11 @@ if res_lf is not None:
 # counts through its converged, valid 3000-iteration rerun (named). The table sets both
 # inputs side by side per class, with each run's worst joint-angle RMSE against the class's
 # own data, then the own-data runs' COT by term and how fast their loaded feet slide.
+#
+# Both probes run at Table 7.1's weights first (how far their runs stay from the children's
+# angles is in the table's last columns). The pair is solved again with the three data-tracking weights (Trq, Ang,
+# GRF) × 10 (`predictive.TIGHT_TRACKING`, both inputs, everything else unchanged): held that
+# much closer to each class's gait, where does the model's cost per metre put its minimum?
 
 # %%
 for variant in fidelity.OWN_DATA_VARIANTS:
@@ -509,6 +522,9 @@ for variant in fidelity.OWN_DATA_VARIANTS:
         print(f"Not stored yet: {e}")
         continue
     cot_o, terms_o, slip_o = fidelity.curve_tables(own_v)
+    curves[f"each class's own data tracked{variant}"] = cot_o
+    if variant:  # the consistent problem with the same change (the "" variant's is the curve above)
+        curves[f"Free's data scaled in time{variant}"] = pr.cot_table(base_v)
     fig = pr.cot_figure(cot_o, label=f"ours: each class's own data tracked{variant} (converged, valid)",
                         others={f"ours: Free's data scaled in time{variant}": pr.cot_table(base_v)})
     stand = [f"{k} (own data): its 3000-iteration rerun" for k in own_v.rerun_used]
@@ -539,10 +555,14 @@ for c in classes:
 #
 # Computed from the runs above; a run that did not converge, or that fails a physical
 # validity gate (`gaitlib.validity`), supplies no number here; a converged, valid
-# 3000-iteration rerun stands in for a run that stopped at the limit (named below).
+# 3000-iteration rerun stands in for a run that stopped at the limit (named below). The
+# table gathers where each COT curve of this page has its minimum (`fidelity.minimum_table`:
+# its valid points, and "lowest at …" where the curve still falls into marked speeds).
 
 # %%
 print("\n".join(pr.ch7_findings(res_used, classes, ctrl, cot, inv, CH5_ROW)))
+minima = fidelity.minimum_table(curves)
+display(minima, Markdown("\n\n".join(fidelity.minimum_findings(minima))))
 if res7_c5 is not None:
     _k, _n = pr.closer_cells(pr.input_pull(used7_c5, gaits))
     _ok = cot_c5[cot_c5["mark"] == ""]["COT (J/kg/m)"]

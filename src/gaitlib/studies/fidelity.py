@@ -1543,6 +1543,47 @@ def _end(beyond: list[str], at: str) -> str:
     return "fastest" if cv.SPEED_CLASSES.index(beyond[0]) > cv.SPEED_CLASSES.index(at) else "slowest"
 
 
+def minimum_table(curves: dict, min_points: int = 3) -> pd.DataFrame:
+    """Where each COT curve has its minimum, one row per curve (``curves``: name →
+    :func:`gaitlib.studies.predictive.cot_table`, None when not stored: left out; rows other
+    than the speed classes, e.g. a labelled reference, are not points of the curve): its valid
+    points (``"n of m"``), where it is lowest (:func:`minimum_phrase`; ``"too few valid points"``
+    under ``min_points``), that COT (J kg⁻¹ m⁻¹) and whether that is a located minimum at *Free*."""
+    rows = {}
+    for name, cot in curves.items():
+        if cot is None:
+            continue
+        cot = cot.loc[[c for c in cv.SPEED_CLASSES if c in cot.index]]
+        good = cot[cot["mark"] == ""]
+        ok = good["COT (J/kg/m)"].astype(float)
+        at = ok.idxmin() if len(ok) >= min_points else None
+        rows[name] = {"valid points": f"{len(ok)} of {len(cot)}",
+                      "where lowest": minimum_phrase(cot, at) if at else "too few valid points",
+                      "COT there (J/kg/m)": ok[at] if at else np.nan,
+                      "minimum at Free": at == "Free" and not unlocated_beyond(cot, at),
+                      "steps the wrong way (not a U)": "; ".join(pr.u_breaks(
+                          {c: (r["speed (m/s)"], r["COT (J/kg/m)"]) for c, r in good.iterrows()})) if at else ""}
+    return pd.DataFrame.from_dict(rows, orient="index").rename_axis("curve")
+
+
+def minimum_findings(table: pd.DataFrame) -> list[str]:
+    """The sentence on a :func:`minimum_table`: of its curves with enough valid points, which
+    have a located minimum at *Free* (the thesis's claim), which elsewhere, which are not located."""
+    measured = table[table["where lowest"] != "too few valid points"]
+    if not len(measured):
+        return []
+    free = [n + (f", not a U: {r['steps the wrong way (not a U)']}" if r["steps the wrong way (not a U)"] else ", a U")
+            for n, r in measured.iterrows() if r["minimum at Free"]]
+    unloc = [n for n, r in measured.iterrows() if r["where lowest"].startswith("lowest")]
+    other = [f"{n} ({r['where lowest'].removeprefix('minimum at ')})" for n, r in measured.iterrows()
+             if not r["minimum at Free"] and n not in unloc]
+    return [f"**Of the {len(measured)} COT curves above with at least three valid points, {len(free)} "
+            f"{'has' if len(free) == 1 else 'have'} a located minimum at Free**"
+            + (f" ({'; '.join(free)})" if free else "")
+            + (f"; elsewhere: {'; '.join(other)}" if other else "")
+            + (f"; not located (lowest at the end of the valid speeds): {'; '.join(unloc)}" if unloc else "") + "."]
+
+
 def cot_curve_findings(cot: pd.DataFrame, terms: pd.DataFrame, min_points: int = 3,
                        name: str = "The consistent curve") -> list[str]:
     """Where the curve (``name``, e.g. the consistent one) has its minimum, and — if not at
@@ -1564,8 +1605,12 @@ def cot_curve_findings(cot: pd.DataFrame, terms: pd.DataFrame, min_points: int =
                 "(marked), so the curve's minimum is not located — whether it lies at the natural speed is not measured.")
     else:
         head = (f"**{name}** ({len(terms)} of {len(cot)} speeds valid; COT in J kg⁻¹ m⁻¹: {pts}) has its "
-                f"minimum at **{at}**" + (" — the natural speed, as the thesis and walking physiology say." if at == "Free"
+                f"minimum at **{at}**" + (" — the natural speed, as the thesis and walking physiology say" if at == "Free"
                                            else ", not at the natural speed."))
+        if at == "Free":
+            breaks = pr.u_breaks({c: (r["speed (m/s)"], r["total"]) for c, r in terms.iterrows()})
+            head += ("; not a U, though: the COT moves the wrong way between " + "; ".join(breaks) + "."
+                     if breaks else ", a U-curve as the thesis reports.")
     out.insert(0, head)
     if at != "Free" and "Free" in terms.index:
         names = [t for t in ("activation", "maintenance", "shortening", "basal", "work") if t in terms.columns]
@@ -1613,8 +1658,10 @@ def own_data_table(res_in, res_own) -> pd.DataFrame:
 
 #: The own-data probes the book shows (:func:`stored_own_data`): name (appended to "each
 #: class's own data") → :func:`consistent_speed_study`'s options besides ``own_data``, e.g.
-#: ``{"friction_floor": FRICTION_FLOOR}``; the thesis's contact only so far.
-OWN_DATA_VARIANTS = {"": {}}
+#: ``{"friction_floor": FRICTION_FLOOR}``, the same options for both inputs: Table 7.1's
+#: weights, and its three data-tracking weights × 10
+#: (:data:`gaitlib.studies.predictive.TIGHT_TRACKING`; the thesis's contact both).
+OWN_DATA_VARIANTS = {"": {}, " with the data terms × 10": {"weights": pr.TIGHT_TRACKING}}
 
 
 def stored_own_data(variant: str = "") -> tuple:

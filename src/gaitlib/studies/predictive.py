@@ -563,6 +563,10 @@ def ch5_activation_speed_study(**kw) -> StudyResult:
 #: each) divided by 10, every other term unchanged — does a prediction held less tightly to
 #: the time-scaled Free data move towards the untracked class data?
 LOOSE_TRACKING = (("Trq", 1 / 40), ("Ang", 1 / 40), ("GRF", 1 / 40))
+#: Its opposite: the three data-tracking weights × 10 (10/4 each) — with each class's own data
+#: as the input (``fidelity.consistent_speed_study(own_data=True)``), how does a gait held
+#: close to the children's gait at each speed cost per metre?
+TIGHT_TRACKING = (("Trq", 10 / 4), ("Ang", 10 / 4), ("GRF", 10 / 4))
 
 
 class Runs:
