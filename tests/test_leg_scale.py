@@ -236,8 +236,8 @@ def test_card_clauses_on_the_stored_legs_curve():
     for c in g["ok"]:
         assert f"{c} {g['cot'].loc[c, 'COT (J/kg/m)']:.2f}" in s
     assert ("not periodic" in s) == (abs(g["drift"]) > fidelity.HAT_DRIFT_TOL)  # the HAT reference's caveat
-    for k in g["restarted"]:  # a marked point's restart standing in is named
-        assert f"{k.split()[-1]} from another class's solution" in s
+    for k in g["restarted"]:  # a marked point's restart standing in is named, with its start
+        assert k in s and k.endswith("'s solution") and " from " in k
     assert fidelity.minimum_phrase(g["cot"], g["at"]) in s and card.CH7_LEGS_HEADING.split(" (")[0].lower().replace(" ", "-") in s
     assert f"closer in {g['closer']} of {g['n']} cells" in card._legs_clause("cells")
     # the Free run tracks its own data: its cells are not counted

@@ -1512,9 +1512,13 @@ def _legs_clause(what: str) -> str:
     if what == "cells":
         return f"{head}; {len(g['ok'])} of {len(g['cot'])} runs converged and valid{used}): closer in {g['closer']} of {g['n']} cells [{where}]"
     cot = g["cot"]
+    low = fidelity.minimum_table({"legs": cot}).iloc[0]
+    shape = (f" (not a U: {low['steps the wrong way (not a U)']})" if low["steps the wrong way (not a U)"] else " (a U)"
+             ) if low["minimum at Free"] else ""
     return (f"{head}; {len(g['ok'])} of {len(cot)} runs converged and valid{used}, feet sliding "
             f"{g['slip'].loc[g['ok'], col].min():.2f}–{g['slip'].loc[g['ok'], col].max():.2f} m/s): "
-            + ", ".join(f"{c} {cot.loc[c, 'COT (J/kg/m)']:.2f}" for c in g["ok"]) + f", {fidelity.minimum_phrase(cot, g['at'])} [{where}]")
+            + ", ".join(f"{c} {cot.loc[c, 'COT (J/kg/m)']:.2f}" for c in g["ok"])
+            + f", {fidelity.minimum_phrase(cot, g['at'])}{shape} [{where}]")
 
 
 def _skating_cause(cot: pd.DataFrame, res) -> str:
