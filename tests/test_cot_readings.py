@@ -350,23 +350,25 @@ def test_restart_runs_never_start_a_run_from_itself_but_from_another_problems_sa
     specs, guesses = fidelity.restart_runs(res)
     assert sorted(specs) == ["NMSK Free from Slow", "NMSK Slow from Free"]
     assert guesses["NMSK Slow from Free"] == ("guess", "free", 1.2)
-    specs, guesses = fidelity.restart_runs(res, ["Slow"], starts={"Slow": "slow'", "Free": "free'"})
+    other = {"Slow": "slow'", "Free": "free'"}
+    assert list(fidelity.restart_runs(res, ["Slow"], starts=other)[0]) == ["NMSK Slow from Free"]  # other classes only
+    specs, guesses = fidelity.restart_runs(res, ["Slow"], starts=other, same_class=True)
     assert sorted(specs) == ["NMSK Slow from Free", "NMSK Slow from Slow"] and specs["NMSK Slow from Slow"] is spec
     assert guesses["NMSK Slow from Slow"][1] == "slow'"
-    assert list(fidelity.restart_runs(res, ["Slow"], starts={"Slow": "slow"})[0]) == []  # its own solution
+    assert list(fidelity.restart_runs(res, ["Slow"], starts={"Slow": "slow"}, same_class=True)[0]) == []  # its own
 
     calls = []
 
-    def fake(r, classes=None, *, starts=None, label="", **kw):
-        calls.append((r, classes, starts, label))
+    def fake(r, classes=None, *, starts=None, label="", same_class=False, **kw):
+        calls.append((r, classes, starts, label, same_class))
         return {c: {fidelity.OWN_START: "own", **{k + label: f"{c}<-{k}{label}" for k in starts}} for c in classes}
 
     monkeypatch.setattr(fidelity, "curve_restarts", fake)
     monkeypatch.setattr(fidelity, "_marked_classes", lambda r: ["Slow"] if r is res else [])
     other = SimpleNamespace(solutions={"NMSK Slow": "o-slow", "NMSK Fast": "o-fast"})
     out = fidelity.marked_restarts(res, also={"floor": other})
-    assert [c[1:] for c in calls] == [(["Slow"], {"Free": "free"}, ""),
-                                      (["Slow"], {"Slow": "o-slow", "Fast": "o-fast"}, " (floor)")]
+    assert [c[1:] for c in calls] == [(["Slow"], {"Free": "free"}, "", False),
+                                      (["Slow"], {"Slow": "o-slow", "Fast": "o-fast"}, " (floor)", True)]
     assert all(c[0] is res for c in calls)  # the problem solved is res's
     assert out == {"Slow": {fidelity.OWN_START: "own", "Free": "Slow<-Free", "Slow (floor)": "Slow<-Slow (floor)",
                             "Fast (floor)": "Slow<-Fast (floor)"}}

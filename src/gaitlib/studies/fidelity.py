@@ -1027,14 +1027,14 @@ def cot_terms(cot: pd.DataFrame, solutions: dict) -> pd.DataFrame:
 OWN_START = "Ch 5 (the study's start)"
 
 
-def restart_runs(res, classes=None, starts: dict | None = None) -> tuple[dict, dict]:
+def restart_runs(res, classes=None, starts: dict | None = None, same_class: bool = False) -> tuple[dict, dict]:
     """The runs of :func:`curve_restarts`: each class's problem of the consistent study ``res``
     (its spec unchanged: same cost, parameters and data) started from every *other* class's
-    solution — ``starts`` (class → solution; default ``res``'s runs; a start may also be the
-    same class's solution of *another* problem, never a run's own solution) — every state and
-    control scaled in time to the class's cycle and stride
-    (:func:`gaitlib.studies.predictive.run_guess`). ``classes``: default every class of ``res``
-    in speed order. Returns ``(specs, guesses)`` keyed ``"NMSK <class> from <source>"``."""
+    solution — ``starts`` (class → solution; default ``res``'s runs) — every state and control
+    scaled in time to the class's cycle and stride (:func:`gaitlib.studies.predictive.run_guess`).
+    ``same_class``: the class's own entry of ``starts`` is a start too (``starts`` of *another*
+    problem; never a run's own solution). ``classes``: default every class of ``res`` in speed
+    order. Returns ``(specs, guesses)`` keyed ``"NMSK <class> from <source>"``."""
     have = [c for c in cv.SPEED_CLASSES if f"NMSK {c}" in res.specs]
     classes = have if classes is None else list(classes)
     if starts is None:
@@ -1046,7 +1046,7 @@ def restart_runs(res, classes=None, starts: dict | None = None) -> tuple[dict, d
         g = data_mod.load_gait_data(c, spec.source, **legs)
         own = res.solutions.get(f"NMSK {c}")
         for src in have:
-            if starts.get(src) is None or (src == c and (own is None or starts[src] is own)):
+            if starts.get(src) is None or (src == c and (not same_class or starts[src] is own)):
                 continue
             k = f"NMSK {c} from {src}"
             specs[k] = spec
@@ -1054,14 +1054,14 @@ def restart_runs(res, classes=None, starts: dict | None = None) -> tuple[dict, d
     return specs, guesses
 
 
-def curve_restarts(res, classes=None, *, starts: dict | None = None, label: str = "",
+def curve_restarts(res, classes=None, *, starts: dict | None = None, label: str = "", same_class: bool = False,
                    scheduler: str | None = None, n_workers: int | None = None, progress: bool = True) -> dict:
     """Is each point of a consistent curve a local optimum? Every class's problem solved again
     from every other class's solution (:func:`restart_runs`; ``starts``: class → the solution
-    to start from, default the study's runs; one dask sweep, solved or reloaded from the
-    cache). Returns class → {start → solution (None if the run raised)}: the study's own run
+    to start from, default the study's runs; ``same_class``: :func:`restart_runs`'s; one dask
+    sweep, solved or reloaded from the cache). Returns class → {start → solution (None if the run raised)}: the study's own run
     first (:data:`OWN_START`), then the starts by class name (+ ``label``)."""
-    specs, guesses = restart_runs(res, classes, starts)
+    specs, guesses = restart_runs(res, classes, starts, same_class)
     recs = gait_ocp.solve_specs(specs, guesses=guesses, scheduler=scheduler, n_workers=n_workers,
                                 progress=progress)
     out = {}
@@ -1099,7 +1099,7 @@ def marked_restarts(res, also: dict | None = None, **kw) -> dict:
     out = curve_restarts(res, classes=bad, starts=valid_solutions(res), **kw)
     for label, other in (also or {}).items():
         for c, sols in curve_restarts(res, classes=bad, starts=valid_solutions(other), label=f" ({label})",
-                                      **kw).items():
+                                      same_class=True, **kw).items():
             out.setdefault(c, {}).update(sols)
     return out
 
