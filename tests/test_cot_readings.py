@@ -491,6 +491,23 @@ def test_minimum_table_and_findings_by_hand():
     assert "(bump, not a U: VerySlow 6.50 → Slow 6.70)" in fidelity.minimum_findings(bump)[0]
 
 
+def test_tracking_weight_findings_by_hand():
+    """fidelity.tracking_weight_findings: per class valid at both weights, the own-data runs'
+    worst angle base → heavier data terms; still far → the weights are not the cause, with the
+    share they take off (1 − after/before, by hand); within 5° → the runs walk as the children."""
+    col, mark = "worst angle RMSE vs class data, deg (own data)", "mark (own data)"
+    base = pd.DataFrame({mark: ["", "", "x"], col: [12.0, 16.0, 15.0]}, index=["Free", "Fast", "VeryFast"])
+    tight = pd.DataFrame({mark: ["", "", ""], col: [10.8, 12.0, 3.0]}, index=base.index)
+    out = fidelity.tracking_weight_findings({"": base, " ×10": tight})
+    assert out == ["**Tracking each class's own data ×10** against the same at Table 7.1's weights, the worst joint "
+                   "angle's RMSE against the class's data (deg, classes valid in both): Free 12.0 → 10.8, Fast 16.0 → "
+                   "12.0 — still 10.8–12.0°: the data terms' weights are not what holds the runs from the children's "
+                   "angles (measured: the change takes off 10–25 %)."]
+    tight[col] = [4.0, 4.5, 3.0]
+    assert "within 5° everywhere" in fidelity.tracking_weight_findings({"": base, " ×10": tight})[0]
+    assert fidelity.tracking_weight_findings({"": base}) == []
+
+
 def test_own_data_findings_by_hand():
     """fidelity.own_data_findings: each input's minimum over its valid points, and the verdict on
     the one change (the tracked data) — moved to Free, not moved, moved elsewhere, too few."""

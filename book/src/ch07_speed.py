@@ -515,6 +515,7 @@ if res_lf is not None:
 # much closer to each class's gait, where does the model's cost per metre put its minimum?
 
 # %%
+own_tables = {}
 for variant in fidelity.OWN_DATA_VARIANTS:
     try:
         base_v, own_v = fidelity.stored_own_data(variant)
@@ -531,10 +532,12 @@ for variant in fidelity.OWN_DATA_VARIANTS:
     stand += [f"{k} (Free scaled in time): its 3000-iteration rerun" for k in base_v.rerun_used]
     stand += [f"{x} (Free scaled in time)" for x in fidelity.stand_in_labels(base_v)]
     print(f"own data{variant} — standing in: " + ("; ".join(stand) or "none"))
-    own_t = fidelity.own_data_table(base_v, own_v)
+    own_t = own_tables[variant] = fidelity.own_data_table(base_v, own_v)
     display(own_t, terms_o, slip_o)
     display(Markdown("\n\n".join(fidelity.own_data_findings(own_t, variant=variant) + fidelity.cot_curve_findings(
         cot_o, terms_o, name=f"The curve tracking each class's own data{variant}"))))
+if "" in own_tables:
+    display(Markdown("\n\n".join(fidelity.tracking_weight_findings(own_tables))))
 
 # %% [markdown]
 # ## The predicted NMSK gaits against each class's data (thesis Figs 7.6–7.9)

@@ -1447,13 +1447,16 @@ def _own_data_clause() -> str:
     (Ch 7, :data:`CH7_OWN_DATA_HEADING`): :func:`gaitlib.studies.fidelity.own_data_findings`
     of every stored probe of :data:`gaitlib.studies.fidelity.OWN_DATA_VARIANTS`; empty when
     none is stored."""
-    text = []
+    text, tables = [], {}
     for variant in fidelity.OWN_DATA_VARIANTS:
         try:
             base, own = fidelity.stored_own_data(variant)
         except cache.NotCached:
             continue
-        text += fidelity.own_data_findings(fidelity.own_data_table(base, own), variant=variant)
+        tables[variant] = fidelity.own_data_table(base, own)
+        text += fidelity.own_data_findings(tables[variant], variant=variant)
+    if "" in tables:
+        text += fidelity.tracking_weight_findings(tables)
     if not text:
         return ""
     return " ".join(x.replace("**", "") for x in text) + f" [{_anchor('ch07_speed', CH7_OWN_DATA_HEADING)}]"

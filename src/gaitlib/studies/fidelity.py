@@ -1722,8 +1722,39 @@ def own_data_findings(table: pd.DataFrame, min_points: int = 3, variant: str = "
         text += (f" Against each class's data the worst joint angle is off by {o.min():.1f}–{o.max():.1f}° in the "
                  f"own-data runs and {f.min():.1f}–{f.max():.1f}° in the Free-input runs ({len(both)} classes where both "
                  "are valid)" + (": at these weights the runs do not walk as the children walk — the input changes, the "
-                                 "gait stays about as far from the class data." if o.min() > 5.0 else "."))
+                                 "gait stays about as far from the class data." if o.min() > OWN_DATA_CLOSE_DEG else "."))
     return [text]
+
+
+def tracking_weight_findings(tables: dict) -> list[str]:
+    """The sentence on the own-data probes at two sets of weights (``tables``: variant name of
+    :data:`OWN_DATA_VARIANTS` → its :func:`own_data_table`; the first is the base, the others
+    compared with it): per class valid in both, the own-data runs' worst joint-angle RMSE against
+    the class's data (deg), base → variant, and whether the heavier data terms bring the runs
+    within :data:`OWN_DATA_CLOSE_DEG` of the children's angles."""
+    col, mark = "worst angle RMSE vs class data, deg (own data)", "mark (own data)"
+    (base_name, base), *others = tables.items()
+    out = []
+    for name, t in others:
+        both = [c for c in base.index if c in t.index and base.loc[c, mark] == "" and t.loc[c, mark] == ""]
+        if not both:
+            continue
+        a, b = base.loc[both, col].astype(float), t.loc[both, col].astype(float)
+        close = b.max() <= OWN_DATA_CLOSE_DEG
+        out.append(f"**Tracking each class's own data{name}** against the same at Table 7.1's weights, the worst "
+                   "joint angle's RMSE against the class's data (deg, classes valid in both): "
+                   + ", ".join(f"{c} {a[c]:.1f} → {b[c]:.1f}" for c in both)
+                   + (f" — within {OWN_DATA_CLOSE_DEG:g}° everywhere: held closer, the runs walk as the children walk."
+                      if close else
+                      f" — still {b.min():.1f}–{b.max():.1f}°: the data terms' weights are not what holds the runs "
+                      "from the children's angles (measured: the change takes off "
+                      f"{100 * (1 - (b / a).max()):.0f}–{100 * (1 - (b / a).min()):.0f} %)."))
+    return out
+
+
+#: A run whose worst joint angle is within this of the class's data (deg) walks as the
+#: children walk for :func:`own_data_findings` and :func:`tracking_weight_findings`.
+OWN_DATA_CLOSE_DEG = 5.0
 
 
 # ======================================================================================
