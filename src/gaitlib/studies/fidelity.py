@@ -942,8 +942,8 @@ LEGS_PROBES = {"legs": {"legs": True}, "legs + floor": {"legs": True, "friction_
 def legs_partner(name: str) -> dict:
     """``also`` of :func:`marked_restarts` for the probe ``name`` of :data:`LEGS_PROBES`: the
     other probe's study read from the store (its 3000-iteration reruns standing in), by its
-    label — the same legs and contact, so its optimum of a class is a start for this one's;
-    empty when it is not stored."""
+    label — the same legs and identified contact (they differ by the friction floor only), so
+    its optimum of a class is a start for this one's; empty when it is not stored."""
     (other,) = [k for k in LEGS_PROBES if k != name]
     try:
         _, _, res = stored_consistent_study(f"the runs on {other}", **LEGS_PROBES[other])
@@ -1059,8 +1059,9 @@ def curve_restarts(res, classes=None, *, starts: dict | None = None, label: str 
     """Is each point of a consistent curve a local optimum? Every class's problem solved again
     from every other class's solution (:func:`restart_runs`; ``starts``: class → the solution
     to start from, default the study's runs; ``same_class``: :func:`restart_runs`'s; one dask
-    sweep, solved or reloaded from the cache). Returns class → {start → solution (None if the run raised)}: the study's own run
-    first (:data:`OWN_START`), then the starts by class name (+ ``label``)."""
+    sweep, solved or reloaded from the cache). Returns class → {start → solution (None if the
+    run raised)}: the study's own run first (:data:`OWN_START`), then the starts by class name
+    (+ ``label``)."""
     specs, guesses = restart_runs(res, classes, starts, same_class)
     recs = gait_ocp.solve_specs(specs, guesses=guesses, scheduler=scheduler, n_workers=n_workers,
                                 progress=progress)
