@@ -486,6 +486,8 @@ def test_minimum_table_and_findings_by_hand():
         "**Of the 3 COT curves above with at least three valid points, 1 has a located minimum at Free** (U, a U); "
         "elsewhere: fast (VeryFast); not located (lowest at the end of the valid speeds): falls."]
     assert fidelity.minimum_findings(t.loc[["few"]]) == []
+    gap = fidelity.minimum_table({"gap": cot([6.8, 6.7, 5.6, 5.9, 6.2], ("x", "", "", "", ""))})
+    assert "(gap, U not tested: marked speeds left out)" in fidelity.minimum_findings(gap)[0]
     bump = fidelity.minimum_table({"bump": cot([6.5, 6.7, 5.6, 5.9, 6.2])})
     assert bump.loc["bump", "steps the wrong way (not a U)"] == "VerySlow 6.50 → Slow 6.70"
     assert "(bump, not a U: VerySlow 6.50 → Slow 6.70)" in fidelity.minimum_findings(bump)[0]

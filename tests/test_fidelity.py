@@ -218,7 +218,9 @@ def test_cot_curve_findings_locate_the_minimum_and_the_term_that_moves_it():
     assert "too few" in " ".join(fidelity.cot_curve_findings(cot, terms.iloc[:2]))
     terms.loc["Free", "shortening"] = 0.5  # now Free is lowest
     terms["total"] = terms[["activation", "maintenance", "shortening", "basal", "work"]].sum(axis=1)
-    text = " ".join(fidelity.cot_curve_findings(cot, terms))  # Slow 2.9, Free 2.1, Fast 3.4
+    text = " ".join(fidelity.cot_curve_findings(cot, terms))  # Slow 2.9, Free 2.1, Fast 3.4; VeryFast marked
+    assert "as the thesis and walking physiology say; whether it is a U is not tested (marked speeds left out)." in text
+    text = " ".join(fidelity.cot_curve_findings(cot.iloc[:3], terms))  # the three speeds measured, all valid
     assert "the natural speed, as the thesis and walking physiology say, a U-curve as the thesis reports." in text
     assert fidelity.minimum_phrase(cot, "Free") == "minimum at Free"
     # a fourth valid point below its slower neighbour: the minimum at Free, but not a U

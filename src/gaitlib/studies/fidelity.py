@@ -1156,8 +1156,7 @@ def stand_in_findings(res, used, restarts: dict) -> list[str]:
         whence = "the other classes' solutions" + (
             " and another problem's" if any(k not in cv.SPEED_CLASSES for k in t.index) else "")
         if f"NMSK {c}" in used.restart_used:
-            s = used.solutions[f"NMSK {c}"]
-            src = next(k for k, v in restarts[c].items() if v is s)
+            s, src = used.solutions[f"NMSK {c}"], used.restart_from[f"NMSK {c}"]
             out.append(f"**{c}** (its own run {own}): {len(ok)} of {len(t)} starts from {whence} "
                        f"converge to a valid gait; the lowest objective, from {src}'s solution (COT "
                        f"{s.stats['COT']:.2f} J kg⁻¹ m⁻¹), stands in for it — the same problem, another start "
@@ -1573,7 +1572,9 @@ def minimum_findings(table: pd.DataFrame) -> list[str]:
     measured = table[table["where lowest"] != "too few valid points"]
     if not len(measured):
         return []
-    free = [n + (f", not a U: {r['steps the wrong way (not a U)']}" if r["steps the wrong way (not a U)"] else ", a U")
+    free = [n + (f", not a U: {r['steps the wrong way (not a U)']}" if r["steps the wrong way (not a U)"]
+                 else ", a U" if r["valid points"].split(" of ")[0] == r["valid points"].split(" of ")[1]
+                 else ", U not tested: marked speeds left out")
             for n, r in measured.iterrows() if r["minimum at Free"]]
     unloc = [n for n, r in measured.iterrows() if r["where lowest"].startswith("lowest")]
     other = [f"{n} ({r['where lowest'].removeprefix('minimum at ')})" for n, r in measured.iterrows()
@@ -1611,7 +1612,8 @@ def cot_curve_findings(cot: pd.DataFrame, terms: pd.DataFrame, min_points: int =
         if at == "Free":
             breaks = pr.u_breaks({c: (r["speed (m/s)"], r["total"]) for c, r in terms.iterrows()})
             head += ("; not a U, though: the COT moves the wrong way between " + "; ".join(breaks) + "."
-                     if breaks else ", a U-curve as the thesis reports.")
+                     if breaks else "; whether it is a U is not tested (marked speeds left out)." if len(marked)
+                     else ", a U-curve as the thesis reports.")
     out.insert(0, head)
     if at != "Free" and "Free" in terms.index:
         names = [t for t in ("activation", "maintenance", "shortening", "basal", "work") if t in terms.columns]
